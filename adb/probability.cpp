@@ -1,0 +1,1 @@
+// The ADB probability model lands here.

@@ -1,0 +1,163 @@
+// Bvh<BV>: a flat, pointer-free bounding-volume hierarchy over one mesh.
+#pragma once
+
+#include "bvh/topology.hpp"
+#include "volumes/concept.hpp"
+
+#include <chrono>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+namespace bvhlab {
+
+struct BvhStats {
+  std::size_t nodes = 0;
+  std::size_t leaves = 0;
+  std::uint32_t depth = 0;
+  std::size_t triangles = 0;
+  std::size_t bytes_per_node = 0;  ///< topology + volume, without polygons
+  double bytes_per_triangle = 0;   ///< node bytes / triangles, without polygons
+  double build_seconds = 0;
+};
+
+template <BoundingVolume BV>
+class Bvh {
+ public:
+  using Volume = BV;
+
+  Bvh() = default;
+
+  /// Builds topology, then fits one BV per node. Throws std::invalid_argument on an empty mesh.
+  static Bvh build(const Mesh& mesh, const BuildOptions& options = {}) {
+    const auto start = std::chrono::steady_clock::now();
+    Bvh out;
+    Topology topology = build_topology(mesh, split_directions_of<BV>(), options);
+    out.nodes_ = std::move(topology.nodes);
+    out.triangle_ids_ = std::move(topology.triangle_order);
+    out.triangles_.reserve(out.triangle_ids_.size());
+    for (std::uint32_t id : out.triangle_ids_) out.triangles_.push_back(mesh.triangle(id));
+    out.depth_ = topology.depth;
+    out.leaves_ = topology.leaves;
+    out.fit_volumes(options.threads ? options.threads : std::thread::hardware_concurrency());
+    out.build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  }
+
+  /// Assembles a tree from saved parts (no polygons: triangles may be empty).
+  static Bvh from_parts(std::vector<TreeNode> nodes, std::vector<BV> volumes, std::vector<std::uint32_t> ids,
+                        std::vector<TrianglePoints> triangles = {}) {
+    Bvh out;
+    out.nodes_ = std::move(nodes);
+    out.volumes_ = std::move(volumes);
+    out.triangle_ids_ = std::move(ids);
+    out.triangles_ = std::move(triangles);
+    out.recount();
+    return out;
+  }
+
+  [[nodiscard]] const std::vector<TreeNode>& nodes() const { return nodes_; }
+  [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
+  [[nodiscard]] const TreeNode& node(std::uint32_t i) const { return nodes_[i]; }
+  [[nodiscard]] const BV& volume(std::uint32_t i) const { return volumes_[i]; }
+  /// Triangle vertices in tree order; empty for a tree loaded without polygons.
+  [[nodiscard]] const std::vector<TrianglePoints>& triangles() const { return triangles_; }
+  [[nodiscard]] bool has_polygons() const { return !triangles_.empty(); }
+  /// Tree order -> index of the triangle in the source mesh.
+  [[nodiscard]] const std::vector<std::uint32_t>& triangle_ids() const { return triangle_ids_; }
+  [[nodiscard]] bool empty() const { return nodes_.empty(); }
+
+  [[nodiscard]] BvhStats stats() const {
+    BvhStats s;
+    s.nodes = nodes_.size();
+    s.leaves = leaves_;
+    s.depth = depth_;
+    s.triangles = triangle_ids_.size();
+    s.bytes_per_node = sizeof(TreeNode) + sizeof(BV);
+    s.bytes_per_triangle = s.triangles ? double(s.nodes * s.bytes_per_node) / double(s.triangles) : 0;
+    s.build_seconds = build_seconds_;
+    return s;
+  }
+
+ private:
+  // Each node's BV is fitted to the vertices of all triangles below it (a contiguous range in tree
+  // order), which is tighter than merging children for non-box volumes. Both root subtrees in parallel.
+  void fit_volumes(unsigned threads) {
+    volumes_.assign(nodes_.size(), BV{});
+    ranges_.assign(nodes_.size(), {0, 0});
+    compute_ranges();
+    auto fit_subtree = [this](std::uint32_t root) {
+      std::vector<std::uint32_t> stack{root};
+      std::vector<Vec3> points;
+      while (!stack.empty()) {
+        const std::uint32_t i = stack.back();
+        stack.pop_back();
+        const auto [begin, end] = ranges_[i];
+        points.clear();
+        for (std::uint32_t t = begin; t < end; ++t)
+          for (const auto& v : triangles_[t]) points.push_back(v);
+        volumes_[i] = BV::fit(points);
+        if (!nodes_[i].is_leaf()) {
+          stack.push_back(nodes_[i].left());
+          stack.push_back(nodes_[i].right());
+        }
+      }
+    };
+    if (threads >= 2 && !nodes_[0].is_leaf() && triangles_.size() > 20'000) {
+      volumes_[0] = fit_all(0);
+      std::thread worker(fit_subtree, nodes_[0].left());
+      fit_subtree(nodes_[0].right());
+      worker.join();
+    } else {
+      fit_subtree(0);
+    }
+    ranges_.clear();
+    ranges_.shrink_to_fit();
+  }
+
+  BV fit_all(std::uint32_t i) {
+    std::vector<Vec3> points;
+    for (std::uint32_t t = ranges_[i].first; t < ranges_[i].second; ++t)
+      for (const auto& v : triangles_[t]) points.push_back(v);
+    return BV::fit(points);
+  }
+
+  // Triangle range of every node: leaves know theirs; inner nodes span their children's.
+  void compute_ranges() {
+    // Children are always allocated after their parent, so a reverse sweep sees children first.
+    for (std::size_t k = nodes_.size(); k-- > 0;) {
+      const TreeNode& n = nodes_[k];
+      ranges_[k] = n.is_leaf() ? std::pair{n.first, n.first + n.count}
+                               : std::pair{ranges_[n.left()].first, ranges_[n.right()].second};
+    }
+  }
+
+  void recount() {
+    leaves_ = 0;
+    depth_ = 0;
+    if (nodes_.empty()) return;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0, 0}};
+    while (!stack.empty()) {
+      const auto [i, d] = stack.back();
+      stack.pop_back();
+      depth_ = std::max(depth_, d);
+      if (nodes_[i].is_leaf()) {
+        ++leaves_;
+      } else {
+        stack.push_back({nodes_[i].left(), d + 1});
+        stack.push_back({nodes_[i].right(), d + 1});
+      }
+    }
+  }
+
+  std::vector<TreeNode> nodes_;
+  std::vector<BV> volumes_;
+  std::vector<std::uint32_t> triangle_ids_;
+  std::vector<TrianglePoints> triangles_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges_;
+  std::uint32_t depth_ = 0;
+  std::size_t leaves_ = 0;
+  double build_seconds_ = 0;
+};
+
+}  // namespace bvhlab

@@ -1,0 +1,32 @@
+// A triangle mesh as plain arrays: the one input type of every builder and tool.
+#pragma once
+
+#include "volumes/geometry.hpp"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+
+using TriangleIndices = std::array<std::uint32_t, 3>;
+
+struct Mesh {
+  std::vector<Vec3> vertices;
+  std::vector<TriangleIndices> triangles;
+  std::string name;  ///< file stem or caller-given label, used in reports
+
+  [[nodiscard]] std::size_t triangle_count() const { return triangles.size(); }
+  [[nodiscard]] TrianglePoints triangle(std::size_t i) const {
+    const auto& t = triangles[i];
+    return {vertices[t[0]], vertices[t[1]], vertices[t[2]]};
+  }
+  [[nodiscard]] Box bounds() const {
+    Box b;
+    for (const auto& v : vertices) b.extend(v);
+    return b;
+  }
+};
+
+}  // namespace bvhlab

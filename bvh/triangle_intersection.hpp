@@ -1,0 +1,14 @@
+// Exact triangle-triangle intersection (closed triangles: touching counts as intersecting).
+#pragma once
+
+#include "volumes/geometry.hpp"
+
+namespace bvhlab {
+
+/// Fast test; agrees with triangles_intersect_exact on every input, degenerate triangles included.
+bool triangles_intersect(const TrianglePoints& p, const TrianglePoints& q);
+
+/// Ground truth: CGAL's exact predicates (Epick); degenerate triangles become segments or points.
+bool triangles_intersect_exact(const TrianglePoints& p, const TrianglePoints& q);
+
+}  // namespace bvhlab

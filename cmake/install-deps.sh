@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs the Debian packages bvhlab needs, and only the missing ones.
+# As root: `apt-get update` once, then `apt-get install -y` of exactly those.
+# Otherwise: prints the command to run and fails, so `make` stops.
+set -euo pipefail
+packages=(build-essential cmake libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libassimp-dev
+          libbenchmark-dev libgtest-dev libfcl-dev libcli11-dev nlohmann-json3-dev libfmt-dev
+          python3 python3-matplotlib ca-certificates)
+# Used only by the optional fetch of larger meshes (apt-get download, npm pack) and by the fuzzers.
+packages+=(npm clang libclang-rt-14-dev)
+if [ -n "${BVHLAB_EXTRA_PACKAGES:-}" ]; then read -r -a extra <<<"$BVHLAB_EXTRA_PACKAGES"; packages+=("${extra[@]}"); fi
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
+  [ "$status" = "installed" ] || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "bvhlab: missing Debian packages: ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "bvhlab: run as root:  apt-get update && apt-get install -y ${missing[*]}" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+apt-get update
+apt-get install -y --no-install-recommends "${missing[@]}"

@@ -1,0 +1,90 @@
+// Basic geometric vocabulary shared by every layer: points, boxes, rigid transforms.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace bvhlab {
+
+// Double precision throughout: the benchmark protocol normalises meshes to [-1, 1]^3, but the stiff-case
+// suite translates them by up to 1e9, where float's 24-bit mantissa cannot even separate vertices.
+using Scalar = double;
+using Vec3 = Eigen::Matrix<Scalar, 3, 1>;
+using Mat3 = Eigen::Matrix<Scalar, 3, 3>;
+using TrianglePoints = std::array<Vec3, 3>;
+
+/// Axis-aligned box as plain data. An empty box has min > max on every axis.
+struct Box {
+  Vec3 min = Vec3::Constant(std::numeric_limits<Scalar>::infinity());
+  Vec3 max = Vec3::Constant(-std::numeric_limits<Scalar>::infinity());
+
+  [[nodiscard]] bool empty() const { return (min.array() > max.array()).any(); }
+  void extend(const Vec3& p) {
+    min = min.cwiseMin(p);
+    max = max.cwiseMax(p);
+  }
+  void extend(const Box& b) {
+    min = min.cwiseMin(b.min);
+    max = max.cwiseMax(b.max);
+  }
+  [[nodiscard]] Vec3 center() const { return (min + max) * Scalar(0.5); }
+  [[nodiscard]] Vec3 extent() const { return max - min; }
+  [[nodiscard]] Scalar volume() const { return empty() ? Scalar(0) : extent().prod(); }
+  [[nodiscard]] bool contains(const Vec3& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+  [[nodiscard]] bool overlaps(const Box& o) const {
+    return (min.array() <= o.max.array()).all() && (o.min.array() <= max.array()).all();
+  }
+};
+
+/// Rigid motion x -> R x + t. R must be a proper rotation; `checked` enforces it for caller input.
+struct RigidTransform {
+  Mat3 rotation = Mat3::Identity();
+  Vec3 translation = Vec3::Zero();
+
+  [[nodiscard]] Vec3 apply(const Vec3& p) const { return rotation * p + translation; }
+  [[nodiscard]] RigidTransform inverse() const {
+    RigidTransform inv;
+    inv.rotation = rotation.transpose();
+    inv.translation = -(inv.rotation * translation);
+    return inv;
+  }
+  /// (this * other)(x) = this(other(x)).
+  [[nodiscard]] RigidTransform operator*(const RigidTransform& other) const {
+    RigidTransform out;
+    out.rotation = rotation * other.rotation;
+    out.translation = rotation * other.translation + translation;
+    return out;
+  }
+
+  static RigidTransform identity() { return {}; }
+  static RigidTransform translate(const Vec3& t) {
+    RigidTransform out;
+    out.translation = t;
+    return out;
+  }
+
+  /// Validates caller input: finite entries, R^T R = I and det R = +1 within `tolerance`.
+  /// Throws std::invalid_argument naming the defect; never returns a non-rigid transform.
+  static RigidTransform checked(const Mat3& rotation, const Vec3& translation, Scalar tolerance = 1e-9) {
+    if (!rotation.allFinite()) throw std::invalid_argument("transform: rotation has a NaN or infinite entry");
+    if (!translation.allFinite())
+      throw std::invalid_argument("transform: translation has a NaN or infinite entry");
+    const Scalar orthogonality = (rotation.transpose() * rotation - Mat3::Identity()).cwiseAbs().maxCoeff();
+    if (orthogonality > tolerance)
+      throw std::invalid_argument("transform: rotation is not orthonormal (max |R^T R - I| = " +
+                                  std::to_string(orthogonality) + ")");
+    if (rotation.determinant() < 0)
+      throw std::invalid_argument("transform: rotation is a reflection (det R = -1), not a rigid motion");
+    return RigidTransform{rotation, translation};
+  }
+};
+
+}  // namespace bvhlab
