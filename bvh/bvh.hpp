@@ -53,6 +53,7 @@ class Bvh {
     out.triangle_ids_ = std::move(ids);
     out.triangles_ = std::move(triangles);
     out.recount();
+    out.compute_sizes();
     return out;
   }
 
@@ -60,6 +61,8 @@ class Bvh {
   [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
   [[nodiscard]] const TreeNode& node(std::uint32_t i) const { return nodes_[i]; }
   [[nodiscard]] const BV& volume(std::uint32_t i) const { return volumes_[i]; }
+  /// Measure of node i's volume, cached: traversals descend into the larger of two nodes.
+  [[nodiscard]] float size(std::uint32_t i) const { return sizes_[i]; }
   /// Triangle vertices in tree order; empty for a tree loaded without polygons.
   [[nodiscard]] const std::vector<TrianglePoints>& triangles() const { return triangles_; }
   [[nodiscard]] bool has_polygons() const { return !triangles_.empty(); }
@@ -113,6 +116,12 @@ class Bvh {
     }
     ranges_.clear();
     ranges_.shrink_to_fit();
+    compute_sizes();
+  }
+
+  void compute_sizes() {
+    sizes_.resize(volumes_.size());
+    for (std::size_t i = 0; i < volumes_.size(); ++i) sizes_[i] = static_cast<float>(volumes_[i].volume());
   }
 
   BV fit_all(std::uint32_t i) {
@@ -152,6 +161,7 @@ class Bvh {
 
   std::vector<TreeNode> nodes_;
   std::vector<BV> volumes_;
+  std::vector<float> sizes_;
   std::vector<std::uint32_t> triangle_ids_;
   std::vector<TrianglePoints> triangles_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges_;

@@ -1,0 +1,47 @@
+// Result: the one currency of every strategy. Tests, benchmarks and the report read only this.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace bvhlab {
+
+/// Work done by one query. All strategies fill what applies to them.
+struct Counters {
+  std::uint64_t bv_tests = 0;        ///< BV-pair overlap tests
+  std::uint64_t triangle_tests = 0;  ///< exact triangle-pair tests
+  std::uint64_t nodes_visited = 0;   ///< node pairs taken off the stack or queue
+  std::uint64_t probability_evaluations = 0;
+
+  Counters& operator+=(const Counters& o) {
+    bv_tests += o.bv_tests;
+    triangle_tests += o.triangle_tests;
+    nodes_visited += o.nodes_visited;
+    probability_evaluations += o.probability_evaluations;
+    return *this;
+  }
+};
+
+/// A pair of intersecting triangles, as indices into the source meshes of A and B.
+struct TrianglePair {
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+  friend bool operator==(const TrianglePair&, const TrianglePair&) = default;
+  friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
+};
+
+struct Result {
+  bool collides = false;
+  /// Estimated probability of collision; exactly 1 or 0 when `exact`.
+  double probability = 0;
+  /// True when the answer is decided by exact triangle tests (or by exhausting all overlapping pairs).
+  bool exact = true;
+  /// True when a time or BV-test budget ran out and the answer is a best effort.
+  bool budget_exhausted = false;
+  std::optional<TrianglePair> witness;  ///< set by exact strategies when collides
+  std::vector<TrianglePair> contacts;   ///< all-contacts mode only
+  Counters counters;
+};
+
+}  // namespace bvhlab
