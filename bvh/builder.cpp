@@ -11,7 +11,9 @@
 
 namespace bvhlab {
 
-std::string_view to_string(SplitMethod m) { return m == SplitMethod::Median ? "median" : "sah"; }
+std::string_view to_string(SplitMethod m) {
+  return m == SplitMethod::Median ? "median" : "sah";
+}
 
 SplitMethod split_method_from_string(std::string_view s) {
   if (s == "median") return SplitMethod::Median;
@@ -231,13 +233,33 @@ class Builder {
 
 }  // namespace
 
-Topology build_topology(const Mesh& mesh, std::span<const Vec3> split_directions, const BuildOptions& options) {
+std::vector<std::pair<std::uint32_t, std::uint32_t>> node_triangle_ranges(std::span<const TreeNode> nodes) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(nodes.size());
+  // Children are stored after their parent, so a reverse sweep sees children first.
+  for (std::size_t k = nodes.size(); k-- > 0;) {
+    const TreeNode& n = nodes[k];
+    if (n.is_leaf()) {
+      ranges[k] = {n.first, n.first + n.count};
+    } else {
+      if (n.first <= k || std::size_t{n.first} + 1 >= nodes.size())
+        throw std::invalid_argument("tree: node " + std::to_string(k) + " has a child index out of order");
+      ranges[k] = {ranges[n.left()].first, ranges[n.right()].second};
+    }
+  }
+  return ranges;
+}
+
+Topology build_topology(const Mesh& mesh, std::span<const Vec3> split_directions,
+                        const BuildOptions& options) {
   if (mesh.triangles.empty()) throw std::invalid_argument("build: mesh '" + mesh.name + "' has no triangles");
-  if (options.max_leaf_triangles == 0) throw std::invalid_argument("build: max_leaf_triangles must be at least 1");
+  if (options.max_leaf_triangles == 0)
+    throw std::invalid_argument("build: max_leaf_triangles must be at least 1");
   if (split_directions.empty()) throw std::invalid_argument("build: no split directions");
   if (mesh.triangles.size() >= std::numeric_limits<std::uint32_t>::max() / 2)
-    throw std::invalid_argument("build: mesh '" + mesh.name + "' has too many triangles for 32-bit node indices");
-  const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    throw std::invalid_argument("build: mesh '" + mesh.name +
+                                "' has too many triangles for 32-bit node indices");
+  const unsigned threads =
+      options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   Builder builder(mesh, split_directions, options);
   return builder.run(threads);
 }

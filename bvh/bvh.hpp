@@ -87,19 +87,20 @@ class Bvh {
   // order), which is tighter than merging children for non-box volumes. Both root subtrees in parallel.
   void fit_volumes(unsigned threads) {
     volumes_.assign(nodes_.size(), BV{});
-    ranges_.assign(nodes_.size(), {0, 0});
-    compute_ranges();
-    auto fit_subtree = [this](std::uint32_t root) {
-      std::vector<std::uint32_t> stack{root};
+    const auto ranges = node_triangle_ranges(nodes_);
+    auto fit_range = [this, &ranges](std::uint32_t i) {
       std::vector<Vec3> points;
+      points.reserve(3 * (ranges[i].second - ranges[i].first));
+      for (std::uint32_t t = ranges[i].first; t < ranges[i].second; ++t)
+        for (const auto& v : triangles_[t]) points.push_back(v);
+      return BV::fit(points);
+    };
+    auto fit_subtree = [&](std::uint32_t root) {
+      std::vector<std::uint32_t> stack{root};
       while (!stack.empty()) {
         const std::uint32_t i = stack.back();
         stack.pop_back();
-        const auto [begin, end] = ranges_[i];
-        points.clear();
-        for (std::uint32_t t = begin; t < end; ++t)
-          for (const auto& v : triangles_[t]) points.push_back(v);
-        volumes_[i] = BV::fit(points);
+        volumes_[i] = fit_range(i);
         if (!nodes_[i].is_leaf()) {
           stack.push_back(nodes_[i].left());
           stack.push_back(nodes_[i].right());
@@ -107,38 +108,19 @@ class Bvh {
       }
     };
     if (threads >= 2 && !nodes_[0].is_leaf() && triangles_.size() > 20'000) {
-      volumes_[0] = fit_all(0);
+      volumes_[0] = fit_range(0);
       std::thread worker(fit_subtree, nodes_[0].left());
       fit_subtree(nodes_[0].right());
       worker.join();
     } else {
       fit_subtree(0);
     }
-    ranges_.clear();
-    ranges_.shrink_to_fit();
     compute_sizes();
   }
 
   void compute_sizes() {
     sizes_.resize(volumes_.size());
     for (std::size_t i = 0; i < volumes_.size(); ++i) sizes_[i] = static_cast<float>(volumes_[i].volume());
-  }
-
-  BV fit_all(std::uint32_t i) {
-    std::vector<Vec3> points;
-    for (std::uint32_t t = ranges_[i].first; t < ranges_[i].second; ++t)
-      for (const auto& v : triangles_[t]) points.push_back(v);
-    return BV::fit(points);
-  }
-
-  // Triangle range of every node: leaves know theirs; inner nodes span their children's.
-  void compute_ranges() {
-    // Children are always allocated after their parent, so a reverse sweep sees children first.
-    for (std::size_t k = nodes_.size(); k-- > 0;) {
-      const TreeNode& n = nodes_[k];
-      ranges_[k] = n.is_leaf() ? std::pair{n.first, n.first + n.count}
-                               : std::pair{ranges_[n.left()].first, ranges_[n.right()].second};
-    }
   }
 
   void recount() {
@@ -164,7 +146,6 @@ class Bvh {
   std::vector<float> sizes_;
   std::vector<std::uint32_t> triangle_ids_;
   std::vector<TrianglePoints> triangles_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges_;
   std::uint32_t depth_ = 0;
   std::size_t leaves_ = 0;
   double build_seconds_ = 0;

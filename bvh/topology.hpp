@@ -45,8 +45,13 @@ struct Topology {
   std::uint32_t leaves = 0;
 };
 
+/// [begin, end) of every node's triangles in tree order (a subtree's triangles are contiguous).
+/// Requires children to be stored after their parent, as build_topology does; throws otherwise.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> node_triangle_ranges(std::span<const TreeNode> nodes);
+
 /// Builds the topology over the triangles' centroids, trying the given split directions.
 /// Throws std::invalid_argument for an empty mesh or max_leaf_triangles == 0.
-Topology build_topology(const Mesh& mesh, std::span<const Vec3> split_directions, const BuildOptions& options);
+Topology build_topology(const Mesh& mesh, std::span<const Vec3> split_directions,
+                        const BuildOptions& options);
 
 }  // namespace bvhlab
