@@ -1,0 +1,168 @@
+// The exact-query protocol (ADB-METHOD.md section 4) as Google Benchmark suites: mesh x BV x distance,
+// with FCL 0.7's OBB and OBBRSS on the same meshes and poses in the same binary, so ratios come from one run.
+//
+//   bench_protocol [--meshes=a.stl,b.obj] [--steps=500] [--volumes=aabb,dop24] [benchmark flags]
+//
+// Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
+// protocol's mean time per query. Counters: BV tests and triangle tests per query, bytes per triangle.
+#include "bench/core/mesh_catalog.hpp"
+#include "bench/core/protocol.hpp"
+#include "bench/core/registry.hpp"
+#include "traversal/exact.hpp"
+
+#include <benchmark/benchmark.h>
+#ifdef BVHLAB_HAVE_FCL
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/narrowphase/collision.h>
+#endif
+
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+namespace {
+
+struct PoseSet {
+  std::string label;  // distance, or "all"
+  std::vector<RigidTransform> poses;
+};
+
+std::vector<PoseSet> make_pose_sets(int steps) {
+  std::vector<PoseSet> sets;
+  PoseSet all{"all", {}};
+  for (double d : ProtocolOptions{}.distances) {
+    char label[16];
+    std::snprintf(label, sizeof label, "%.1f", d);
+    sets.push_back({label, protocol_poses(d, steps)});
+    all.poses.insert(all.poses.end(), sets.back().poses.begin(), sets.back().poses.end());
+  }
+  sets.push_back(std::move(all));
+  return sets;
+}
+
+void set_per_query_counters(benchmark::State& state, std::size_t queries, const Counters& per_pass,
+                            std::size_t colliding, double bytes_per_triangle) {
+  const double n = static_cast<double>(queries);
+  state.counters["time_per_query"] =
+      benchmark::Counter(n, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["bv_tests"] = static_cast<double>(per_pass.bv_tests) / n;
+  state.counters["tri_tests"] = static_cast<double>(per_pass.triangle_tests) / n;
+  state.counters["colliding"] = static_cast<double>(colliding) / n;
+  if (bytes_per_triangle > 0) state.counters["bytes_per_tri"] = bytes_per_triangle;
+}
+
+template <class BV>
+void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
+                     const std::vector<PoseSet>& sets) {
+  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
+  for (const auto& set : sets) {
+    const std::string name = "exact/" + mesh_name + "/" + std::string(BV::name()) + "/d:" + set.label;
+    benchmark::RegisterBenchmark(name.c_str(), [tree, &set](benchmark::State& state) {
+      Counters pass;
+      std::size_t colliding = 0;
+      for (auto _ : state) {
+        pass = {};
+        colliding = 0;
+        for (const auto& pose : set.poses) {
+          const Result r = query_exact(*tree, *tree, pose);
+          pass += r.counters;
+          colliding += r.collides;
+        }
+        benchmark::DoNotOptimize(colliding);
+      }
+      set_per_query_counters(state, set.poses.size(), pass, colliding, tree->stats().bytes_per_triangle);
+    })->Unit(benchmark::kMillisecond);
+  }
+}
+
+#ifdef BVHLAB_HAVE_FCL
+template <class FclBV>
+void register_fcl(const std::string& mesh_name, const std::string& bv_name,
+                  const std::shared_ptr<const Mesh>& mesh, const std::vector<PoseSet>& sets) {
+  auto model = std::make_shared<fcl::BVHModel<FclBV>>();
+  std::vector<fcl::Vector3d> points(mesh->vertices.begin(), mesh->vertices.end());
+  std::vector<fcl::Triangle> triangles;
+  for (const auto& t : mesh->triangles) triangles.emplace_back(t[0], t[1], t[2]);
+  model->beginModel();
+  model->addSubModel(points, triangles);
+  model->endModel();
+  for (const auto& set : sets) {
+    const std::string name = "fcl/" + mesh_name + "/" + bv_name + "/d:" + set.label;
+    benchmark::RegisterBenchmark(name.c_str(), [model, &set](benchmark::State& state) {
+      const fcl::CollisionRequestd request(1, false);
+      std::size_t colliding = 0;
+      for (auto _ : state) {
+        colliding = 0;
+        for (const auto& pose : set.poses) {
+          fcl::Transform3d tf = fcl::Transform3d::Identity();
+          tf.linear() = pose.rotation;
+          tf.translation() = pose.translation;
+          fcl::CollisionResultd result;
+          fcl::collide(model.get(), fcl::Transform3d::Identity(), model.get(), tf, request, result);
+          colliding += result.isCollision();
+        }
+        benchmark::DoNotOptimize(colliding);
+      }
+      set_per_query_counters(state, set.poses.size(), {}, colliding, 0);
+    })->Unit(benchmark::kMillisecond);
+  }
+}
+#endif
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+}  // namespace
+}  // namespace bvhlab
+
+int main(int argc, char** argv) {
+  using namespace bvhlab;
+  benchmark::Initialize(&argc, argv);
+  std::vector<std::string> meshes{"injector_pipes.stl", "occt_tr12j_housing.stl", "jeep1.ms3d", "bunny.obj"};
+  std::vector<std::string> volumes = volume_names();
+  int steps = 500;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--meshes=", 0) == 0)
+      meshes = split_list(arg.substr(9));
+    else if (arg.rfind("--volumes=", 0) == 0)
+      volumes = split_list(arg.substr(10));
+    else if (arg.rfind("--steps=", 0) == 0)
+      steps = std::stoi(arg.substr(8));
+    else {
+      std::fprintf(stderr, "bench_protocol: unknown argument '%s'\n", arg.c_str());
+      return 2;
+    }
+  }
+  if (steps < 1) {
+    std::fprintf(stderr, "bench_protocol: --steps must be at least 1\n");
+    return 2;
+  }
+  static const std::vector<PoseSet> sets = make_pose_sets(steps);
+  for (const auto& file : meshes) {
+    if (!find_mesh(file)) {
+      std::fprintf(stderr, "bench_protocol: skipping %s (not found; run meshes/fetch.sh)\n", file.c_str());
+      continue;
+    }
+    const auto mesh = std::make_shared<const Mesh>(load_protocol_mesh(file));
+    const std::string label = std::filesystem::path(file).stem().string();
+    for (const auto& v : volumes)
+      with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_bvhlab<BV>(label, mesh, sets); });
+#ifdef BVHLAB_HAVE_FCL
+    register_fcl<fcl::OBBd>(label, "fcl_obb", mesh, sets);
+    register_fcl<fcl::OBBRSSd>(label, "fcl_obbrss", mesh, sets);
+#endif
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

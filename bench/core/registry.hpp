@@ -1,0 +1,48 @@
+// The one place where run-time names meet compile-time BV policies. A new bounding volume is named
+// here (one line) and nowhere else outside its own header; tools instantiate only what they are asked for.
+#pragma once
+
+#include "volumes/aabb.hpp"
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bvhlab {
+
+template <class... Ts>
+struct TypeList {};
+
+using RegisteredVolumes = TypeList<Aabb>;
+
+/// Calls f(std::type_identity<BV>{}) for the BV whose name() is `name`; throws naming the choices.
+template <class F, class... BVs>
+decltype(auto) with_volume_impl(std::string_view name, F&& f, TypeList<BVs...>) {
+  using R = decltype(f(std::type_identity<Aabb>{}));
+  if constexpr (std::is_void_v<R>) {
+    bool found = false;
+    ((found = found || (BVs::name() == name ? (f(std::type_identity<BVs>{}), true) : false)), ...);
+    if (!found) throw std::invalid_argument("unknown bounding volume '" + std::string(name) + "'");
+  } else {
+    std::optional<R> out;
+    ((out || BVs::name() != name ? void() : void(out.emplace(f(std::type_identity<BVs>{})))), ...);
+    if (!out) throw std::invalid_argument("unknown bounding volume '" + std::string(name) + "'");
+    return *out;
+  }
+}
+template <class F>
+decltype(auto) with_volume(std::string_view name, F&& f) {
+  return with_volume_impl(name, std::forward<F>(f), RegisteredVolumes{});
+}
+
+template <class... BVs>
+std::vector<std::string> volume_names_impl(TypeList<BVs...>) {
+  return {std::string(BVs::name())...};
+}
+inline std::vector<std::string> volume_names() {
+  return volume_names_impl(RegisteredVolumes{});
+}
+
+}  // namespace bvhlab
