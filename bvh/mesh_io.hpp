@@ -13,20 +13,36 @@
 
 namespace bvhlab {
 
-/// Thrown for any input the library refuses; what() names the file and the problem.
+/// Thrown for any input the library refuses; what() is "<file or name>: <problem>".
 class MeshError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
+/// Precision limits the loader enforces (see load_mesh).
+struct MeshPrecisionLimits {
+  /// Coordinates beyond this are refused: there a double's spacing exceeds 0.1, so even unit-sized features
+  /// are no longer representable.
+  static constexpr double max_abs_coordinate = 1e15;
+  /// A bounding-box diagonal below this (or zero) is refused: the model has no usable size.
+  static constexpr double min_diagonal = 1e-300;
+  /// Warn when max|coordinate| / diagonal exceeds this: the spacing of doubles near the largest coordinate is
+  /// then above ratio * 1.1e-16 of the model size, i.e. above ~1e-10, close to the ~1e-9 relative detail the
+  /// exact queries are expected to resolve.
+  static constexpr double warn_offset_ratio = 1e6;
+};
+
 /// What the loader saw, for reports and the `info` command.
 struct LoadReport {
-  std::string source;                  ///< file path or caller-given name
-  std::size_t submeshes = 0;           ///< merged into one Mesh
-  std::size_t input_vertices = 0;      ///< before identical vertices were joined
-  std::size_t degenerate_triangles = 0;///< zero area: kept (they can still touch), counted here
+  std::string source;              ///< file path or caller-given name
+  std::size_t submeshes = 0;       ///< sub-mesh instances (after node instancing) merged into one Mesh
+  std::size_t input_vertices = 0;  ///< vertices used by triangles, before identical ones were joined
+  std::size_t degenerate_triangles =
+      0;                           ///< repeated vertex or exactly collinear: kept (they can still touch)
+  std::size_t ignored_points = 0;  ///< point primitives: not part of a triangle mesh, dropped
+  std::size_t ignored_lines = 0;   ///< line primitives: dropped likewise
   Box bounds;
-  std::vector<std::string> warnings;   ///< e.g. coordinates too large for the query precision
+  std::vector<std::string> warnings;  ///< e.g. coordinates too large for the query precision, assimp warnings
 };
 
 struct LoadedMesh {
@@ -34,14 +50,23 @@ struct LoadedMesh {
   LoadReport report;
 };
 
-/// Loads and validates a mesh file; throws MeshError.
+/// Loads and validates a mesh file in any format assimp reads (OBJ, PLY, STL, OFF, MS3D, glTF, ...).
+/// All sub-meshes are merged with their scene-graph transforms applied, polygons triangulated, vertices with
+/// exactly equal positions joined (across sub-meshes too), point and line primitives dropped and counted.
+/// Mesh::name is the file stem. Coordinates pass through assimp's float (ai_real) before becoming double.
+/// Throws MeshError for: a missing, unreadable or empty file; an unknown format; any assimp failure; no
+/// triangles; a NaN or infinite coordinate; an out-of-range index (also when assimp only logs it and
+/// substitutes another vertex); coordinates beyond MeshPrecisionLimits; a zero-size model.
 LoadedMesh load_mesh(const std::filesystem::path& path);
-/// Same from a memory buffer; `format_hint` is a file extension such as "obj" or "ply".
+/// Same from a memory buffer; `format_hint` is a file extension such as "obj" or "ply" (leading dot allowed).
+/// Mesh::name is the stem of `name`. Formats that refer to side files (OBJ's .mtl, glTF's .bin) cannot
+/// resolve them from memory.
 LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_view format_hint,
                                  std::string_view name = "<memory>");
 
 /// The protocol normalisation (ADB-METHOD.md section 4): bounding-box centre to the origin, uniform scale
-/// so the longest bounding-box side is 2. Returns the applied scale. Throws MeshError on an empty or flat-zero mesh.
+/// so the longest bounding-box side is 2. Returns the applied scale. Throws MeshError on an empty mesh, a
+/// non-finite coordinate or a zero-size bounding box.
 double normalize_to_unit_cube(Mesh& mesh);
 
 }  // namespace bvhlab

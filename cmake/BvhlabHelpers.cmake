@@ -13,18 +13,31 @@ function(bvhlab_folder_includes target scope)
     $<INSTALL_INTERFACE:include/bvhlab>)
 endfunction()
 
-# bvhlab_add_test(NAME name SOURCES a.cpp ... [LIBS ...] [LABELS ...] [TIMEOUT s])
+# bvhlab_add_test(NAME name SOURCES a.cpp ... [LIBS ...] [LABELS ...] [TIMEOUT s] [NEEDS_MESHES])
 # One GoogleTest executable; each TEST is a separate ctest entry so ctest -j spreads them.
+# NEEDS_MESHES: the tests read fetched meshes, so they require the ctest fixture `meshes` (cmake/Meshes.cmake).
 function(bvhlab_add_test)
-  cmake_parse_arguments(T "" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(T "NEEDS_MESHES" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main bvhlab_warnings)
   target_include_directories(${T_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 600)
   endif()
-  gtest_discover_tests(${T_NAME}
-    PROPERTIES LABELS "unit;${T_LABELS}" TIMEOUT ${T_TIMEOUT}
-               ENVIRONMENT "BVHLAB_SOURCE_DIR=${PROJECT_SOURCE_DIR};BVHLAB_MESH_CACHE=${BVHLAB_MESH_CACHE}"
-    DISCOVERY_TIMEOUT 60)
+  gtest_discover_tests(${T_NAME} DISCOVERY_TIMEOUT 60)
+  # The properties go into a script ctest includes after the discovered tests, not into
+  # gtest_discover_tests(PROPERTIES): that flattens list values ("unit;bvh", two ENVIRONMENT entries) into the
+  # name/value pairs, so labels, timeout and environment were silently lost.
+  string(JOIN ";" labels unit ${T_LABELS})
+  set(properties "LABELS [==[${labels}]==] TIMEOUT ${T_TIMEOUT} ENVIRONMENT [==[BVHLAB_SOURCE_DIR=")
+  string(APPEND properties "${PROJECT_SOURCE_DIR};BVHLAB_MESH_CACHE=${BVHLAB_MESH_CACHE}]==]")
+  if(T_NEEDS_MESHES)
+    string(APPEND properties " FIXTURES_REQUIRED meshes")
+  endif()
+  set(script "${CMAKE_CURRENT_BINARY_DIR}/${T_NAME}_properties.cmake")
+  file(WRITE "${script}"
+       "if(NOT \"\${${T_NAME}_TESTS}\" STREQUAL \"\")\n"
+       "  set_tests_properties(\${${T_NAME}_TESTS} PROPERTIES ${properties})\n"
+       "endif()\n")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${script}")
 endfunction()
