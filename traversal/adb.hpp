@@ -1,0 +1,282 @@
+// ADB traversal (ADB-METHOD.md section 3): best-first descent ordered by the estimated probability that
+// a BV pair holds intersecting polygons. One loop, parameterised by options, serves three strategies:
+//   - probability-guided with p_min: answer "collision" as soon as a pair's estimate exceeds p_min;
+//   - time-critical: the same, under a budget of BV tests and/or a deadline; on exhaustion, a best effort;
+//   - guided exact: the same order, but leaf pairs run exact triangle tests and nothing is pruned by
+//     probability, so the answer is exact.
+//
+// Decisions (see README, "Method"):
+//   * Vol(A ∩ B) is the volume of the intersection of A's bounding box with B's bounding box re-boxed in
+//     A's frame (centre R c + t, half-extents |R| h). It over-estimates the true overlap for rotated pairs,
+//     which errs toward "collision" (false positives, not false negatives).
+//   * Cells: each node's grid lies on its bounding box, so its cell volume is Vol(box) / g^3. Differently
+//     sized BVs are mapped onto the coarser cell volume c = max(c_A, c_B): s = Vol(A ∩ B) / c, and the finer
+//     side's expected count is scaled by (c_fine / c)^(2/3), the square of the cell side ratio, because
+//     possible collision cells hold surface. For equal sizes the factor is 1: the paper's case.
+//   * Rounding: s is rounded up (at least 1 when the volumes overlap, at most g^3); the fractional s_A, s_B
+//     are interpolated bilinearly between the table's integer entries, so a query still does no
+//     transcendental math and a small expected count is not rounded away to a probability of 0.
+#pragma once
+
+#include "adb/lb_table.hpp"
+#include "adb/probability.hpp"
+#include "adb/tree.hpp"
+#include "bvh/triangle_intersection.hpp"
+#include "traversal/result.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <queue>
+#include <stdexcept>
+#include <vector>
+
+namespace bvhlab {
+
+/// Limits for time-critical queries. Zero means "no limit".
+struct Budget {
+  std::uint64_t max_bv_tests = 0;  ///< hard cap on BV-pair tests (never exceeded)
+  double deadline_us = 0;          ///< wall-clock limit, checked every few node pairs
+  [[nodiscard]] bool unlimited() const { return max_bv_tests == 0 && deadline_us <= 0; }
+};
+
+struct AdbOptions {
+  double p_min = 0.9;  ///< answer "collision" once a pair's estimate exceeds this
+  Budget budget;
+  /// On budget exhaustion: "collision" iff the highest probability still queued is at least this.
+  double best_effort_threshold = 0.5;
+  /// Guided exact: leaf pairs run exact triangle tests, no pruning by probability; the answer is exact.
+  bool exact_leaves = false;
+
+  /// Throws std::invalid_argument for nonsense values (NaN, outside [0, 1], negative deadline).
+  void validate() const {
+    if (!(p_min >= 0 && p_min <= 1)) throw std::invalid_argument("adb: p_min must lie in [0, 1]");
+    if (!(best_effort_threshold >= 0 && best_effort_threshold <= 1))
+      throw std::invalid_argument("adb: best_effort_threshold must lie in [0, 1]");
+    if (!(budget.deadline_us >= 0)) throw std::invalid_argument("adb: deadline must be >= 0 microseconds");
+  }
+};
+
+/// The probability model for one (grid, tau): the lookup table over (s, s_A, s_B). Built once, shared
+/// read-only by any number of queries and threads.
+class AdbModel {
+ public:
+  AdbModel(int grid, double tau) : grid_(grid), tau_(tau), table_(grid * grid * grid, lb_for_tau(tau)) {}
+
+  [[nodiscard]] int grid() const { return grid_; }
+  [[nodiscard]] double tau() const { return tau_; }
+  [[nodiscard]] const ProbabilityTable& table() const { return table_; }
+
+  /// The estimate for a BV pair from the boxes' volumes, the overlap volume and the pc counts.
+  [[nodiscard]] double estimate(double volume_a, double volume_b, double overlap, int pc_a, int pc_b) const {
+    if (!(overlap > 0) || pc_a == 0 || pc_b == 0) return 0;
+    const int cells = grid_ * grid_ * grid_;
+    const double cell_a = volume_a / cells, cell_b = volume_b / cells;
+    const double coarse = std::max(cell_a, cell_b);
+    if (!(coarse > 0)) return 0;
+    // Expected possible-collision cells in the overlap, in each node's own cells...
+    double s_a = pc_a * std::min(1.0, overlap / volume_a);
+    double s_b = pc_b * std::min(1.0, overlap / volume_b);
+    // ...mapped onto the coarser cells: a surface's cell count scales with the square of the side ratio.
+    if (cell_a < coarse) s_a *= std::cbrt(cell_a / coarse) * std::cbrt(cell_a / coarse);
+    if (cell_b < coarse) s_b *= std::cbrt(cell_b / coarse) * std::cbrt(cell_b / coarse);
+    const int s = std::clamp(static_cast<int>(std::ceil(overlap / coarse - 1e-9)), 1, cells);
+    s_a = std::min(s_a, double(s));
+    s_b = std::min(s_b, double(s));
+    return interpolate(s, s_a, s_b);
+  }
+
+ private:
+  [[nodiscard]] double interpolate(int s, double s_a, double s_b) const {
+    const int a0 = static_cast<int>(s_a), b0 = static_cast<int>(s_b);
+    const int a1 = std::min(a0 + 1, s), b1 = std::min(b0 + 1, s);
+    const double fa = s_a - a0, fb = s_b - b0;
+    const double p00 = table_.lookup(s, a0, b0), p10 = table_.lookup(s, a1, b0);
+    const double p01 = table_.lookup(s, a0, b1), p11 = table_.lookup(s, a1, b1);
+    return (1 - fa) * ((1 - fb) * p00 + fb * p01) + fa * ((1 - fb) * p10 + fb * p11);
+  }
+
+  int grid_;
+  double tau_;
+  ProbabilityTable table_;
+};
+
+namespace detail {
+
+/// Volume of A's box ∩ (B's box re-boxed in A's frame).
+inline double overlap_volume(const Box& a, const Box& b, const Mat3& rotation, const Mat3& abs_rotation,
+                             const Vec3& translation) {
+  if (a.empty() || b.empty()) return 0;
+  const Vec3 center = rotation * b.center() + translation;
+  const Vec3 half = abs_rotation * (b.extent() * 0.5);
+  const Vec3 lo = a.min.cwiseMax(center - half), hi = a.max.cwiseMin(center + half);
+  const Vec3 edge = (hi - lo).cwiseMax(0.0);
+  return edge.prod();
+}
+
+struct QueuedPair {
+  double probability;
+  std::uint32_t a, b;
+  bool operator<(const QueuedPair& o) const { return probability < o.probability; }
+};
+
+}  // namespace detail
+
+/// Shapes the answer once the loop ends without a decisive pair: exhausted budget or empty queue.
+template <class Queue>
+Result& finish_adb(Result& result, const Queue& queue, const AdbOptions& options, bool budget_hit,
+                   bool dropped_possible_contact, double best_dropped) {
+  if (result.collides) return result;
+  if (budget_hit) {
+    result.budget_exhausted = true;
+    result.exact = false;
+    result.probability = queue.empty() ? best_dropped : std::max(queue.top().probability, best_dropped);
+    result.collides = result.probability >= options.best_effort_threshold;
+    return result;
+  }
+  // Queue empty: every pair was disproved by its volumes (exact "no"), or some were left below p_min.
+  result.collides = false;
+  result.exact = options.exact_leaves || !dropped_possible_contact;
+  result.probability = options.exact_leaves ? 0 : best_dropped;
+  return result;
+}
+
+/// ADB query on two annotated trees. `b_to_a` maps B's frame into A's.
+/// Const and thread-safe: the model is read-only and all traversal state is local.
+template <BoundingVolume BV, int G>
+Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>& b,
+                 const RigidTransform& b_to_a, const AdbModel& model, const AdbOptions& options) {
+  options.validate();
+  if (model.grid() != G) throw std::invalid_argument("adb: the model's grid differs from the trees'");
+  if (a.density.tau != model.tau() || b.density.tau != model.tau())
+    throw std::invalid_argument("adb: the trees were annotated with another tau than the model's");
+  if (options.exact_leaves && (!a.bvh.has_polygons() || !b.bvh.has_polygons()))
+    throw std::invalid_argument("adb: guided exact needs trees with polygons");
+
+  Result result;
+  if (a.bvh.empty() || b.bvh.empty()) return result;
+  Counters& counters = result.counters;
+  const auto start = std::chrono::steady_clock::now();
+  const typename BV::PairContext context = BV::make_context(b_to_a);
+  const Mat3 abs_rotation = b_to_a.rotation.cwiseAbs();
+  const auto& pc_a = a.density.possible_collision_cells;
+  const auto& pc_b = b.density.possible_collision_cells;
+  const Budget& budget = options.budget;
+
+  bool budget_hit = false;
+  auto may_test = [&] {
+    if (budget.max_bv_tests && counters.bv_tests >= budget.max_bv_tests) return budget_hit = true, false;
+    return true;
+  };
+  // Estimated probability of a pair; negative when the volumes do not overlap (provably no contact).
+  auto probability = [&](std::uint32_t i, std::uint32_t j) -> double {
+    ++counters.bv_tests;
+    if (!BV::overlap(a.bvh.volume(i), b.bvh.volume(j), context)) return -1;
+    ++counters.probability_evaluations;
+    const Box box_a = a.bvh.volume(i).bounding_box(), box_b = b.bvh.volume(j).bounding_box();
+    const double overlap =
+        detail::overlap_volume(box_a, box_b, b_to_a.rotation, abs_rotation, b_to_a.translation);
+    return model.estimate(box_a.volume(), box_b.volume(), overlap, pc_a[i], pc_b[j]);
+  };
+
+  std::priority_queue<detail::QueuedPair> queue;
+  bool dropped_possible_contact = false;  // a pair whose volumes overlap was left unexamined
+  double best_dropped = 0;
+
+  auto consider = [&](std::uint32_t i, std::uint32_t j) -> bool {  // true: answer found
+    const double p = probability(i, j);
+    if (p < 0) return false;
+    if (!options.exact_leaves) {
+      if (p > options.p_min) {
+        result.collides = true;
+        result.exact = false;
+        result.probability = p;
+        return true;
+      }
+      if (p <= 0) {
+        dropped_possible_contact = true;
+        return false;
+      }
+    }
+    queue.push({p, i, j});
+    return false;
+  };
+
+  auto leaf_pair_hits = [&](std::uint32_t i, std::uint32_t j) {
+    const TreeNode& na = a.bvh.node(i);
+    const TreeNode& nb = b.bvh.node(j);
+    const auto& tri_a = a.bvh.triangles();
+    const auto& tri_b = b.bvh.triangles();
+    for (std::uint32_t tb = nb.first; tb < nb.first + nb.count; ++tb) {
+      const TrianglePoints moved = {b_to_a.apply(tri_b[tb][0]), b_to_a.apply(tri_b[tb][1]),
+                                    b_to_a.apply(tri_b[tb][2])};
+      for (std::uint32_t ta = na.first; ta < na.first + na.count; ++ta) {
+        ++counters.triangle_tests;
+        if (triangles_intersect(tri_a[ta], moved)) {
+          result.witness = TrianglePair{a.bvh.triangle_ids()[ta], b.bvh.triangle_ids()[tb]};
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+
+  if (!may_test() || consider(0, 0)) return finish_adb(result, queue, options, budget_hit, false, 0);
+  std::uint64_t pops = 0;
+  while (!queue.empty()) {
+    if (budget.deadline_us > 0 && (++pops & 15) == 0 &&
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() >
+            budget.deadline_us) {
+      budget_hit = true;
+      break;
+    }
+    const detail::QueuedPair top = queue.top();
+    queue.pop();
+    ++counters.nodes_visited;
+    const TreeNode& na = a.bvh.node(top.a);
+    const TreeNode& nb = b.bvh.node(top.b);
+    if (na.is_leaf() && nb.is_leaf()) {
+      if (options.exact_leaves) {
+        if (leaf_pair_hits(top.a, top.b)) {
+          result.collides = true;
+          result.exact = true;
+          result.probability = 1;
+          return result;
+        }
+      } else {
+        dropped_possible_contact = true;  // nothing left to refine: the pair's estimate stays below p_min
+        best_dropped = std::max(best_dropped, top.probability);
+      }
+      continue;
+    }
+    // A leaf stands for itself; an inner node for its two children.
+    const std::uint32_t a_children[2] = {na.is_leaf() ? top.a : na.left(), na.right()};
+    const std::uint32_t b_children[2] = {nb.is_leaf() ? top.b : nb.left(), nb.right()};
+    const int a_count = na.is_leaf() ? 1 : 2, b_count = nb.is_leaf() ? 1 : 2;
+    for (int x = 0; x < a_count; ++x)
+      for (int y = 0; y < b_count; ++y) {
+        if (!may_test()) {
+          queue.push(top);  // the unexpanded pair keeps its estimate for the best-effort answer
+          return finish_adb(result, queue, options, true, dropped_possible_contact, best_dropped);
+        }
+        if (consider(a_children[x], b_children[y])) return result;
+      }
+  }
+  return finish_adb(result, queue, options, budget_hit, dropped_possible_contact, best_dropped);
+}
+
+/// Strategy object: ADB with p_min, optionally under a budget, or guided exact. Holds the shared model.
+template <int G>
+struct AdbStrategy {
+  std::shared_ptr<const AdbModel> model;
+  AdbOptions options;
+
+  template <BoundingVolume BV>
+  Result query(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>& b,
+               const RigidTransform& b_to_a) const {
+    return query_adb(a, b, b_to_a, *model, options);
+  }
+};
+
+}  // namespace bvhlab
