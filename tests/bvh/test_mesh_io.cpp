@@ -91,15 +91,25 @@ TEST_F(MeshIo, BundledMeshesHaveTheDocumentedTriangleCounts) {
   }
 }
 
-// pinion.off's header says 650 vertices, 1300 faces, 1950 edges, and the gear is closed. assimp hands over
-// one vertex per face corner, so only a correct weld gives back the shared vertices and a closed edge graph.
-TEST_F(MeshIo, WeldRestoresTheClosedPinion) {
+// pinion.off's header says 650 vertices, 1300 faces, 1950 edges, and the gear is closed.
+TEST_F(MeshIo, PinionIsClosedWithTheHeadersCounts) {
   const LoadedMesh loaded = load_mesh(bundled_mesh("pinion.off"));
   EXPECT_EQ(loaded.mesh.vertices.size(), 650u);
   const auto uses = edge_uses(loaded.mesh);
   EXPECT_EQ(uses.size(), 1950u);
   for (const auto& [edge, count] : uses) EXPECT_EQ(count, 2) << edge.first << "-" << edge.second;
   EXPECT_EQ(loaded.report.degenerate_triangles, 0u);
+}
+
+// assimp's OBJ reader hands over one vertex per face corner (18,960 for the teapot); only a correct weld
+// gives back the shared edges, leaving the 160 boundary edges meshes/README.md documents.
+TEST_F(MeshIo, WeldRestoresTheTeapotsEdgeGraph) {
+  const LoadedMesh loaded = load_mesh(bundled_mesh("teapot.obj"));
+  EXPECT_EQ(loaded.report.input_vertices, 3 * loaded.mesh.triangle_count());
+  EXPECT_LT(loaded.mesh.vertices.size(), loaded.report.input_vertices / 4);
+  std::size_t boundary = 0;
+  for (const auto& [edge, count] : edge_uses(loaded.mesh)) boundary += count == 1;
+  EXPECT_EQ(boundary, 160u);
 }
 
 TEST_F(MeshIo, Jeep1MergesItsSubMeshes) {
