@@ -37,6 +37,16 @@ decltype(auto) with_volume(std::string_view name, F&& f) {
   return with_volume_impl(name, std::forward<F>(f), RegisteredVolumes{});
 }
 
+/// Calls f(std::type_identity<BV>{}) for every registered BV, in registration order.
+template <class F, class... BVs>
+void with_each_volume_impl(F&& f, TypeList<BVs...>) {
+  (f(std::type_identity<BVs>{}), ...);
+}
+template <class F>
+void with_each_volume(F&& f) {
+  with_each_volume_impl(std::forward<F>(f), RegisteredVolumes{});
+}
+
 template <class... BVs>
 std::vector<std::string> volume_names_impl(TypeList<BVs...>) {
   return {std::string(BVs::name())...};
