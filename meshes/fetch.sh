@@ -88,8 +88,8 @@ fi
 
 work_dir=$(mktemp -d "${TMPDIR:-/tmp}/bvhlab-fetch.XXXXXX")
 trap 'rm -rf "$work_dir"' EXIT
-# apt drops privileges to _apt for downloads; let it write into the work dir so it need not warn.
-chmod 755 "$work_dir"
+# The work dir stays private (mode 700); as root, apt then downloads unsandboxed and says so in its log, which
+# is shown only if the download fails.
 
 # Downloads the .deb of package $1 into $work_dir (once) and prints its path.
 fetch_deb() {
