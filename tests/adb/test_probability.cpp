@@ -213,6 +213,13 @@ TEST(ProbabilityModel, EdgeCountsHaveClosedForms) {
       EXPECT_NEAR(pr_collision_cells_at_least(s, s - 1, s - 1, s - 1), 1.0 / s, 1e-12 / s);
     }
   }
+  // The maximising x is not always small: when every cell is possible for both, cc = s for sure and the
+  // best x is s (why x is not capped; capping at 2 would lose up to 0.23 at LB = 0.52, see the doc).
+  for (int s : {1, 8, 64}) {
+    const ProbabilityEstimate full = estimate_probability_detailed(s, s, s, 0.5);
+    EXPECT_EQ(full.best_x, s);
+    EXPECT_DOUBLE_EQ(full.probability, 1.0 - std::pow(0.5, s));
+  }
   EXPECT_EQ(estimate_probability(0, 0, 0, 1.0), 0.0);  // an empty overlap
   EXPECT_EQ(pr_collision_cells_at_least(0, 0, 0, 0), 1.0);
 }
