@@ -10,9 +10,6 @@ namespace {
 Point3d operator-(const Point3d& a, const Point3d& b) {
   return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
 }
-Point3d operator+(const Point3d& a, const Point3d& b) {
-  return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-}
 Point3d operator*(double k, const Point3d& a) {
   return {k * a[0], k * a[1], k * a[2]};
 }
@@ -23,52 +20,67 @@ Point3d cross(const Point3d& a, const Point3d& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-// Keeps the part of `poly` with sign * (p[axis] - bound) >= 0.
-void clip_against(CubeSection& poly, int axis, double bound, double sign) {
-  CubeSection out;
-  auto inside = [&](const Point3d& p) { return sign * (p[static_cast<std::size_t>(axis)] - bound); };
-  for (int i = 0; i < poly.count; ++i) {
-    const Point3d& a = poly.vertices[static_cast<std::size_t>(i)];
-    const Point3d& b = poly.vertices[static_cast<std::size_t>((i + 1) % poly.count)];
+struct PlanePoint {  // coordinates in the projection plane of a section
+  double u;
+  double v;
+};
+
+// Sutherland-Hodgman step: keeps the part of the convex polygon `in` where the affine function
+// `inside` is >= 0, writing it to `out`.
+template <class Inside>
+int clip_polygon(const std::array<PlanePoint, 6>& in, int count, std::array<PlanePoint, 6>& out,
+                 const Inside& inside) {
+  int kept = 0;
+  for (int i = 0; i < count; ++i) {
+    const PlanePoint& a = in[static_cast<std::size_t>(i)];
+    const PlanePoint& b = in[static_cast<std::size_t>((i + 1) % count)];
     const double fa = inside(a);
     const double fb = inside(b);
-    if (fa >= 0.0) out.vertices[static_cast<std::size_t>(out.count++)] = a;
+    if (fa >= 0.0) out[static_cast<std::size_t>(kept++)] = a;
     if ((fa >= 0.0) != (fb >= 0.0)) {
       const double t = fa / (fa - fb);
-      out.vertices[static_cast<std::size_t>(out.count++)] = a + t * (b - a);
+      out[static_cast<std::size_t>(kept++)] = {a.u + t * (b.u - a.u), a.v + t * (b.v - a.v)};
     }
   }
-  poly = out;
+  return kept;
 }
 
 }  // namespace
 
 CubeSection clip_plane_to_unit_cube(const CellPlane& plane) {
+  // Project along the normal's dominant axis k (|n_k| >= 1/sqrt 3): the section is the graph
+  // p_k = (offset - n_i u - n_j v) / n_k over the part of the unit square in (u, v) = (p_i, p_j) where
+  // that height lies in [0, 1]. Two 2D clips of a square instead of six 3D clips of a big polygon.
   const Point3d& n = plane.normal;
-  // An in-plane basis (u, w): cross n with the axis it is least aligned with.
-  int least = 0;
-  for (int k = 1; k < 3; ++k) {
-    if (std::fabs(n[static_cast<std::size_t>(k)]) < std::fabs(n[static_cast<std::size_t>(least)])) least = k;
+  std::size_t k = 0;
+  for (std::size_t axis = 1; axis < 3; ++axis) {
+    if (std::fabs(n[axis]) > std::fabs(n[k])) k = axis;
   }
-  Point3d axis{0.0, 0.0, 0.0};
-  axis[static_cast<std::size_t>(least)] = 1.0;
-  Point3d u = cross(n, axis);
-  u = (1.0 / std::sqrt(dot(u, u))) * u;
-  const Point3d w = cross(n, u);
-  // Every cube point is within sqrt(3) of the origin, so its projection lies within sqrt(3) of the foot
-  // point offset * n: a square of half side 2 around the foot covers the whole section.
-  const Point3d foot = plane.offset * n;
-  CubeSection poly;
-  poly.count = 4;
-  poly.vertices[0] = foot + (2.0 * u + 2.0 * w);
-  poly.vertices[1] = foot + (-2.0 * u + 2.0 * w);
-  poly.vertices[2] = foot + (-2.0 * u + -2.0 * w);
-  poly.vertices[3] = foot + (2.0 * u + -2.0 * w);
-  for (int axis_index = 0; axis_index < 3 && poly.count > 0; ++axis_index) {
-    clip_against(poly, axis_index, 0.0, 1.0);
-    if (poly.count > 0) clip_against(poly, axis_index, 1.0, -1.0);
+  const std::size_t i = (k + 1) % 3;
+  const std::size_t j = (k + 2) % 3;
+  const double sign = n[k] > 0.0 ? 1.0 : -1.0;
+  const double n_k_abs = std::fabs(n[k]);
+  // |n_k| times the height p_k: must lie in [0, |n_k|].
+  const auto scaled_height = [&](const PlanePoint& p) {
+    return sign * (plane.offset - n[i] * p.u - n[j] * p.v);
+  };
+
+  std::array<PlanePoint, 6> square{{{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 1.0}}};
+  std::array<PlanePoint, 6> above_floor{};
+  const int count_above = clip_polygon(square, 4, above_floor, scaled_height);
+  const int count = clip_polygon(above_floor, count_above, square,
+                                 [&](const PlanePoint& p) { return n_k_abs - scaled_height(p); });
+  CubeSection section;
+  if (count < 3) return section;
+  section.count = count;
+  for (int m = 0; m < count; ++m) {
+    const PlanePoint& p = square[static_cast<std::size_t>(m)];
+    Point3d& vertex = section.vertices[static_cast<std::size_t>(m)];
+    vertex[i] = p.u;
+    vertex[j] = p.v;
+    vertex[k] = scaled_height(p) / n_k_abs;
   }
-  return poly;
+  return section;
 }
 
 double section_area(const CubeSection& section, const Point3d& unit_normal) {

@@ -37,10 +37,10 @@ struct CellPlane {
   double offset = 0.0;
 };
 
-/// A plane clipped to the unit cube: a convex polygon (vertices in order) of at most 6 vertices, with
-/// room for Sutherland-Hodgman's intermediate results. count < 3 means the plane misses the cube.
+/// A plane clipped to the unit cube: a convex polygon of 3 to 6 vertices in order; count < 3 (and no
+/// vertices) when the plane misses the cube or only touches it.
 struct CubeSection {
-  std::array<Point3d, 12> vertices{};
+  std::array<Point3d, 6> vertices{};
   int count = 0;
 };
 
