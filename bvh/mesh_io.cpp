@@ -143,6 +143,8 @@ class SceneMerger {
   [[noreturn]] void fail(const std::string& problem) const { throw MeshError(source_ + ": " + problem); }
 
   void add_instance(unsigned mesh_index, const aiMesh& mesh, const Mat4& transform) {
+    if (mesh.mNumFaces > 0 && mesh.mFaces == nullptr)
+      fail(describe_submesh(mesh_index, mesh) + " has no faces array");
     if (mesh.mNumVertices > 0 && mesh.mVertices == nullptr)
       fail(describe_submesh(mesh_index, mesh) + " has no positions");
     const Eigen::Matrix3d linear = transform.topLeftCorner<3, 3>();
