@@ -37,7 +37,7 @@ concept DensityPolicy = requires {
   typename D::Storage;
 };
 
-template <BoundingVolume BV, DensityPolicy Density = NoDensity>
+template <TreeVolume BV, DensityPolicy Density = NoDensity>
 struct Tree {
   using Volume = BV;
   using DensityType = Density;
@@ -46,7 +46,7 @@ struct Tree {
 };
 
 /// True when Tree<BV, NoDensity> is exactly as large as the bare Bvh<BV> (checked per BV where used).
-template <BoundingVolume BV>
+template <TreeVolume BV>
 inline constexpr bool no_density_is_free = sizeof(Tree<BV, NoDensity>) == sizeof(Bvh<BV>);
 
 }  // namespace bvhlab

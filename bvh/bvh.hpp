@@ -21,10 +21,12 @@ struct BvhStats {
   double build_seconds = 0;
 };
 
-template <BoundingVolume BV>
+template <TreeVolume BV>
 class Bvh {
  public:
   using Volume = BV;
+  using Fitted = fitted_volume_t<BV>;  ///< BV itself, or its Decoded form for hierarchical volumes
+  static constexpr bool hierarchical = HierarchicalVolume<BV>;
 
   Bvh() = default;
 
@@ -46,8 +48,9 @@ class Bvh {
 
   /// Assembles a tree from saved parts (no polygons: triangles may be empty).
   static Bvh from_parts(std::vector<TreeNode> nodes, std::vector<BV> volumes, std::vector<std::uint32_t> ids,
-                        std::vector<TrianglePoints> triangles = {}) {
+                        std::vector<TrianglePoints> triangles = {}, const Fitted& root = {}) {
     Bvh out;
+    out.root_ = root;
     out.nodes_ = std::move(nodes);
     out.volumes_ = std::move(volumes);
     out.triangle_ids_ = std::move(ids);
@@ -61,6 +64,18 @@ class Bvh {
   [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
   [[nodiscard]] const TreeNode& node(std::uint32_t i) const { return nodes_[i]; }
   [[nodiscard]] const BV& volume(std::uint32_t i) const { return volumes_[i]; }
+  /// The root's full volume (hierarchical volumes store every other node relative to its parent).
+  [[nodiscard]] const Fitted& root_volume() const { return root_; }
+  /// Every node's bounding box in the tree's own frame, decoding hierarchical volumes top-down.
+  [[nodiscard]] std::vector<Box> node_boxes() const {
+    std::vector<Box> boxes(nodes_.size());
+    if constexpr (hierarchical) {
+      for_each_decoded([&](std::uint32_t i, const Fitted& v) { boxes[i] = v.bounding_box(); });
+    } else {
+      for (std::size_t i = 0; i < nodes_.size(); ++i) boxes[i] = volumes_[i].bounding_box();
+    }
+    return boxes;
+  }
   /// Measure of node i's volume, cached: traversals descend into the larger of two nodes.
   [[nodiscard]] float size(std::uint32_t i) const { return sizes_[i]; }
   /// Triangle vertices in tree order; empty for a tree loaded without polygons.
@@ -86,21 +101,21 @@ class Bvh {
   // Each node's BV is fitted to the vertices of all triangles below it (a contiguous range in tree
   // order), which is tighter than merging children for non-box volumes. Both root subtrees in parallel.
   void fit_volumes(unsigned threads) {
-    volumes_.assign(nodes_.size(), BV{});
+    std::vector<Fitted> fitted(nodes_.size(), Fitted{});
     const auto ranges = node_triangle_ranges(nodes_);
     auto fit_range = [this, &ranges](std::uint32_t i) {
       std::vector<Vec3> points;
       points.reserve(3 * (ranges[i].second - ranges[i].first));
       for (std::uint32_t t = ranges[i].first; t < ranges[i].second; ++t)
         for (const auto& v : triangles_[t]) points.push_back(v);
-      return BV::fit(points);
+      return Fitted::fit(points);
     };
     auto fit_subtree = [&](std::uint32_t root) {
       std::vector<std::uint32_t> stack{root};
       while (!stack.empty()) {
         const std::uint32_t i = stack.back();
         stack.pop_back();
-        volumes_[i] = fit_range(i);
+        fitted[i] = fit_range(i);
         if (!nodes_[i].is_leaf()) {
           stack.push_back(nodes_[i].left());
           stack.push_back(nodes_[i].right());
@@ -108,19 +123,56 @@ class Bvh {
       }
     };
     if (threads >= 2 && !nodes_[0].is_leaf() && triangles_.size() > 20'000) {
-      volumes_[0] = fit_range(0);
+      fitted[0] = fit_range(0);
       std::thread worker(fit_subtree, nodes_[0].left());
       fit_subtree(nodes_[0].right());
       worker.join();
     } else {
       fit_subtree(0);
     }
+    root_ = fitted[0];
+    if constexpr (hierarchical) {
+      // Children are encoded against the parent's *decoded* volume, the one the traversal will see.
+      volumes_.assign(nodes_.size(), BV{});
+      std::vector<Fitted> decoded(nodes_.size());
+      decoded[0] = fitted[0];
+      for (std::uint32_t i = 0; i < nodes_.size(); ++i) {
+        if (nodes_[i].is_leaf()) continue;
+        for (std::uint32_t c : {nodes_[i].left(), nodes_[i].right()}) {
+          volumes_[c] = BV::encode(decoded[i], fitted[c]);
+          decoded[c] = BV::decode(decoded[i], volumes_[c]);
+        }
+      }
+    } else {
+      volumes_ = std::move(fitted);
+    }
     compute_sizes();
+  }
+
+  // Calls f(index, decoded volume) for every node, parents before children.
+  template <class F>
+  void for_each_decoded(F&& f) const {
+    if (nodes_.empty()) return;
+    std::vector<std::pair<std::uint32_t, Fitted>> stack{{0, root_}};
+    while (!stack.empty()) {
+      const auto [i, v] = stack.back();
+      stack.pop_back();
+      f(i, v);
+      if (!nodes_[i].is_leaf())
+        for (std::uint32_t c : {nodes_[i].left(), nodes_[i].right()})
+          stack.emplace_back(c, BV::decode(v, volumes_[c]));
+    }
   }
 
   void compute_sizes() {
     sizes_.resize(volumes_.size());
-    for (std::size_t i = 0; i < volumes_.size(); ++i) sizes_[i] = static_cast<float>(volumes_[i].volume());
+    if constexpr (hierarchical) {
+      if (!nodes_.empty() && volumes_.size() == nodes_.size())
+        for_each_decoded(
+            [&](std::uint32_t i, const Fitted& v) { sizes_[i] = static_cast<float>(v.volume()); });
+    } else {
+      for (std::size_t i = 0; i < volumes_.size(); ++i) sizes_[i] = static_cast<float>(volumes_[i].volume());
+    }
   }
 
   void recount() {
@@ -143,6 +195,7 @@ class Bvh {
 
   std::vector<TreeNode> nodes_;
   std::vector<BV> volumes_;
+  Fitted root_{};
   std::vector<float> sizes_;
   std::vector<std::uint32_t> triangle_ids_;
   std::vector<TrianglePoints> triangles_;

@@ -23,6 +23,7 @@
 #include "adb/tree.hpp"
 #include "bvh/triangle_intersection.hpp"
 #include "traversal/result.hpp"
+#include "traversal/tree_access.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -115,9 +116,12 @@ inline double overlap_volume(const Box& a, const Box& b, const Mat3& rotation, c
   return edge.prod();
 }
 
+template <class Working>
 struct QueuedPair {
   double probability;
   std::uint32_t a, b;
+  [[no_unique_address]] Working wa;
+  [[no_unique_address]] Working wb;
   bool operator<(const QueuedPair& o) const { return probability < o.probability; }
 };
 
@@ -144,7 +148,7 @@ Result& finish_adb(Result& result, const Queue& queue, const AdbOptions& options
 
 /// ADB query on two annotated trees. `b_to_a` maps B's frame into A's.
 /// Const and thread-safe: the model is read-only and all traversal state is local.
-template <BoundingVolume BV, int G>
+template <TreeVolume BV, int G>
 Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>& b,
                  const RigidTransform& b_to_a, const AdbModel& model, const AdbOptions& options) {
   options.validate();
@@ -158,7 +162,9 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
   if (a.bvh.empty() || b.bvh.empty()) return result;
   Counters& counters = result.counters;
   const auto start = std::chrono::steady_clock::now();
-  const typename BV::PairContext context = BV::make_context(b_to_a);
+  using Walker = VolumeWalker<BV>;
+  using Pair = detail::QueuedPair<typename Walker::Working>;
+  const typename Walker::Context context = Walker::make_context(b_to_a);
   const Mat3 abs_rotation = b_to_a.rotation.cwiseAbs();
   const auto& pc_a = a.density.possible_collision_cells;
   const auto& pc_b = b.density.possible_collision_cells;
@@ -170,22 +176,22 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
     return true;
   };
   // Estimated probability of a pair; negative when the volumes do not overlap (provably no contact).
-  auto probability = [&](std::uint32_t i, std::uint32_t j) -> double {
+  auto probability = [&](const Pair& e) -> double {
     ++counters.bv_tests;
-    if (!BV::overlap(a.bvh.volume(i), b.bvh.volume(j), context)) return -1;
+    if (!Walker::overlap(a.bvh, e.a, e.wa, b.bvh, e.b, e.wb, context)) return -1;
     ++counters.probability_evaluations;
-    const Box box_a = a.bvh.volume(i).bounding_box(), box_b = b.bvh.volume(j).bounding_box();
+    const Box box_a = Walker::box(a.bvh, e.a, e.wa), box_b = Walker::box(b.bvh, e.b, e.wb);
     const double overlap =
         detail::overlap_volume(box_a, box_b, b_to_a.rotation, abs_rotation, b_to_a.translation);
-    return model.estimate(box_a.volume(), box_b.volume(), overlap, pc_a[i], pc_b[j]);
+    return model.estimate(box_a.volume(), box_b.volume(), overlap, pc_a[e.a], pc_b[e.b]);
   };
 
-  std::priority_queue<detail::QueuedPair> queue;
+  std::priority_queue<Pair> queue;
   bool dropped_possible_contact = false;  // a pair whose volumes overlap was left unexamined
   double best_dropped = 0;
 
-  auto consider = [&](std::uint32_t i, std::uint32_t j) -> bool {  // true: answer found
-    const double p = probability(i, j);
+  auto consider = [&](Pair e) -> bool {  // true: answer found
+    const double p = probability(e);
     if (p < 0) return false;
     if (!options.exact_leaves) {
       if (p > options.p_min) {
@@ -199,7 +205,8 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
         return false;
       }
     }
-    queue.push({p, i, j});
+    e.probability = p;
+    queue.push(e);
     return false;
   };
 
@@ -222,7 +229,8 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
     return false;
   };
 
-  if (!may_test() || consider(0, 0)) return finish_adb(result, queue, options, budget_hit, false, 0);
+  if (!may_test() || consider({0, 0, 0, Walker::root_a(a.bvh, context), Walker::root_b(b.bvh, context)}))
+    return finish_adb(result, queue, options, budget_hit, false, 0);
   std::uint64_t pops = 0;
   while (!queue.empty()) {
     if (budget.deadline_us > 0 && (++pops & 15) == 0 &&
@@ -231,7 +239,7 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
       budget_hit = true;
       break;
     }
-    const detail::QueuedPair top = queue.top();
+    const Pair top = queue.top();
     queue.pop();
     ++counters.nodes_visited;
     const TreeNode& na = a.bvh.node(top.a);
@@ -251,16 +259,29 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
       continue;
     }
     // A leaf stands for itself; an inner node for its two children.
-    const std::uint32_t a_children[2] = {na.is_leaf() ? top.a : na.left(), na.right()};
-    const std::uint32_t b_children[2] = {nb.is_leaf() ? top.b : nb.left(), nb.right()};
+    using Working = typename Walker::Working;
+    std::pair<std::uint32_t, Working> a_children[2] = {{top.a, top.wa}, {top.a, top.wa}};
+    std::pair<std::uint32_t, Working> b_children[2] = {{top.b, top.wb}, {top.b, top.wb}};
     const int a_count = na.is_leaf() ? 1 : 2, b_count = nb.is_leaf() ? 1 : 2;
+    if (!na.is_leaf())
+      for (int x = 0; x < 2; ++x) {
+        const std::uint32_t c = x ? na.right() : na.left();
+        a_children[x] = {c, Walker::child_a(a.bvh, top.wa, c, context)};
+      }
+    if (!nb.is_leaf())
+      for (int y = 0; y < 2; ++y) {
+        const std::uint32_t c = y ? nb.right() : nb.left();
+        b_children[y] = {c, Walker::child_b(b.bvh, top.wb, c, context)};
+      }
     for (int x = 0; x < a_count; ++x)
       for (int y = 0; y < b_count; ++y) {
         if (!may_test()) {
           queue.push(top);  // the unexpanded pair keeps its estimate for the best-effort answer
           return finish_adb(result, queue, options, true, dropped_possible_contact, best_dropped);
         }
-        if (consider(a_children[x], b_children[y])) return result;
+        if (consider(
+                {0, a_children[x].first, b_children[y].first, a_children[x].second, b_children[y].second}))
+          return result;
       }
   }
   return finish_adb(result, queue, options, budget_hit, dropped_possible_contact, best_dropped);
@@ -272,7 +293,7 @@ struct AdbStrategy {
   std::shared_ptr<const AdbModel> model;
   AdbOptions options;
 
-  template <BoundingVolume BV>
+  template <TreeVolume BV>
   Result query(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>& b,
                const RigidTransform& b_to_a) const {
     return query_adb(a, b, b_to_a, *model, options);

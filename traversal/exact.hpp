@@ -16,34 +16,42 @@ enum class ContactMode { First, All };
 
 /// Exact first-contact (or all-contacts) query. `b_to_a` maps B's local frame into A's.
 /// Const and thread-safe on shared trees: all traversal state lives on this call's stack.
-template <BoundingVolume BV>
+template <TreeVolume BV>
 Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
                    ContactMode mode = ContactMode::First) {
+  using Walker = VolumeWalker<BV>;
+  using Working = typename Walker::Working;
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;
   if (!a.has_polygons() || !b.has_polygons())
     throw std::invalid_argument("exact query: a tree was loaded without polygons; exact mode needs them");
 
-  const typename BV::PairContext context = BV::make_context(b_to_a);
+  const typename Walker::Context context = Walker::make_context(b_to_a);
   Counters& counters = result.counters;
-  auto overlap = [&](std::uint32_t i, std::uint32_t j) {
+  struct Entry {
+    std::uint32_t i, j;
+    [[no_unique_address]] Working wa;
+    [[no_unique_address]] Working wb;
+  };
+  auto overlap = [&](const Entry& e) {
     ++counters.bv_tests;
-    return BV::overlap(a.volume(i), b.volume(j), context);
+    return Walker::overlap(a, e.i, e.wa, b, e.j, e.wb, context);
   };
 
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack;
+  std::vector<Entry> stack;
   stack.reserve(64);
-  if (overlap(0, 0)) stack.emplace_back(0, 0);
+  if (const Entry root{0, 0, Walker::root_a(a, context), Walker::root_b(b, context)}; overlap(root))
+    stack.push_back(root);
 
   const auto& tri_a = a.triangles();
   const auto& tri_b = b.triangles();
   while (!stack.empty()) {
-    const auto [i, j] = stack.back();
+    const Entry top = stack.back();
     stack.pop_back();
     ++counters.nodes_visited;
-    const TreeNode& na = a.node(i);
-    const TreeNode& nb = b.node(j);
+    const TreeNode& na = a.node(top.i);
+    const TreeNode& nb = b.node(top.j);
 
     if (na.is_leaf() && nb.is_leaf()) {
       for (std::uint32_t tb = nb.first; tb < nb.first + nb.count; ++tb) {
@@ -66,13 +74,15 @@ Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_t
       continue;
     }
     // Descend into the larger node (a leaf cannot be split), testing children before pushing them.
-    const bool split_a = nb.is_leaf() || (!na.is_leaf() && a.size(i) >= b.size(j));
+    const bool split_a = nb.is_leaf() || (!na.is_leaf() && a.size(top.i) >= b.size(top.j));
     if (split_a) {
-      if (overlap(na.right(), j)) stack.emplace_back(na.right(), j);
-      if (overlap(na.left(), j)) stack.emplace_back(na.left(), j);
+      for (std::uint32_t child : {na.right(), na.left()})
+        if (const Entry e{child, top.j, Walker::child_a(a, top.wa, child, context), top.wb}; overlap(e))
+          stack.push_back(e);
     } else {
-      if (overlap(i, nb.right())) stack.emplace_back(i, nb.right());
-      if (overlap(i, nb.left())) stack.emplace_back(i, nb.left());
+      for (std::uint32_t child : {nb.right(), nb.left()})
+        if (const Entry e{top.i, child, top.wa, Walker::child_b(b, top.wb, child, context)}; overlap(e))
+          stack.push_back(e);
     }
   }
   return result;

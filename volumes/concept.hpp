@@ -38,20 +38,67 @@
 namespace bvhlab {
 
 template <class BV>
-concept BoundingVolume =
-    std::is_trivially_copyable_v<BV> && std::is_standard_layout_v<BV> &&
+concept BoundingVolume = std::is_trivially_copyable_v<BV> && std::is_standard_layout_v<BV> &&
     std::is_trivially_copyable_v<typename BV::PairContext> &&
     requires(const BV& a, const BV& b, std::span<const Vec3> points, const RigidTransform& pose,
              const typename BV::PairContext& context, const Vec3& p) {
-      { BV::name() } -> std::convertible_to<std::string_view>;
-      { BV::fit(points) } -> std::same_as<BV>;
-      { BV::merge(a, b) } -> std::same_as<BV>;
-      { BV::make_context(pose) } -> std::same_as<typename BV::PairContext>;
-      { BV::overlap(a, b, context) } -> std::same_as<bool>;
-      { a.volume() } -> std::convertible_to<Scalar>;
-      { a.bounding_box() } -> std::same_as<Box>;
-      { a.contains(p) } -> std::same_as<bool>;
-    };
+  { BV::name() } -> std::convertible_to<std::string_view>;
+  { BV::fit(points) } -> std::same_as<BV>;
+  { BV::merge(a, b) } -> std::same_as<BV>;
+  { BV::make_context(pose) } -> std::same_as<typename BV::PairContext>;
+  { BV::overlap(a, b, context) } -> std::same_as<bool>;
+  { a.volume() } -> std::convertible_to<Scalar>;
+  { a.bounding_box() } -> std::same_as<Box>;
+  { a.contains(p) } -> std::same_as<bool>;
+};
+
+/// Concept `HierarchicalVolume<HV>`: a node volume stored relative to its parent's, as in Zachmann's
+/// restricted boxtree. Only the root is stored whole (as an `HV::Decoded`, itself a BoundingVolume).
+/// The traversal walks the tree top-down carrying an `HV::Working` state per side, so a node's volume is
+/// never re-derived from the root.
+///
+/// Types
+///   HV::Decoded      The full volume of a node, in its own frame (fitting, ADB grid, tightness).
+///   HV::Frame        How one side's volumes map into the frame where overlaps are tested: built from a
+///                    RigidTransform (B's side) or the identity (A's side). Trivially copyable.
+///   HV::Working      Traversal state of one node on one side. Trivially copyable.
+/// Operations (p: Decoded parent; c: Decoded child inside p; s: HV; w: Working; f: Frame)
+///   HV::encode(p, c)        A stored node whose decode contains c. Conservative: decode(p, encode(p, c)) ⊇
+///   c. HV::decode(p, s)        The full volume s stands for, given its parent's. HV::make_frame(pose) Frame
+///   for a side whose volumes the pose maps into the test frame. HV::start(root, f)      Working state of the
+///   root. HV::descend(w, s, f)    Working state of a child from its parent's: the cheap, incremental step.
+///   HV::decoded(w)          The node's Decoded volume (own frame).
+///   HV::overlap(wa, wb)     Conservative overlap of two working states (both already in the test frame).
+template <class HV>
+concept HierarchicalVolume = std::is_trivially_copyable_v<HV> && BoundingVolume<typename HV::Decoded> &&
+    std::is_trivially_copyable_v<typename HV::Working> && std::is_trivially_copyable_v<typename HV::Frame> &&
+    requires(const HV& stored, const typename HV::Decoded& decoded, const typename HV::Working& w,
+             const typename HV::Frame& frame, const RigidTransform& pose) {
+  { HV::name() } -> std::convertible_to<std::string_view>;
+  { HV::encode(decoded, decoded) } -> std::same_as<HV>;
+  { HV::decode(decoded, stored) } -> std::same_as<typename HV::Decoded>;
+  { HV::make_frame(pose) } -> std::same_as<typename HV::Frame>;
+  { HV::start(decoded, frame) } -> std::same_as<typename HV::Working>;
+  { HV::descend(w, stored, frame) } -> std::same_as<typename HV::Working>;
+  { HV::decoded(w) } -> std::same_as<typename HV::Decoded>;
+  { HV::overlap(w, w) } -> std::same_as<bool>;
+};
+
+/// What a Bvh can hold: a self-contained volume, or one stored relative to its parent.
+template <class V>
+concept TreeVolume = BoundingVolume<V> || HierarchicalVolume<V>;
+
+/// The volume type fitted to a node's triangles: the model itself, or its Decoded form.
+template <class V>
+struct fitted_volume {
+  using type = V;
+};
+template <HierarchicalVolume V>
+struct fitted_volume<V> {
+  using type = typename V::Decoded;
+};
+template <class V>
+using fitted_volume_t = typename fitted_volume<V>::type;
 
 namespace detail {
 inline const Vec3 kAxisDirections[3] = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
@@ -60,7 +107,9 @@ inline const Vec3 kAxisDirections[3] = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0,
 /// The builder's split directions for BV: its own hint if it has one, else the coordinate axes.
 template <class BV>
 std::span<const Vec3> split_directions_of() {
-  if constexpr (requires { { BV::split_directions() } -> std::convertible_to<std::span<const Vec3>>; })
+  if constexpr (requires {
+                  { BV::split_directions() } -> std::convertible_to<std::span<const Vec3>>;
+                })
     return BV::split_directions();
   else
     return std::span<const Vec3>(detail::kAxisDirections);

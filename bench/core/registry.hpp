@@ -3,6 +3,7 @@
 #pragma once
 
 #include "volumes/aabb.hpp"
+#include "volumes/restricted_box.hpp"
 
 #include <optional>
 #include <stdexcept>
@@ -15,7 +16,7 @@ namespace bvhlab {
 template <class... Ts>
 struct TypeList {};
 
-using RegisteredVolumes = TypeList<Aabb>;
+using RegisteredVolumes = TypeList<Aabb, RestrictedBox>;
 
 /// Calls f(std::type_identity<BV>{}) for the BV whose name() is `name`; throws naming the choices.
 template <class F, class... BVs>

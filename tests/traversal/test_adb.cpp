@@ -4,6 +4,7 @@
 #include "traversal/adb.hpp"
 #include "traversal/exact.hpp"
 #include "volumes/aabb.hpp"
+#include "volumes/restricted_box.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,9 +14,9 @@ namespace bvhlab {
 namespace {
 
 // A crude stand-in annotation, independent of adb/annotate: pc = min(g^3, triangles below the node).
-template <int G>
-Tree<Aabb, AdbDensity<G>> crude_annotation(Bvh<Aabb> bvh, double tau) {
-  Tree<Aabb, AdbDensity<G>> tree{std::move(bvh), {}};
+template <int G, class BV = Aabb>
+Tree<BV, AdbDensity<G>> crude_annotation(Bvh<BV> bvh, double tau) {
+  Tree<BV, AdbDensity<G>> tree{std::move(bvh), {}};
   const auto ranges = node_triangle_ranges(tree.bvh.nodes());
   for (const auto& [begin, end] : ranges)
     tree.density.possible_collision_cells.push_back(
@@ -48,6 +49,20 @@ TEST(AdbTraversal, GuidedExactEqualsExactTraversal) {
   }
   EXPECT_GT(colliding, 30);
   EXPECT_LT(colliding, 270);
+}
+
+TEST(AdbTraversal, GuidedExactOnTheRestrictedBoxtree) {
+  const Scene scene;
+  const auto tree_a = crude_annotation<2>(Bvh<RestrictedBox>::build(scene.a), 0.5);
+  const auto tree_b = crude_annotation<2>(Bvh<RestrictedBox>::build(scene.b), 0.5);
+  AdbOptions guided;
+  guided.exact_leaves = true;
+  std::mt19937_64 rng(31);
+  for (int k = 0; k < 200; ++k) {
+    const RigidTransform pose = testing::random_pose(rng, 1.5);
+    const Result r = query_adb(tree_a, tree_b, pose, scene.model, guided);
+    ASSERT_EQ(r.collides, query_exact(scene.tree_a.bvh, scene.tree_b.bvh, pose).collides) << "pose " << k;
+  }
 }
 
 TEST(AdbTraversal, BvTestBudgetIsNeverExceeded) {

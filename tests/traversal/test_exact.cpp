@@ -84,3 +84,42 @@ TEST(ExactTraversal, DeepChainTreeDoesNotOverflow) {
 
 }  // namespace
 }  // namespace bvhlab
+
+#include "volumes/restricted_box.hpp"
+
+namespace bvhlab {
+namespace {
+
+TEST(ExactTraversal, RestrictedBoxtreeMatchesCgalAndStaysCompact) {
+  const Mesh a = testing::make_torus(0.7, 0.25, 40, 20);
+  const Mesh b = testing::make_random_soup(600, 0.08, 13);
+  const auto rbox_a = Bvh<RestrictedBox>::build(a);
+  const auto rbox_b = Bvh<RestrictedBox>::build(b);
+  const CgalGroundTruth truth(a, b);
+  std::mt19937_64 rng(29);
+  int colliding = 0;
+  for (int k = 0; k < 300; ++k) {
+    const RigidTransform pose = testing::random_pose(rng, 1.5);
+    const bool expected = truth.collides(pose);
+    ASSERT_EQ(query_exact(rbox_a, rbox_b, pose).collides, expected) << "pose " << k;
+    colliding += expected;
+  }
+  EXPECT_GT(colliding, 30);
+  // 12 bytes of volume a node against the AABB's 24.
+  EXPECT_LT(rbox_a.stats().bytes_per_node, Bvh<Aabb>::build(a).stats().bytes_per_node);
+  // Every decoded child box lies inside its parent's and contains its triangles.
+  const auto boxes = rbox_a.node_boxes();
+  const auto ranges = node_triangle_ranges(rbox_a.nodes());
+  for (std::uint32_t i = 0; i < rbox_a.nodes().size(); ++i) {
+    for (std::uint32_t t = ranges[i].first; t < ranges[i].second; ++t)
+      for (const auto& v : rbox_a.triangles()[t]) ASSERT_TRUE(boxes[i].contains(v)) << "node " << i;
+    if (!rbox_a.node(i).is_leaf())
+      for (std::uint32_t c : {rbox_a.node(i).left(), rbox_a.node(i).right()}) {
+        ASSERT_TRUE(boxes[i].contains(boxes[c].min));
+        ASSERT_TRUE(boxes[i].contains(boxes[c].max));
+      }
+  }
+}
+
+}  // namespace
+}  // namespace bvhlab
