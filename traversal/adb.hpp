@@ -9,10 +9,12 @@
 //   * Vol(A ∩ B) is the volume of the intersection of A's bounding box with B's bounding box re-boxed in
 //     A's frame (centre R c + t, half-extents |R| h). It over-estimates the true overlap for rotated pairs,
 //     which errs toward "collision" (false positives, not false negatives).
-//   * Cells: each node's grid lies on its bounding box, so its cell volume is Vol(box) / g^3. Differently
-//     sized BVs are mapped onto the coarser cell volume c = max(c_A, c_B): s = Vol(A ∩ B) / c, and the finer
-//     side's expected count is scaled by (c_fine / c)^(2/3), the square of the cell side ratio, because
-//     possible collision cells hold surface. For equal sizes the factor is 1: the paper's case.
+//   * Cells: each node's grid lies on its bounding box, so its cells are boxes of extent / g. Differently
+//     sized BVs are mapped onto the coarser cells (the larger cell volume): s = Vol(A ∩ B) / c_coarse, and
+//     the finer side's expected count is scaled by F_fine / F_coarse, the ratio of the cells' mean face
+//     areas. Possible collision cells hold surface, and a surface crosses about area / F cells; for cubic
+//     cells this is the square of the side ratio, and for equal sizes it is 1: the paper's case. The
+//     same mean face area defines the annotation's threshold tau, and the ratio needs no roots.
 //   * Rounding: s is rounded up (at least 1 when the volumes overlap, at most g^3); the fractional s_A, s_B
 //     are interpolated bilinearly between the table's integer entries, so a query still does no
 //     transcendental math and a small expected count is not rounded away to a probability of 0.
@@ -69,20 +71,29 @@ class AdbModel {
   [[nodiscard]] double tau() const { return tau_; }
   [[nodiscard]] const ProbabilityTable& table() const { return table_; }
 
-  /// The estimate for a BV pair from the boxes' volumes, the overlap volume and the pc counts.
-  [[nodiscard]] double estimate(double volume_a, double volume_b, double overlap, int pc_a, int pc_b) const {
+  /// The estimate for a BV pair from the nodes' own-frame bounding boxes, the overlap volume and the pc
+  /// counts. Only arithmetic and four table loads: no transcendental math on the query path.
+  [[nodiscard]] double estimate(const Box& box_a, const Box& box_b, double overlap, int pc_a,
+                                int pc_b) const {
     if (!(overlap > 0) || pc_a == 0 || pc_b == 0) return 0;
+    const Vec3 ea = box_a.extent(), eb = box_b.extent();
+    const double volume_a = ea.prod(), volume_b = eb.prod();
+    // Mean face area of a cell, times 3 g^2 (the common factor cancels in the ratio).
+    const double face_a = ea.x() * ea.y() + ea.y() * ea.z() + ea.z() * ea.x();
+    const double face_b = eb.x() * eb.y() + eb.y() * eb.z() + eb.z() * eb.x();
     const int cells = grid_ * grid_ * grid_;
-    const double cell_a = volume_a / cells, cell_b = volume_b / cells;
-    const double coarse = std::max(cell_a, cell_b);
-    if (!(coarse > 0)) return 0;
+    const bool a_coarse = volume_a >= volume_b;
+    const double coarse_cell = (a_coarse ? volume_a : volume_b) / cells;
     // Expected possible-collision cells in the overlap, in each node's own cells...
-    double s_a = pc_a * std::min(1.0, overlap / volume_a);
-    double s_b = pc_b * std::min(1.0, overlap / volume_b);
-    // ...mapped onto the coarser cells: a surface's cell count scales with the square of the side ratio.
-    if (cell_a < coarse) s_a *= std::cbrt(cell_a / coarse) * std::cbrt(cell_a / coarse);
-    if (cell_b < coarse) s_b *= std::cbrt(cell_b / coarse) * std::cbrt(cell_b / coarse);
-    const int s = std::clamp(static_cast<int>(std::ceil(overlap / coarse - 1e-9)), 1, cells);
+    double s_a = volume_a > 0 ? pc_a * std::min(1.0, overlap / volume_a) : pc_a;
+    double s_b = volume_b > 0 ? pc_b * std::min(1.0, overlap / volume_b) : pc_b;
+    // ...with the finer side mapped onto the coarser cells by the ratio of cell face areas.
+    if (a_coarse && face_a > 0)
+      s_b *= std::min(1.0, face_b / face_a);
+    else if (!a_coarse && face_b > 0)
+      s_a *= std::min(1.0, face_a / face_b);
+    const double s_real = coarse_cell > 0 ? overlap / coarse_cell : cells;
+    const int s = s_real >= cells ? cells : std::clamp(static_cast<int>(std::ceil(s_real - 1e-9)), 1, cells);
     s_a = std::min(s_a, double(s));
     s_b = std::min(s_b, double(s));
     return interpolate(s, s_a, s_b);
@@ -183,7 +194,7 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
     const Box box_a = Walker::box(a.bvh, e.a, e.wa), box_b = Walker::box(b.bvh, e.b, e.wb);
     const double overlap =
         detail::overlap_volume(box_a, box_b, b_to_a.rotation, abs_rotation, b_to_a.translation);
-    return model.estimate(box_a.volume(), box_b.volume(), overlap, pc_a[e.a], pc_b[e.b]);
+    return model.estimate(box_a, box_b, overlap, pc_a[e.a], pc_b[e.b]);
   };
 
   std::priority_queue<Pair> queue;

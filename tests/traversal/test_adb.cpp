@@ -123,25 +123,37 @@ TEST(AdbTraversal, NonsenseOptionsAndMismatchedTauAreRejected) {
   EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, other_tau, {}), std::invalid_argument);
 }
 
+Box cube(double side) {
+  return {Vec3::Zero(), Vec3::Constant(side)};
+}
+
 TEST(AdbModel, EqualSizesReduceToThePaperCaseAndDifferentSizesScale) {
   const AdbModel model(2, 0.5);
   // Equal volumes fully overlapping: s = 8, s_A = pc_A, s_B = pc_B: exactly the table entry.
-  EXPECT_DOUBLE_EQ(model.estimate(8.0, 8.0, 8.0, 3, 5), model.table().lookup(8, 3, 5));
+  EXPECT_DOUBLE_EQ(model.estimate(cube(2), cube(2), 8.0, 3, 5), model.table().lookup(8, 3, 5));
   // Half overlap: s = 4, s_A = pc_A / 2.
-  EXPECT_DOUBLE_EQ(model.estimate(8.0, 8.0, 4.0, 4, 2), model.table().lookup(4, 2, 1));
-  // B eight times smaller (cell side ratio 1/2) inside A: s = Vol(B)/c_A = 1 coarse cell; B's count scales
-  // by (1/2)^2, A's by overlap / Vol(A) = 1/8.
-  const double p = model.estimate(8.0, 1.0, 1.0, 8, 8);
-  EXPECT_DOUBLE_EQ(p, model.table().lookup(1, 1, 1) * 1.0);  // s_a = 1, s_b = min(2, 1) = 1
+  EXPECT_DOUBLE_EQ(model.estimate(cube(2), cube(2), 4.0, 4, 2), model.table().lookup(4, 2, 1));
+  // B eight times smaller (cell side ratio 1/2) inside A: s = Vol(B) / c_A = 1 coarse cell; A's count is
+  // scaled by overlap / Vol(A) = 1/8, B's by the face-area ratio 1/4: s_a = 1, s_b = min(2, s) = 1.
+  EXPECT_DOUBLE_EQ(model.estimate(cube(2), cube(1), 1.0, 8, 8), model.table().lookup(1, 1, 1));
+  // Symmetric in the roles of A and B.
+  EXPECT_DOUBLE_EQ(model.estimate(cube(1), cube(2), 1.0, 8, 8), model.estimate(cube(2), cube(1), 1.0, 8, 8));
+  // Fractional expected counts interpolate: halfway between the integer entries.
+  const double mid = model.estimate(cube(2), cube(2), 8.0 * 0.75, 2, 2);  // s = 6, s_a = s_b = 1.5
+  EXPECT_NEAR(mid,
+              0.25 * (model.table().lookup(6, 1, 1) + model.table().lookup(6, 2, 1) +
+                      model.table().lookup(6, 1, 2) + model.table().lookup(6, 2, 2)),
+              1e-15);
   // No possible collision cell on one side: probability 0.
-  EXPECT_EQ(model.estimate(8.0, 8.0, 8.0, 0, 8), 0.0);
-  // Never outside [0, 1], never NaN, on a sweep including degenerate volumes.
-  for (double va : {0.0, 1e-300, 1.0, 1e300})
+  EXPECT_EQ(model.estimate(cube(2), cube(2), 8.0, 0, 8), 0.0);
+  // Never outside [0, 1], never NaN, on a sweep including flat, tiny and huge boxes.
+  const Box flat{Vec3::Zero(), Vec3(1, 1, 0)};
+  for (const Box& a : {cube(0), cube(1e-300), flat, cube(1), cube(1e100)})
     for (double ov : {0.0, 1e-300, 0.5, 1.0, 1e300})
       for (int pa : {0, 1, 8})
         for (int pb : {0, 1, 8}) {
-          const double q = model.estimate(va, 1.0, ov, pa, pb);
-          EXPECT_TRUE(q >= 0 && q <= 1) << va << " " << ov << " " << pa << " " << pb << " -> " << q;
+          const double q = model.estimate(a, cube(1), ov, pa, pb);
+          EXPECT_TRUE(q >= 0 && q <= 1) << a.max.x() << " " << ov << " " << pa << " " << pb << " -> " << q;
         }
 }
 
