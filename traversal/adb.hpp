@@ -6,9 +6,10 @@
 //     probability, so the answer is exact.
 //
 // Decisions (see README, "Method"):
-//   * Vol(A ∩ B) is the volume of the intersection of A's bounding box with B's bounding box re-boxed in
-//     A's frame (centre R c + t, half-extents |R| h). It over-estimates the true overlap for rotated pairs,
-//     which errs toward "collision" (false positives, not false negatives).
+//   * Vol(A ∩ B) is bounded from above by re-boxing: A's bounding box ∩ B's box re-boxed in A's frame
+//     (centre R c + t, half-extents |R| h), and the same with the roles swapped; the smaller bound is used.
+//     It still over-estimates the true overlap of a rotated pair, which errs toward "collision" (false
+//     positives rather than false negatives).
 //   * Cells: each node's grid lies on its bounding box, so its cells are boxes of extent / g. Differently
 //     sized BVs are mapped onto the coarser cells (the larger cell volume): s = Vol(A ∩ B) / c_coarse, and
 //     the finer side's expected count is scaled by F_fine / F_coarse, the ratio of the cells' mean face
@@ -116,15 +117,25 @@ class AdbModel {
 
 namespace detail {
 
-/// Volume of A's box ∩ (B's box re-boxed in A's frame).
-inline double overlap_volume(const Box& a, const Box& b, const Mat3& rotation, const Mat3& abs_rotation,
-                             const Vec3& translation) {
+/// Volume of `box` ∩ (`other` re-boxed through rotation/translation): an upper bound of the overlap.
+inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rotation,
+                              const Mat3& abs_rotation, const Vec3& translation) {
+  const Vec3 center = rotation * other.center() + translation;
+  const Vec3 half = abs_rotation * (other.extent() * 0.5);
+  const Vec3 lo = box.min.cwiseMax(center - half), hi = box.max.cwiseMin(center + half);
+  return (hi - lo).cwiseMax(0.0).prod();
+}
+
+/// An upper bound of Vol(A ∩ B) for a rotated pair: re-boxing either box in the other's frame bounds the
+/// overlap from above, so the smaller of the two bounds is the tighter one.
+inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b_to_a,
+                             const Mat3& abs_rotation) {
   if (a.empty() || b.empty()) return 0;
-  const Vec3 center = rotation * b.center() + translation;
-  const Vec3 half = abs_rotation * (b.extent() * 0.5);
-  const Vec3 lo = a.min.cwiseMax(center - half), hi = a.max.cwiseMin(center + half);
-  const Vec3 edge = (hi - lo).cwiseMax(0.0);
-  return edge.prod();
+  const double in_a = reboxed_overlap(a, b, b_to_a.rotation, abs_rotation, b_to_a.translation);
+  if (!(in_a > 0)) return 0;
+  const Mat3 r_t = b_to_a.rotation.transpose();
+  const double in_b = reboxed_overlap(b, a, r_t, abs_rotation.transpose(), -(r_t * b_to_a.translation));
+  return std::min(in_a, in_b);
 }
 
 template <class Working>
@@ -192,8 +203,7 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
     if (!Walker::overlap(a.bvh, e.a, e.wa, b.bvh, e.b, e.wb, context)) return -1;
     ++counters.probability_evaluations;
     const Box box_a = Walker::box(a.bvh, e.a, e.wa), box_b = Walker::box(b.bvh, e.b, e.wb);
-    const double overlap =
-        detail::overlap_volume(box_a, box_b, b_to_a.rotation, abs_rotation, b_to_a.translation);
+    const double overlap = detail::overlap_volume(box_a, box_b, b_to_a, abs_rotation);
     return model.estimate(box_a, box_b, overlap, pc_a[e.a], pc_b[e.b]);
   };
 

@@ -1,0 +1,245 @@
+// ADB error and speed on the protocol (ADB-METHOD.md section 4): ADB on AABB (g = 2) for a list of p_min,
+// side by side with bvhlab's exact trees, in one binary. Per (mesh, strategy, distance): time per query,
+// false-positive and false-negative rates against exact ground truth, BV tests per query. At the end, a
+// summary per mesh: for every p_min the mean time, the total error, and the speed-up over each exact tree;
+// and the operating point: the fastest p_min whose total error is at most 4%.
+//
+//   bench_adb [--meshes=a,b] [--steps=200] [--p-min=0.5,0.7,...] [--exact=aabb,dop24] [--grid=2]
+//             [--tau=0.5] [--distances=1.2,1.4,...] [benchmark flags]
+#include "adb/annotate.hpp"
+#include "bench/core/mesh_catalog.hpp"
+#include "bench/core/protocol.hpp"
+#include "bench/core/registry.hpp"
+#include "traversal/adb.hpp"
+#include "traversal/exact.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+namespace {
+
+struct Workload {
+  std::vector<double> distances;
+  std::vector<std::vector<RigidTransform>> poses;  // per distance
+  std::vector<std::vector<char>> truth;            // per distance, per pose
+};
+
+struct Measured {
+  double seconds_per_query = 0;
+  std::size_t queries = 0, false_positives = 0, false_negatives = 0;
+  double bv_tests = 0;
+};
+// (mesh, strategy label) -> per distance. Filled by the benchmark bodies; read by the summary.
+std::map<std::pair<std::string, std::string>, std::map<double, Measured>> g_measured;
+
+template <class Query>
+void run_poses(benchmark::State& state, const Workload& w, std::size_t d, Query&& query, Measured& out) {
+  const auto& poses = w.poses[d];
+  const auto& truth = w.truth[d];
+  std::size_t fp = 0, fn = 0;
+  double bv_tests = 0;
+  std::size_t passes = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    fp = fn = 0;
+    bv_tests = 0;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      const Result r = query(poses[k]);
+      fp += r.collides && !truth[k];
+      fn += !r.collides && truth[k];
+      bv_tests += static_cast<double>(r.counters.bv_tests);
+    }
+    ++passes;
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double n = static_cast<double>(poses.size());
+  out = {seconds / (static_cast<double>(passes) * n), poses.size(), fp, fn, bv_tests / n};
+  state.counters["time_per_query"] =
+      benchmark::Counter(n, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["fp_rate"] = static_cast<double>(fp) / n;
+  state.counters["fn_rate"] = static_cast<double>(fn) / n;
+  state.counters["bv_tests"] = bv_tests / n;
+}
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+std::vector<double> split_numbers(const std::string& s) {
+  std::vector<double> out;
+  for (const auto& item : split_list(s)) out.push_back(std::stod(item));
+  return out;
+}
+
+template <int G>
+void register_adb(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w,
+                  const std::vector<double>& p_mins, double tau) {
+  AnnotateStats stats;
+  auto tree = std::make_shared<const Tree<Aabb, AdbDensity<G>>>(
+      annotate<G>(Bvh<Aabb>::build(mesh), AnnotateOptions{.tau = tau}, &stats));
+  std::fprintf(stderr, "bench_adb: %s annotated (g = %d) in %.2f s\n", label.c_str(), G, stats.seconds);
+  auto model = std::make_shared<const AdbModel>(G, tau);
+  for (double p_min : p_mins) {
+    char strategy[64];
+    std::snprintf(strategy, sizeof strategy, "adb_aabb_g%d/p:%.2f", G, p_min);
+    for (std::size_t d = 0; d < w->distances.size(); ++d) {
+      char name[160];
+      std::snprintf(name, sizeof name, "%s/%s/d:%.1f", label.c_str(), strategy, w->distances[d]);
+      benchmark::RegisterBenchmark(name, [=](benchmark::State& state) {
+        AdbOptions options;
+        options.p_min = p_min;
+        run_poses(
+            state, *w, d,
+            [&](const RigidTransform& pose) { return query_adb(*tree, *tree, pose, *model, options); },
+            g_measured[{label, strategy}][w->distances[d]]);
+      })->Unit(benchmark::kMillisecond);
+    }
+  }
+}
+
+template <class BV>
+void register_exact(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w) {
+  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(mesh));
+  const std::string strategy = "exact_" + std::string(BV::name());
+  for (std::size_t d = 0; d < w->distances.size(); ++d) {
+    char name[160];
+    std::snprintf(name, sizeof name, "%s/%s/d:%.1f", label.c_str(), strategy.c_str(), w->distances[d]);
+    benchmark::RegisterBenchmark(name, [=](benchmark::State& state) {
+      run_poses(
+          state, *w, d, [&](const RigidTransform& pose) { return query_exact(*tree, *tree, pose); },
+          g_measured[{label, strategy}][w->distances[d]]);
+    })->Unit(benchmark::kMillisecond);
+  }
+}
+
+void print_summary(const std::vector<std::string>& exact_names) {
+  std::map<std::string, std::vector<std::pair<std::string, Measured>>> by_mesh;
+  for (const auto& [key, per_distance] : g_measured) {
+    Measured total;
+    double seconds = 0;
+    for (const auto& [d, m] : per_distance) {
+      seconds += m.seconds_per_query * static_cast<double>(m.queries);
+      total.queries += m.queries;
+      total.false_positives += m.false_positives;
+      total.false_negatives += m.false_negatives;
+      total.bv_tests += m.bv_tests * static_cast<double>(m.queries);
+    }
+    if (total.queries == 0) continue;
+    total.seconds_per_query = seconds / static_cast<double>(total.queries);
+    total.bv_tests /= static_cast<double>(total.queries);
+    by_mesh[key.first].emplace_back(key.second, total);
+  }
+  std::printf("\n=== ADB summary (means over all measured poses and distances) ===\n");
+  for (const auto& [mesh, rows] : by_mesh) {
+    std::map<std::string, double> exact_time;
+    for (const auto& [strategy, m] : rows)
+      if (strategy.rfind("exact_", 0) == 0) exact_time[strategy] = m.seconds_per_query;
+    std::printf("\n%s\n%-24s %12s %8s %8s %8s %10s", mesh.c_str(), "strategy", "us/query", "FP%", "FN%",
+                "err%", "BV tests");
+    for (const auto& e : exact_names) std::printf("  vs %-10s", ("exact_" + e).c_str());
+    std::printf("\n");
+    std::string best;
+    double best_time = 0;
+    for (const auto& [strategy, m] : rows) {
+      const double n = static_cast<double>(m.queries);
+      const double fp = 100.0 * m.false_positives / n, fn = 100.0 * m.false_negatives / n;
+      std::printf("%-24s %12.2f %8.2f %8.2f %8.2f %10.1f", strategy.c_str(), m.seconds_per_query * 1e6, fp,
+                  fn, fp + fn, m.bv_tests);
+      for (const auto& e : exact_names) {
+        const auto it = exact_time.find("exact_" + e);
+        if (it != exact_time.end()) std::printf("  %12.2fx", it->second / m.seconds_per_query);
+      }
+      std::printf("\n");
+      if (strategy.rfind("adb_", 0) == 0 && fp + fn <= 4.0 &&
+          (best.empty() || m.seconds_per_query < best_time))
+        best = strategy, best_time = m.seconds_per_query;
+    }
+    if (best.empty())
+      std::printf("operating point: no p_min reaches total error <= 4%%\n");
+    else
+      for (const auto& e : exact_names) {
+        const auto it = exact_time.find("exact_" + e);
+        if (it != exact_time.end())
+          std::printf("operating point (error <= 4%%): %s, %.2fx faster than exact %s\n", best.c_str(),
+                      it->second / best_time, e.c_str());
+      }
+  }
+}
+
+}  // namespace
+}  // namespace bvhlab
+
+int main(int argc, char** argv) {
+  using namespace bvhlab;
+  benchmark::Initialize(&argc, argv);
+  std::vector<std::string> meshes{"injector_pipes.stl", "occt_tr12j_housing.stl"};
+  std::vector<std::string> exact{"aabb", "dop24"};
+  std::vector<double> p_mins{0.5, 0.7, 0.8, 0.9, 0.95, 0.99};
+  std::vector<double> distances = ProtocolOptions{}.distances;
+  int steps = 200, grid = 2;
+  double tau = kDefaultAdbTau;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      auto value = [&](const char* prefix) { return arg.substr(std::string(prefix).size()); };
+      if (arg.rfind("--meshes=", 0) == 0)
+        meshes = split_list(value("--meshes="));
+      else if (arg.rfind("--exact=", 0) == 0)
+        exact = split_list(value("--exact="));
+      else if (arg.rfind("--p-min=", 0) == 0)
+        p_mins = split_numbers(value("--p-min="));
+      else if (arg.rfind("--distances=", 0) == 0)
+        distances = split_numbers(value("--distances="));
+      else if (arg.rfind("--steps=", 0) == 0)
+        steps = std::stoi(value("--steps="));
+      else if (arg.rfind("--grid=", 0) == 0)
+        grid = std::stoi(value("--grid="));
+      else if (arg.rfind("--tau=", 0) == 0)
+        tau = std::stod(value("--tau="));
+      else
+        throw std::invalid_argument("unknown argument '" + arg + "'");
+    }
+    if (steps < 1) throw std::invalid_argument("--steps must be at least 1");
+    if (grid < 2 || grid > 4) throw std::invalid_argument("--grid must be 2, 3 or 4");
+    for (const auto& file : meshes) {
+      if (!find_mesh(file)) {
+        std::fprintf(stderr, "bench_adb: skipping %s (not found; run meshes/fetch.sh)\n", file.c_str());
+        continue;
+      }
+      const Mesh mesh = load_protocol_mesh(file);
+      const std::string label = std::filesystem::path(file).stem().string();
+      auto workload = std::make_shared<Workload>();
+      workload->distances = distances;
+      const auto truth_tree = Bvh<Aabb>::build(mesh);  // exact, and equal to CGAL (tests/traversal)
+      for (double d : distances) {
+        workload->poses.push_back(protocol_poses(d, steps));
+        auto& truth = workload->truth.emplace_back();
+        for (const auto& pose : workload->poses.back())
+          truth.push_back(query_exact(truth_tree, truth_tree, pose).collides);
+      }
+      for (const auto& e : exact)
+        with_volume(e, [&]<class BV>(std::type_identity<BV>) { register_exact<BV>(label, mesh, workload); });
+      if (grid == 2) register_adb<2>(label, mesh, workload, p_mins, tau);
+      if (grid == 3) register_adb<3>(label, mesh, workload, p_mins, tau);
+      if (grid == 4) register_adb<4>(label, mesh, workload, p_mins, tau);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_adb: %s\n", e.what());
+    return 2;
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  print_summary(exact);
+  benchmark::Shutdown();
+  return 0;
+}
