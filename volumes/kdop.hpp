@@ -1,0 +1,479 @@
+// k-DOPs (discrete orientation polytopes): the intersection of k/2 slabs along fixed directions.
+// Dop<6>, Dop<14>, Dop<18>, Dop<26> use the classic direction sets; volumes/dop24.hpp adds Zachmann's 24-DOP.
+//
+// Overlap under a relative rotation (Zachmann's re-alignment). B's DOP is not a DOP in A's frame, so for each
+// of A's k plane normals u the support of B in direction u is bounded from above instead of recomputed:
+// with v = R^T u (u in B's frame) and any three of B's planes i, j, l whose normals n_i, n_j, n_l are
+// independent and span a cone containing v, i.e. v = lambda_i n_i + lambda_j n_j + lambda_l n_l with
+// lambda >= 0, every point x of B satisfies
+//     v . x = sum lambda_m (n_m . x) <= sum lambda_m d_m,
+// because n_m . x <= d_m on B and lambda_m >= 0. (This is LP duality: the bound is the maximum of v over the
+// cone of those three half-spaces, attained at their common vertex.) It holds for *any* such triple, so it is
+// always conservative; it is tight when the triple is the one meeting at B's extremal vertex in direction v.
+// B's actual vertex structure varies from node to node, so the triple is the one meeting at the extremal
+// vertex of the *prototype* DOP (all offsets equal), found once per query in make_context. Vertices where
+// more than three prototype planes meet (corners of the 14- and 26-DOP) are split into all independent
+// triples of their planes; by the conic Caratheodory theorem some triple's cone contains v, and the one with
+// the largest smallest lambda is taken. lambda = M^-T v for the 3x3 matrix M of the triple's normals, so the
+// stored coefficients are c = (u^T R) M^-1, three multiply-adds per direction at test time, plus u . t for
+// the translation. Only A's k/2 axes are tested (both ends of each); that is a subset of the separating
+// axes, so it is conservative too.
+//
+// Storage: the k offsets d_m = max over the volume of n_m . x as floats rounded upwards (unit normals; the
+// lower end of axis a is stored negated as d_{a + k/2}). Arithmetic is in double with a rounding slack as in
+// aabb.hpp, scaled by the magnitudes involved.
+#pragma once
+
+#include "volumes/concept.hpp"
+#include "volumes/storage.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <numbers>
+#include <vector>
+
+namespace bvhlab {
+
+namespace dop_detail {
+
+using RawDirection = std::array<int, 3>;
+
+/// Plane normals of a DOP: axis m in [0, k/2) is `directions[m]` normalised; plane m + k/2 is its negation.
+/// The first three axes must be x, y, z (bounding box, magnitude bound for the slack).
+template <std::size_t Axes>
+struct DirectionSet {
+  std::array<RawDirection, Axes> raw;
+};
+
+/// Everything derived once per direction set: unit normals and the prototype polytope's vertices with the
+/// plane triples that span their normal cones.
+template <std::size_t Axes>
+struct Tables {
+  static constexpr std::size_t kPlanes = 2 * Axes;
+  struct Triple {
+    std::array<std::uint8_t, 3> planes;
+    Mat3 inverse_transpose;  // M^-T: lambda = M^-T v
+  };
+  struct Vertex {
+    Vec3 position;
+    std::vector<Triple> triples;
+  };
+  std::array<Vec3, Axes> axes;        // unit directions
+  std::array<Vec3, kPlanes> normals;  // axes, then their negations
+  std::vector<Vertex> vertices;       // prototype: n_m . x <= 1 for every m
+  double max_lambda_sum = 0;          // largest sum of lambda over the chosen triples (= prototype radius)
+
+  explicit Tables(const DirectionSet<Axes>& set) {
+    for (std::size_t a = 0; a < Axes; ++a) {
+      axes[a] = Vec3(set.raw[a][0], set.raw[a][1], set.raw[a][2]).normalized();
+      normals[a] = axes[a];
+      normals[a + Axes] = -axes[a];
+    }
+    // Enumerate the prototype's vertices: every independent triple whose common point satisfies all planes.
+    constexpr double kTol = 1e-9;
+    auto independent = [&](std::size_t i, std::size_t j, std::size_t l, Mat3& m) {
+      m.row(0) = normals[i];
+      m.row(1) = normals[j];
+      m.row(2) = normals[l];
+      return std::abs(m.determinant()) > 1e-6;
+    };
+    for (std::size_t i = 0; i < kPlanes; ++i)
+      for (std::size_t j = i + 1; j < kPlanes; ++j)
+        for (std::size_t l = j + 1; l < kPlanes; ++l) {
+          Mat3 m;
+          if (!independent(i, j, l, m)) continue;
+          const Vec3 x = m.inverse() * Vec3::Ones();
+          bool feasible = true;
+          for (const Vec3& n : normals) feasible = feasible && n.dot(x) <= 1 + kTol;
+          if (!feasible) continue;
+          const bool known = std::any_of(vertices.begin(), vertices.end(),
+                                         [&](const Vertex& v) { return (v.position - x).norm() < 1e-7; });
+          if (!known) vertices.push_back({x, {}});
+        }
+    for (Vertex& v : vertices) {
+      std::vector<std::uint8_t> active;
+      for (std::size_t m = 0; m < kPlanes; ++m)
+        if (normals[m].dot(v.position) >= 1 - kTol) active.push_back(static_cast<std::uint8_t>(m));
+      for (std::size_t i = 0; i < active.size(); ++i)
+        for (std::size_t j = i + 1; j < active.size(); ++j)
+          for (std::size_t l = j + 1; l < active.size(); ++l) {
+            Mat3 m;
+            if (!independent(active[i], active[j], active[l], m)) continue;
+            v.triples.push_back({{active[i], active[j], active[l]}, m.inverse().transpose()});
+          }
+    }
+    // The prototype's circumradius bounds sum(lambda) for unit directions: sum(lambda) is the support of the
+    // prototype in direction v, attained at the chosen vertex.
+    for (const Vertex& v : vertices) max_lambda_sum = std::max(max_lambda_sum, v.position.norm());
+  }
+
+  /// The triple at the prototype's extremal vertex in direction v, and its (non-negative) coefficients.
+  void realign(const Vec3& v, std::array<std::uint8_t, 3>& planes,
+               std::array<double, 3>& coefficients) const {
+    const Vertex* best = &vertices.front();
+    double best_value = -std::numeric_limits<double>::infinity();
+    for (const Vertex& vertex : vertices) {
+      const double value = v.dot(vertex.position);
+      if (value > best_value) {
+        best_value = value;
+        best = &vertex;
+      }
+    }
+    double best_min = -std::numeric_limits<double>::infinity();
+    for (const Triple& t : best->triples) {
+      const Vec3 lambda = t.inverse_transpose * v;
+      if (lambda.minCoeff() > best_min) {
+        best_min = lambda.minCoeff();
+        planes = t.planes;
+        // Rounding may leave a coefficient a hair below zero when v lies on a cone boundary; the bound
+        // error that causes is a few ulps of the offsets, inside the overlap slack.
+        coefficients = {lambda[0], lambda[1], lambda[2]};
+      }
+    }
+  }
+};
+
+/// Lebesgue measure of {x : n_m . x <= d_m for all m}, where planes a and a + Axes (a < 3) are the
+/// bounding box's. Clips the box by the other planes one at a time (each face polygon clipped, the cut
+/// closed by a new face), then sums d_m * area(face m) / 3 (divergence theorem). About k^2 small steps:
+/// Bvh computes it for every node at build time.
+template <std::size_t Axes>
+double clipped_box_volume(const std::array<Vec3, 2 * Axes>& normals,
+                          const std::array<double, 2 * Axes>& offsets, const Box& box) {
+  struct Face {
+    std::size_t plane, begin, count;
+  };
+  const double scale =
+      box.extent().maxCoeff() + box.min.cwiseAbs().maxCoeff() + box.max.cwiseAbs().maxCoeff();
+  const double tol = 1e-12 * scale;
+  // Scratch reused across calls (Bvh calls this once per node).
+  thread_local std::vector<Vec3> points, next_points, cap;
+  thread_local std::vector<Face> faces, next_faces;
+  thread_local std::vector<std::pair<double, std::size_t>> order;
+  thread_local std::vector<double> distances;
+  points.clear();
+  faces.clear();
+  // The box: for each axis a and side, the face's four corners in cyclic order.
+  for (std::size_t a = 0; a < 3; ++a)
+    for (int side = 0; side < 2; ++side) {
+      const std::size_t b = (a + 1) % 3, c = (a + 2) % 3;
+      const double fixed = side == 0 ? box.max[a] : box.min[a];
+      const double uv[4][2] = {{box.min[b], box.min[c]},
+                               {box.max[b], box.min[c]},
+                               {box.max[b], box.max[c]},
+                               {box.min[b], box.max[c]}};
+      faces.push_back({side == 0 ? a : a + Axes, points.size(), 4});
+      for (const auto& corner : uv) {
+        Vec3 x;
+        x[a] = fixed;
+        x[b] = corner[0];
+        x[c] = corner[1];
+        points.push_back(x);
+      }
+    }
+  for (std::size_t m = 3; m < 2 * Axes; ++m) {
+    if (m >= Axes && m < Axes + 3) continue;  // the box's own planes
+    const Vec3& n = normals[m];
+    const double d = offsets[m];
+    distances.resize(points.size());
+    double farthest = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      distances[k] = n.dot(points[k]) - d;
+      farthest = std::max(farthest, distances[k]);
+    }
+    if (farthest <= tol) continue;  // the plane does not cut
+    next_points.clear();
+    next_faces.clear();
+    cap.clear();
+    for (const Face& f : faces) {
+      const std::size_t begin = next_points.size();
+      for (std::size_t k = 0; k < f.count; ++k) {
+        const std::size_t i = f.begin + k, j = f.begin + (k + 1 == f.count ? 0 : k + 1);
+        const double dp = distances[i], dq = distances[j];
+        if (dp <= tol) {
+          next_points.push_back(points[i]);
+          if (dp >= -tol) cap.push_back(points[i]);
+        }
+        if ((dp < -tol && dq > tol) || (dp > tol && dq < -tol)) {
+          const Vec3 x = points[i] + (points[j] - points[i]) * (dp / (dp - dq));
+          next_points.push_back(x);
+          cap.push_back(x);
+        }
+      }
+      if (next_points.size() - begin >= 3)
+        next_faces.push_back({f.plane, begin, next_points.size() - begin});
+      else
+        next_points.resize(begin);
+    }
+    if (cap.size() >= 3) {
+      // The cut face: its points are on a convex polygon; order them by (pseudo-)angle about their mean.
+      const Vec3 e1 = n.unitOrthogonal(), e2 = n.cross(e1);
+      Vec3 mean = Vec3::Zero();
+      for (const Vec3& x : cap) mean += x;
+      mean /= double(cap.size());
+      order.clear();
+      for (std::size_t k = 0; k < cap.size(); ++k) {
+        const double u = e1.dot(cap[k] - mean), v = e2.dot(cap[k] - mean);
+        // Monotone in the angle, without atan2: position on the unit diamond's perimeter, in [0, 4).
+        const double r = std::abs(u) + std::abs(v);
+        const double p = r > 0 ? v / r : 0;
+        order.push_back({u >= 0 ? (v >= 0 ? p : 4 + p) : 2 - p, k});
+      }
+      std::sort(order.begin(), order.end());
+      next_faces.push_back({m, next_points.size(), cap.size()});
+      for (const auto& [key, k] : order) next_points.push_back(cap[k]);
+    }
+    std::swap(points, next_points);
+    std::swap(faces, next_faces);
+    if (faces.empty()) return 0;
+  }
+  double volume = 0;
+  for (const Face& f : faces) {
+    Vec3 twice_area = Vec3::Zero();
+    const Vec3& origin = points[f.begin];
+    for (std::size_t k = 1; k + 1 < f.count; ++k)
+      twice_area += (points[f.begin + k] - origin).cross(points[f.begin + k + 1] - origin);
+    volume += offsets[f.plane] * std::abs(normals[f.plane].dot(twice_area)) / 6;
+  }
+  return volume;
+}
+
+inline bool all_finite(std::span<const Vec3> points) {
+  return std::all_of(points.begin(), points.end(), [](const Vec3& p) { return p.allFinite(); });
+}
+
+}  // namespace dop_detail
+
+/// A DOP over the direction set `Set` (a struct with `static constexpr DirectionSet<n> set`, `name` and
+/// `split_along_directions`). Plain data: k floats.
+template <class Set>
+struct KDop {
+  static constexpr std::size_t kAxes = Set::set.raw.size();
+  static constexpr std::size_t kPlanes = 2 * kAxes;
+  static_assert(Set::set.raw[0] == dop_detail::RawDirection{1, 0, 0} &&
+                    Set::set.raw[1] == dop_detail::RawDirection{0, 1, 0} &&
+                    Set::set.raw[2] == dop_detail::RawDirection{0, 0, 1},
+                "a DOP's first three axes must be x, y, z");
+  static_assert(kPlanes <= 255, "plane indices are stored as bytes");
+
+  /// offsets[m] >= n_m . x for every point x of the volume; default: empty (hi < lo on every axis).
+  std::array<float, kPlanes> offsets = filled(-1.0f);
+
+  struct PairContext {
+    // Per plane m of A (direction n_m): B's support in n_m is at most
+    //   sum_k coefficients[m][k] * b.offsets[planes[m][k]] + shift(m),
+    // with shift(m) = +axis_shift[a] for m = a < k/2 and -axis_shift[a] for m = a + k/2.
+    std::array<std::array<std::uint8_t, 3>, kPlanes> planes;
+    std::array<std::array<double, 3>, kPlanes> coefficients;
+    std::array<double, kAxes> axis_shift;  // n_a . t
+    double slack_per_a_scale;              // rounding slack per unit of A's coordinate magnitude
+    double slack_per_b_scale;
+    double slack_translation;
+  };
+
+  static constexpr std::string_view name() { return Set::name; }
+
+  static const dop_detail::Tables<kAxes>& tables() {
+    static const dop_detail::Tables<kAxes> instance(Set::set);
+    return instance;
+  }
+
+  /// The unit axis directions (the builder's split directions when Set asks for it).
+  static std::span<const Vec3> split_directions() requires(Set::split_along_directions) {
+    return std::span<const Vec3>(tables().axes);
+  }
+
+  static KDop fit(std::span<const Vec3> points) {
+    if (!dop_detail::all_finite(points))
+      throw std::invalid_argument(std::string(name()) + "::fit: a point has a NaN or infinite coordinate");
+    if (points.empty()) return {};
+    const auto& axes = tables().axes;
+    std::array<double, kAxes> hi, lo;
+    hi.fill(-std::numeric_limits<double>::infinity());
+    lo.fill(std::numeric_limits<double>::infinity());
+    for (const Vec3& p : points)
+      for (std::size_t a = 0; a < kAxes; ++a) {
+        const double s = project(axes[a], p);
+        hi[a] = std::max(hi[a], s);
+        lo[a] = std::min(lo[a], s);
+      }
+    KDop out;
+    for (std::size_t a = 0; a < kAxes; ++a) {
+      out.offsets[a] = float_up(hi[a]);
+      out.offsets[a + kAxes] = float_up(-lo[a]);
+    }
+    return out;
+  }
+
+  static KDop merge(const KDop& a, const KDop& b) {
+    if (a.empty()) return b;
+    if (b.empty()) return a;
+    KDop out;
+    for (std::size_t m = 0; m < kPlanes; ++m) out.offsets[m] = std::max(a.offsets[m], b.offsets[m]);
+    return out;
+  }
+
+  static PairContext make_context(const RigidTransform& pose) {
+    const auto& t = tables();
+    PairContext c{};
+    double max_coefficient_sum = 0;
+    for (std::size_t m = 0; m < kPlanes; ++m) {
+      const Vec3 v = pose.rotation.transpose() * t.normals[m];
+      t.realign(v, c.planes[m], c.coefficients[m]);
+      max_coefficient_sum =
+          std::max(max_coefficient_sum, std::abs(c.coefficients[m][0]) + std::abs(c.coefficients[m][1]) +
+                                            std::abs(c.coefficients[m][2]));
+    }
+    for (std::size_t a = 0; a < kAxes; ++a) c.axis_shift[a] = t.axes[a].dot(pose.translation);
+    // Offsets of a fitted or merged DOP are at most sqrt(3) times its largest x/y/z offset in magnitude
+    // (each is a support value of points inside that box); errors of the few products and sums below, and
+    // of c itself (from R and M^-1), stay far inside 512 ulps of those magnitudes.
+    constexpr double kUlps = 512 * std::numeric_limits<double>::epsilon();
+    c.slack_per_a_scale = kUlps * std::numbers::sqrt3 * 2;
+    c.slack_per_b_scale = kUlps * std::numbers::sqrt3 * (max_coefficient_sum + 1);
+    c.slack_translation = kUlps * pose.translation.norm();
+    return c;
+  }
+
+  static bool overlap(const KDop& a, const KDop& b, const PairContext& c) {
+    // Smallest signed overlap of the projection intervals over A's axes; negative means separated.
+    double worst = std::numeric_limits<double>::infinity();
+    for (std::size_t m = 0; m < kAxes; ++m) {
+      const std::size_t opposite = m + kAxes;
+      const double b_upper = c.coefficients[m][0] * double(b.offsets[c.planes[m][0]]) +
+                             c.coefficients[m][1] * double(b.offsets[c.planes[m][1]]) +
+                             c.coefficients[m][2] * double(b.offsets[c.planes[m][2]]) + c.axis_shift[m];
+      const double b_neg_lower = c.coefficients[opposite][0] * double(b.offsets[c.planes[opposite][0]]) +
+                                 c.coefficients[opposite][1] * double(b.offsets[c.planes[opposite][1]]) +
+                                 c.coefficients[opposite][2] * double(b.offsets[c.planes[opposite][2]]) -
+                                 c.axis_shift[m];
+      // B's interval [-b_neg_lower, b_upper] against A's [-a.offsets[opposite], a.offsets[m]].
+      worst = std::min(worst,
+                       std::min(b_upper + double(a.offsets[opposite]), b_neg_lower + double(a.offsets[m])));
+    }
+    const double slack = c.slack_per_a_scale * a.coordinate_scale() +
+                         c.slack_per_b_scale * b.coordinate_scale() + c.slack_translation;
+    return worst >= -slack;
+  }
+
+  [[nodiscard]] bool empty() const { return offsets[0] + offsets[kAxes] < 0; }
+
+  [[nodiscard]] Scalar volume() const {
+    if (empty()) return 0;
+    std::array<double, kPlanes> d;
+    for (std::size_t m = 0; m < kPlanes; ++m) d[m] = offsets[m];
+    const Box box = bounding_box();
+    // Clamped: a flat DOP's faces cancel to round-off, and a DOP is inside its bounding box.
+    return std::clamp(dop_detail::clipped_box_volume<kAxes>(tables().normals, d, box), 0.0, box.volume());
+  }
+
+  [[nodiscard]] Box bounding_box() const {
+    if (empty()) return {};
+    return {Vec3(-offsets[kAxes], -offsets[kAxes + 1], -offsets[kAxes + 2]),
+            Vec3(offsets[0], offsets[1], offsets[2])};
+  }
+
+  [[nodiscard]] bool contains(const Vec3& p) const {
+    if (empty()) return false;
+    const auto& axes = tables().axes;
+    for (std::size_t a = 0; a < kAxes; ++a) {
+      const double s = project(axes[a], p);
+      if (s > offsets[a] || -s > offsets[a + kAxes]) return false;
+    }
+    return true;
+  }
+
+ private:
+  static constexpr std::array<float, kPlanes> filled(float value) {
+    std::array<float, kPlanes> out{};
+    for (auto& x : out) x = value;
+    return out;
+  }
+  // One expression for fit and contains, so a fitted point always tests as contained.
+  static double project(const Vec3& axis, const Vec3& p) {
+    return axis.x() * p.x() + axis.y() * p.y() + axis.z() * p.z();
+  }
+  // Largest |x|, |y|, |z| offset: bounds |n . x| for every offset of a fitted DOP, up to sqrt(3).
+  [[nodiscard]] double coordinate_scale() const {
+    double s = 0;
+    for (std::size_t a = 0; a < 3; ++a)
+      s = std::max({s, std::abs(double(offsets[a])), std::abs(double(offsets[a + kAxes]))});
+    return s;
+  }
+};
+
+namespace dop_sets {
+struct Dop6 {
+  static constexpr std::string_view name = "dop6";
+  static constexpr bool split_along_directions = false;
+  static constexpr dop_detail::DirectionSet<3> set{{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}};
+};
+// Axes plus the four corner diagonals (the cube's vertices).
+struct Dop14 {
+  static constexpr std::string_view name = "dop14";
+  static constexpr bool split_along_directions = false;
+  static constexpr dop_detail::DirectionSet<7> set{
+      {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}}}};
+};
+// Axes plus the six edge diagonals (the cube's edge midpoints).
+struct Dop18 {
+  static constexpr std::string_view name = "dop18";
+  static constexpr bool split_along_directions = false;
+  static constexpr dop_detail::DirectionSet<9> set{{{{1, 0, 0},
+                                                     {0, 1, 0},
+                                                     {0, 0, 1},
+                                                     {1, 1, 0},
+                                                     {1, -1, 0},
+                                                     {1, 0, 1},
+                                                     {1, 0, -1},
+                                                     {0, 1, 1},
+                                                     {0, 1, -1}}}};
+};
+// Axes, edge diagonals and corner diagonals.
+struct Dop26 {
+  static constexpr std::string_view name = "dop26";
+  static constexpr bool split_along_directions = false;
+  static constexpr dop_detail::DirectionSet<13> set{{{{1, 0, 0},
+                                                      {0, 1, 0},
+                                                      {0, 0, 1},
+                                                      {1, 1, 0},
+                                                      {1, -1, 0},
+                                                      {1, 0, 1},
+                                                      {1, 0, -1},
+                                                      {0, 1, 1},
+                                                      {0, 1, -1},
+                                                      {1, 1, 1},
+                                                      {1, 1, -1},
+                                                      {1, -1, 1},
+                                                      {-1, 1, 1}}}};
+};
+template <int K>
+struct ForK;
+template <>
+struct ForK<6> {
+  using type = Dop6;
+};
+template <>
+struct ForK<14> {
+  using type = Dop14;
+};
+template <>
+struct ForK<18> {
+  using type = Dop18;
+};
+template <>
+struct ForK<26> {
+  using type = Dop26;
+};
+}  // namespace dop_sets
+
+/// The classic k-DOPs, k in {6, 14, 18, 26}.
+template <int K>
+using Dop = KDop<typename dop_sets::ForK<K>::type>;
+
+static_assert(BoundingVolume<Dop<6>>);
+static_assert(BoundingVolume<Dop<14>>);
+static_assert(BoundingVolume<Dop<18>>);
+static_assert(BoundingVolume<Dop<26>>);
+
+}  // namespace bvhlab

@@ -1,0 +1,200 @@
+// Oriented bounding box: centre, orientation, half-extents; separating-axis test on 15 axes.
+//
+// Storage (40 bytes): the orientation as a float quaternion, centre and half-extents as floats. The box is
+// *defined* by the stored numbers: its axes are the columns of the rotation computed (in double, always by
+// the same function) from the float quaternion, orthonormal to a few ulps. The fit widens the half-extents
+// by a bound on what rounding the frame and centre to float can move (about 5e-7 of the box's size) and
+// rounds them up, so storing the fit as floats never loses a point.
+//
+// Fit: the principal axes of the points' covariance (PCA), or the coordinate axes when those give a smaller
+// box (PCA is poor for some symmetric or skewed sets); degenerate sets (flat, collinear, one point) need no
+// special case, the eigen-solver still returns an orthonormal frame and the extents become zero.
+//
+// Overlap: the classic 15-axis test with B's box expressed in A's box frame. |C| is widened by a few ulps
+// as usual, so near-parallel edges (cross products of rounding-noise length) cannot separate; and every
+// comparison has a slack scaled by the magnitudes of the centres, translation and extents, which covers the
+// rounding of those products (absolute errors grow with |t|, not with the box size).
+#pragma once
+
+#include "volumes/concept.hpp"
+#include "volumes/storage.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <string>
+
+namespace bvhlab {
+
+struct Obb {
+  std::array<float, 4> orientation{0, 0, 0, 1};  // quaternion (x, y, z, w), need not be unit
+  Float3 center{0, 0, 0};
+  Float3 half{-1, -1, -1};  // negative: empty
+
+  struct PairContext {
+    PlainMat3 rotation;  // B -> A
+    Double3 translation;
+    double translation_magnitude;  // max |t_i|
+  };
+
+  static constexpr std::string_view name() { return "obb"; }
+
+  /// Rotation matrix of a (not necessarily unit) quaternion; columns are the box axes.
+  static Mat3 axes_of(const std::array<float, 4>& q) {
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    const double s = 2 / (x * x + y * y + z * z + w * w);
+    Mat3 r;
+    r << 1 - s * (y * y + z * z), s * (x * y - w * z), s * (x * z + w * y),  //
+        s * (x * y + w * z), 1 - s * (x * x + z * z), s * (y * z - w * x),   //
+        s * (x * z - w * y), s * (y * z + w * x), 1 - s * (x * x + y * y);
+    return r;
+  }
+
+  static Obb fit(std::span<const Vec3> points) { return fit_with_margin(points, 0); }
+
+  static Obb merge(const Obb& a, const Obb& b) {
+    if (a.empty()) return b;
+    if (b.empty()) return a;
+    std::array<Vec3, 16> corners;
+    a.write_corners(corners.data());
+    b.write_corners(corners.data() + 8);
+    // Corners are computed in double; widen by their rounding, and by the float rounding of the inputs'
+    // frames and centres (which the GCC 12 folding may undo when they were just stored, see box_in_frame).
+    const double magnitude = std::max(a.magnitude(), b.magnitude());
+    return fit_with_margin(corners,
+                           (kFrameRounding + 16 * std::numeric_limits<double>::epsilon()) * magnitude);
+  }
+
+  static PairContext make_context(const RigidTransform& pose) {
+    return {PlainMat3::from(pose.rotation), to_double3(pose.translation),
+            pose.translation.cwiseAbs().maxCoeff()};
+  }
+
+  static bool overlap(const Obb& a, const Obb& b, const PairContext& c) {
+    const Mat3 ra = axes_of(a.orientation), rb = axes_of(b.orientation);
+    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center), ha = to_vec(a.half), hb = to_vec(b.half);
+    const auto rotation = c.rotation.map();
+    // B's axes (columns) and the centre offset in A's box frame.
+    const Mat3 m = ra.transpose() * (rotation * rb);
+    const Vec3 t = ra.transpose() * (rotation * cb + to_vec(c.translation) - ca);
+    const Mat3 abs_m = m.cwiseAbs().array() + Scalar(8) * std::numeric_limits<Scalar>::epsilon();
+
+    double gap = -std::numeric_limits<double>::infinity();  // largest (|T . L| - radii) over the 15 axes
+    for (int i = 0; i < 3; ++i) gap = std::max(gap, std::abs(t[i]) - ha[i] - abs_m.row(i).dot(hb));
+    for (int j = 0; j < 3; ++j) gap = std::max(gap, std::abs(t.dot(m.col(j))) - abs_m.col(j).dot(ha) - hb[j]);
+    for (int i = 0; i < 3; ++i) {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+      for (int j = 0; j < 3; ++j) {
+        const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+        // L = a_i x b_j in A's frame.
+        const double distance = std::abs(t[i2] * m(i1, j) - t[i1] * m(i2, j));
+        const double radius_a = ha[i1] * abs_m(i2, j) + ha[i2] * abs_m(i1, j);
+        const double radius_b = hb[j1] * abs_m(i, j2) + hb[j2] * abs_m(i, j1);
+        gap = std::max(gap, distance - radius_a - radius_b);
+      }
+    }
+    const double magnitude = a.magnitude() + b.magnitude() + c.translation_magnitude;
+    return gap <= 64 * std::numeric_limits<double>::epsilon() * magnitude;
+  }
+
+  [[nodiscard]] bool empty() const { return half[0] < 0; }
+  [[nodiscard]] Scalar volume() const { return empty() ? 0 : 8 * double(half[0]) * half[1] * half[2]; }
+
+  [[nodiscard]] Box bounding_box() const {
+    if (empty()) return {};
+    const Vec3 reach =
+        axes_of(orientation).cwiseAbs() * to_vec(half) + Vec3::Constant(kFrameRounding * magnitude());
+    return {to_vec(center) - reach, to_vec(center) + reach};
+  }
+
+  [[nodiscard]] bool contains(const Vec3& p) const {
+    if (empty()) return false;
+    const Vec3 local = local_coordinates(axes_of(orientation), to_vec(center), p);
+    return (local.cwiseAbs().array() <= to_vec(half).array()).all();
+  }
+
+ private:
+  // One expression for fit and contains, so a fitted point always tests as contained.
+  static Vec3 local_coordinates(const Mat3& axes, const Vec3& center, const Vec3& p) {
+    return axes.transpose() * (p - center);
+  }
+
+  [[nodiscard]] double magnitude() const {
+    return to_vec(center).cwiseAbs().maxCoeff() + to_vec(half).cwiseAbs().sum();
+  }
+
+  void write_corners(Vec3* out) const {
+    const Mat3 axes = axes_of(orientation);
+    const Vec3 c = to_vec(center), h = to_vec(half);
+    for (int k = 0; k < 8; ++k)
+      out[k] = c + axes * Vec3(k & 1 ? h[0] : -h[0], k & 2 ? h[1] : -h[1], k & 4 ? h[2] : -h[2]);
+  }
+
+  // The stored box for the points in the orthonormal frame F. The stored frame F' = axes_of(float
+  // quaternion) is within angle 2^-22 of F (quaternion components rounded to 2^-24 relative), and the stored
+  // centre within 2^-24 |c| of the exact one, so each half-extent measured in F about c grows by
+  // kFrameRounding * (largest |p - c|) + 2^-24 |c| (triangle inequality) and a few ulps. Bounding the
+  // rounding instead of re-measuring against the stored floats also keeps this correct under GCC 12's -O2
+  // SLP vectoriser, which folds double(float(x)) back to x.
+  static constexpr double kFrameRounding = 0x1p-21;
+  static Obb box_in_frame(std::span<const Vec3> points, const Mat3& frame, double margin) {
+    Obb out;
+    Eigen::Quaterniond q(frame);
+    q.normalize();
+    out.orientation = {float(q.x()), float(q.y()), float(q.z()), float(q.w())};
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const Vec3& p : points) {
+      const Vec3 s = frame.transpose() * p;
+      lo = lo.cwiseMin(s);
+      hi = hi.cwiseMax(s);
+    }
+    const Vec3 center = frame * ((lo + hi) * 0.5);
+    out.center = {float(center.x()), float(center.y()), float(center.z())};
+    Vec3 reach = Vec3::Zero();
+    double farthest = 0;
+    for (const Vec3& p : points) {
+      reach = reach.cwiseMax(local_coordinates(frame, center, p).cwiseAbs());
+      farthest = std::max(farthest, (p - center).norm());
+    }
+    const double widen = kFrameRounding * farthest + 0x1p-24 * center.norm() + 1e-44 + margin;
+    out.half = float3_up((reach.array() + widen) * (1 + 8 * std::numeric_limits<double>::epsilon()));
+    return out;
+  }
+
+  static Obb fit_with_margin(std::span<const Vec3> points, double margin) {
+    if (std::any_of(points.begin(), points.end(), [](const Vec3& p) { return !p.allFinite(); }))
+      throw std::invalid_argument("obb::fit: a point has a NaN or infinite coordinate");
+    if (points.empty()) return {};
+    Vec3 mean = Vec3::Zero();
+    for (const Vec3& p : points) mean += p;
+    mean /= double(points.size());
+    Mat3 covariance = Mat3::Zero();
+    for (const Vec3& p : points) covariance += (p - mean) * (p - mean).transpose();
+    Mat3 pca = Mat3::Identity();
+    if (covariance.allFinite()) {
+      const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
+      if (solver.info() == Eigen::Success) {
+        pca = solver.eigenvectors();
+        pca.col(2) = pca.col(0).cross(pca.col(1));  // right-handed, so it is a rotation
+      }
+    }
+    const Obb by_pca = box_in_frame(points, pca, margin);
+    const Obb by_axes = box_in_frame(points, Mat3::Identity(), margin);
+    return smaller(by_pca, by_axes) ? by_pca : by_axes;
+  }
+
+  // Smaller volume wins; for (nearly) flat boxes, the smaller surface, then the smaller extents.
+  static bool smaller(const Obb& a, const Obb& b) {
+    const Vec3 ha = to_vec(a.half), hb = to_vec(b.half);
+    auto area = [](const Vec3& h) { return h[0] * h[1] + h[1] * h[2] + h[0] * h[2]; };
+    const double va = a.volume(), vb = b.volume();
+    if (std::abs(va - vb) > 1e-9 * std::max(va, vb)) return va < vb;
+    const double aa = area(ha), ab = area(hb);
+    if (std::abs(aa - ab) > 1e-9 * std::max(aa, ab)) return aa < ab;
+    return ha.sum() <= hb.sum();
+  }
+};
+
+static_assert(BoundingVolume<Obb>);
+
+}  // namespace bvhlab

@@ -1,0 +1,141 @@
+// Bounding sphere: centre and radius as floats (16 bytes); the overlap test is one distance comparison.
+//
+// Fit: the smallest of three cheap candidates, each a sphere around a centre with the largest distance to
+// the points as radius: the bounding-box centre, the centroid, and Ritter's grown sphere (from an
+// approximate diameter, enlarged for every point outside). Not the minimal sphere, typically within a few
+// percent of it. The radius is widened by a bound on the centre's rounding to float and rounded up, so the
+// stored sphere holds every point.
+#pragma once
+
+#include "volumes/concept.hpp"
+#include "volumes/storage.hpp"
+
+#include <algorithm>
+#include <numbers>
+
+namespace bvhlab {
+
+struct Sphere {
+  Float3 center{0, 0, 0};
+  float radius = -1;  // negative: empty
+
+  struct PairContext {
+    PlainMat3 rotation;  // B -> A
+    Double3 translation;
+    double translation_magnitude;  // max |t_i|
+  };
+
+  static constexpr std::string_view name() { return "sphere"; }
+
+  static Sphere fit(std::span<const Vec3> points) {
+    if (std::any_of(points.begin(), points.end(), [](const Vec3& p) { return !p.allFinite(); }))
+      throw std::invalid_argument("sphere::fit: a point has a NaN or infinite coordinate");
+    if (points.empty()) return {};
+    Box box;
+    Vec3 centroid = Vec3::Zero();
+    for (const Vec3& p : points) {
+      box.extend(p);
+      centroid += p;
+    }
+    centroid /= double(points.size());
+    Sphere best = around(points, box.center(), 0);
+    for (const Sphere& candidate : {around(points, centroid, 0), around(points, ritter_center(points), 0)})
+      if (candidate.radius < best.radius) best = candidate;
+    return best;
+  }
+
+  static Sphere merge(const Sphere& a, const Sphere& b) {
+    if (a.empty()) return b;
+    if (b.empty()) return a;
+    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center);
+    // Inputs are widened by their own centre rounding bound: under the GCC 12 folding (see rounded()) the
+    // centres read here may be the unrounded ones.
+    const double ra = a.radius + 0x1p-24 * ca.norm(), rb = b.radius + 0x1p-24 * cb.norm();
+    const double gap = (cb - ca).norm() * (1 + 4 * std::numeric_limits<double>::epsilon());
+    if (gap + rb <= a.radius) return a;
+    if (gap + ra <= b.radius) return b;
+    // The smallest sphere around both: its diameter spans the two far ends along the centre line.
+    const double radius = (gap + ra + rb) / 2;
+    const Vec3 center = gap > 0 ? Vec3(ca + (cb - ca) * ((radius - ra) / gap)) : ca;
+    return rounded(center,
+                   radius + 8 * std::numeric_limits<double>::epsilon() * std::max(ca.norm(), cb.norm()));
+  }
+
+  static PairContext make_context(const RigidTransform& pose) {
+    return {PlainMat3::from(pose.rotation), to_double3(pose.translation),
+            pose.translation.cwiseAbs().maxCoeff()};
+  }
+
+  static bool overlap(const Sphere& a, const Sphere& b, const PairContext& c) {
+    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center);
+    const Vec3 offset = c.rotation.map() * cb + to_vec(c.translation) - ca;
+    const double slack = 32 * std::numeric_limits<double>::epsilon() *
+                         (ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + c.translation_magnitude +
+                          double(a.radius) + double(b.radius));
+    const double reach = double(a.radius) + double(b.radius) + slack;
+    return offset.squaredNorm() <= reach * reach;
+  }
+
+  [[nodiscard]] bool empty() const { return radius < 0; }
+  [[nodiscard]] Scalar volume() const {
+    return empty() ? 0 : 4.0 / 3.0 * std::numbers::pi * double(radius) * radius * radius;
+  }
+  [[nodiscard]] Box bounding_box() const {
+    if (empty()) return {};
+    const Vec3 c = to_vec(center);
+    // c +- r in double is exact for all but extreme exponent gaps; the margin covers those.
+    const Vec3 reach = Vec3::Constant(radius + 4 * std::numeric_limits<double>::epsilon() *
+                                                   (c.cwiseAbs().maxCoeff() + radius));
+    return {c - reach, c + reach};
+  }
+  [[nodiscard]] bool contains(const Vec3& p) const {
+    return !empty() && distance(to_vec(center), p) <= radius;
+  }
+
+ private:
+  // One expression for fit and contains, so a fitted point always tests as contained.
+  static double distance(const Vec3& c, const Vec3& p) { return (p - c).norm(); }
+
+  static Sphere around(std::span<const Vec3> points, const Vec3& center, double margin) {
+    double r = 0;
+    for (const Vec3& p : points) r = std::max(r, distance(center, p));
+    return rounded(center, r + margin);
+  }
+
+  // The stored sphere for an exact one: the centre moves by at most one float rounding (half an ulp,
+  // <= 2^-24 |c|), so the radius grows by that bound and a few ulps for the arithmetic. Bounding the move
+  // instead of measuring it also keeps this correct under GCC 12's -O2 SLP vectoriser, which folds
+  // double(float(x)) back to x.
+  static Sphere rounded(const Vec3& center, double radius) {
+    Sphere out;
+    out.center = {float(center.x()), float(center.y()), float(center.z())};
+    const double moved = 0x1p-24 * center.norm() + 1e-44;
+    out.radius = float_up((radius + moved) * (1 + 8 * std::numeric_limits<double>::epsilon()));
+    return out;
+  }
+
+  static Vec3 ritter_center(std::span<const Vec3> points) {
+    auto farthest = [&](const Vec3& from) {
+      const Vec3* best = &points[0];
+      for (const Vec3& p : points)
+        if ((p - from).squaredNorm() > (*best - from).squaredNorm()) best = &p;
+      return *best;
+    };
+    const Vec3 y = farthest(points[0]), z = farthest(y);
+    Vec3 center = (y + z) / 2;
+    double radius = (z - y).norm() / 2;
+    for (const Vec3& p : points) {
+      const double d = (p - center).norm();
+      if (d > radius) {
+        const double grown = (radius + d) / 2;
+        center += (p - center) * ((grown - radius) / d);
+        radius = grown;
+      }
+    }
+    return center;
+  }
+};
+
+static_assert(BoundingVolume<Sphere>);
+
+}  // namespace bvhlab
