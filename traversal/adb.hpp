@@ -52,6 +52,11 @@ struct AdbOptions {
   double best_effort_threshold = 0.5;
   /// Guided exact: leaf pairs run exact triangle tests, no pruning by probability; the answer is exact.
   bool exact_leaves = false;
+  /// Leaf pairs cannot be refined; each one left below p_min is still evidence. When set, the traversal
+  /// tracks 1 - prod(1 - p_i) over those pairs (the probability that at least one of them collides, if
+  /// independent) and answers "collision" once that exceeds p_min. When not set: the paper's literal
+  /// rule, which drops each such pair. (A running product: no transcendental math.)
+  bool combine_leaf_evidence = true;
 
   /// Throws std::invalid_argument for nonsense values (NaN, outside [0, 1], negative deadline).
   void validate() const {
@@ -153,6 +158,7 @@ struct QueuedPair {
 template <class Queue>
 Result& finish_adb(Result& result, const Queue& queue, const AdbOptions& options, bool budget_hit,
                    bool dropped_possible_contact, double best_dropped) {
+  // best_dropped: the strongest evidence left unexamined (a single pair's or the combined leaf estimate).
   if (result.collides) return result;
   if (budget_hit) {
     result.budget_exhausted = true;
@@ -210,6 +216,7 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
   std::priority_queue<Pair> queue;
   bool dropped_possible_contact = false;  // a pair whose volumes overlap was left unexamined
   double best_dropped = 0;
+  double no_contact_in_leaves = 1;  // prod(1 - p) over leaf pairs left below p_min
 
   auto consider = [&](Pair e) -> bool {  // true: answer found
     const double p = probability(e);
@@ -276,6 +283,17 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
       } else {
         dropped_possible_contact = true;  // nothing left to refine: the pair's estimate stays below p_min
         best_dropped = std::max(best_dropped, top.probability);
+        if (options.combine_leaf_evidence) {
+          no_contact_in_leaves *= 1 - top.probability;
+          const double combined = 1 - no_contact_in_leaves;
+          best_dropped = std::max(best_dropped, combined);
+          if (combined > options.p_min) {
+            result.collides = true;
+            result.exact = false;
+            result.probability = combined;
+            return result;
+          }
+        }
       }
       continue;
     }

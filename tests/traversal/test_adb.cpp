@@ -103,6 +103,29 @@ TEST(AdbTraversal, PMinEnds) {
   EXPECT_FALSE(r1.exact);
 }
 
+TEST(AdbTraversal, CombiningLeafEvidenceOnlyAddsCollisionsAndNeverCostsMore) {
+  const Scene scene;
+  std::mt19937_64 rng(37);
+  int changed = 0;
+  for (double p_min : {0.5, 0.9, 0.99})
+    for (int k = 0; k < 150; ++k) {
+      const RigidTransform pose = testing::random_pose(rng, 1.2);
+      AdbOptions literal;
+      literal.p_min = p_min;
+      literal.combine_leaf_evidence = false;
+      AdbOptions combined = literal;
+      combined.combine_leaf_evidence = true;
+      const Result a = query_adb(scene.tree_a, scene.tree_b, pose, scene.model, literal);
+      const Result b = query_adb(scene.tree_a, scene.tree_b, pose, scene.model, combined);
+      // Same traversal order until the combined evidence decides, so a literal "collision" is found too.
+      if (a.collides) EXPECT_TRUE(b.collides) << "pose " << k;
+      EXPECT_LE(b.counters.bv_tests, a.counters.bv_tests);
+      EXPECT_TRUE(b.probability >= 0 && b.probability <= 1);
+      changed += a.collides != b.collides;
+    }
+  EXPECT_GT(changed, 0);  // the option must matter on this scene, or the test shows nothing
+}
+
 TEST(AdbTraversal, DisjointIsAnExactNo) {
   const Scene scene;
   const Result r =
