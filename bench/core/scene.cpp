@@ -1,0 +1,618 @@
+#include "bench/core/scene.hpp"
+
+#include "adb/lb_table.hpp"
+#include "bench/core/content_hash.hpp"
+#include "bench/core/mesh_catalog.hpp"
+#include "bench/core/protocol.hpp"
+#include "bench/core/registry.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace bvhlab {
+
+using json = nlohmann::json;
+
+std::string_view to_string(StrategyKind kind) {
+  switch (kind) {
+    case StrategyKind::Exact:
+      return "exact";
+    case StrategyKind::GuidedExact:
+      return "guided_exact";
+    case StrategyKind::Adb:
+      return "adb";
+    case StrategyKind::TimeCritical:
+      return "time_critical";
+  }
+  return "?";
+}
+
+namespace {
+
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string join(const std::vector<std::string>& items, std::string_view sep = ", ") {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? std::string(sep) : "") + items[i];
+  return out;
+}
+
+/// A JSON value and where it sits (a JSON pointer), so every complaint can name the field.
+class Node {
+ public:
+  Node(const json& value, std::string pointer, const std::string& source)
+      : value_(&value), pointer_(std::move(pointer)), source_(&source) {}
+
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw SceneError(*source_ + ": " + (pointer_.empty() ? "/" : pointer_) + ": " + problem);
+  }
+  [[nodiscard]] const json& value() const { return *value_; }
+  [[nodiscard]] const std::string& pointer() const { return pointer_; }
+
+  [[nodiscard]] std::string got() const {
+    const json& v = *value_;
+    if (v.is_string()) return "got \"" + v.get<std::string>() + "\"";
+    if (v.is_number() || v.is_boolean()) return "got " + v.dump();
+    if (v.is_null()) return "got null";
+    if (v.is_array()) return "got an array";
+    return "got an object";
+  }
+
+  [[nodiscard]] bool has(const std::string& key) const { return value_->contains(key); }
+  [[nodiscard]] Node child(const std::string& key) const {
+    if (!value_->contains(key)) Node(*value_, pointer_ + "/" + key, *source_).fail("missing");
+    return Node((*value_)[key], pointer_ + "/" + escape(key), *source_);
+  }
+  [[nodiscard]] Node child(std::size_t index) const {
+    return Node((*value_)[index], pointer_ + "/" + std::to_string(index), *source_);
+  }
+
+  const Node& expect_object(const std::vector<std::string>& allowed) const {
+    if (!value_->is_object()) fail("expected an object; " + got());
+    for (const auto& [key, _] : value_->items())
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+        Node((*value_)[key], pointer_ + "/" + escape(key), *source_)
+            .fail("unknown field; expected one of " + join(allowed));
+    return *this;
+  }
+  [[nodiscard]] std::size_t array_size(bool allow_empty = false) const {
+    if (!value_->is_array()) fail("expected an array; " + got());
+    if (!allow_empty && value_->empty()) fail("expected a non-empty array");
+    return value_->size();
+  }
+  [[nodiscard]] std::string string() const {
+    if (!value_->is_string()) fail("expected a string; " + got());
+    return value_->get<std::string>();
+  }
+  [[nodiscard]] std::string choice(const std::vector<std::string>& choices) const {
+    if (!value_->is_string() ||
+        std::find(choices.begin(), choices.end(), value_->get<std::string>()) == choices.end())
+      fail("expected one of " + join(choices) + "; " + got());
+    return value_->get<std::string>();
+  }
+  [[nodiscard]] double number(double lo = -HUGE_VAL, double hi = HUGE_VAL) const {
+    if (!value_->is_number()) fail("expected a number; " + got());
+    const double v = value_->get<double>();
+    if (!std::isfinite(v) || v < lo || v > hi)
+      fail("expected a number in [" + number_text(lo) + ", " + number_text(hi) + "]; " + got());
+    return v;
+  }
+  [[nodiscard]] long long integer(long long lo, long long hi) const {
+    if (!value_->is_number_integer()) fail("expected an integer; " + got());
+    const long long v = value_->get<long long>();
+    if (v < lo || v > hi)
+      fail("expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]; " + got());
+    return v;
+  }
+  [[nodiscard]] bool boolean() const {
+    if (!value_->is_boolean()) fail("expected true or false; " + got());
+    return value_->get<bool>();
+  }
+  [[nodiscard]] std::vector<double> numbers(std::size_t count, double lo = -HUGE_VAL,
+                                            double hi = HUGE_VAL) const {
+    if (!value_->is_array() || (count && value_->size() != count))
+      fail("expected an array of " + (count ? std::to_string(count) + " " : std::string()) + "numbers; " +
+           got());
+    std::vector<double> out;
+    for (std::size_t i = 0; i < value_->size(); ++i) out.push_back(child(i).number(lo, hi));
+    return out;
+  }
+
+ private:
+  static std::string escape(const std::string& key) {  // RFC 6901
+    std::string out;
+    for (char c : key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    return out;
+  }
+  const json* value_;
+  std::string pointer_;
+  const std::string* source_;
+};
+
+json parse_json(std::string_view text, const std::string& source) {
+  try {
+    return json::parse(text.begin(), text.end());
+  } catch (const json::parse_error& e) {
+    // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ..."
+    std::string what = e.what();
+    const auto cut = what.find("] ");
+    throw SceneError(source +
+                     ": not valid JSON: " + (cut == std::string::npos ? what : what.substr(cut + 2)));
+  }
+}
+
+std::string read_text(const std::filesystem::path& file, const std::string& what) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SceneError(file.string() + ": cannot read the " + what + " file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+RigidTransform parse_transform(const Node& node) {
+  node.expect_object({"translation", "rotation", "axis_angle_deg", "group"});
+  Vec3 translation = Vec3::Zero();
+  Mat3 rotation = Mat3::Identity();
+  if (node.has("translation")) {
+    const auto t = node.child("translation").numbers(3);
+    translation = Vec3(t[0], t[1], t[2]);
+  }
+  if (node.has("rotation") && node.has("axis_angle_deg"))
+    node.child("axis_angle_deg").fail("give either \"rotation\" or \"axis_angle_deg\", not both");
+  if (node.has("rotation")) {
+    const Node r = node.child("rotation");
+    if (r.array_size() != 3) r.fail("expected 3 rows of 3 numbers");
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto row = r.child(i).numbers(3);
+      for (int j = 0; j < 3; ++j) rotation(static_cast<int>(i), j) = row[static_cast<std::size_t>(j)];
+    }
+    try {
+      return RigidTransform::checked(rotation, translation, 1e-6);
+    } catch (const std::invalid_argument& e) {
+      r.fail(std::string("not a rotation: ") + e.what());
+    }
+  }
+  if (node.has("axis_angle_deg")) {
+    const Node aa = node.child("axis_angle_deg");
+    const auto v = aa.numbers(4);
+    const Vec3 axis(v[0], v[1], v[2]);
+    if (axis.norm() == 0) aa.fail("the axis [" + number_text(v[0]) + ", 0, 0] has zero length");
+    rotation = Eigen::AngleAxisd(v[3] * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+  }
+  return RigidTransform{rotation, translation};
+}
+
+std::vector<PoseGroup> parse_poses(const json& document, const std::string& source) {
+  const Node root(document, "", source);
+  const Node list = document.is_array() ? root : root.expect_object({"poses"}).child("poses");
+  const std::size_t n = list.array_size();
+  std::vector<PoseGroup> groups;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Node entry = list.child(i);
+    const RigidTransform pose = parse_transform(entry);
+    const double group = entry.has("group") ? entry.child("group").number() : pose.translation.norm();
+    auto it =
+        std::find_if(groups.begin(), groups.end(), [&](const PoseGroup& g) { return g.distance == group; });
+    if (it == groups.end()) it = groups.insert(groups.end(), PoseGroup{group, {}});
+    it->poses.push_back(pose);
+  }
+  std::sort(groups.begin(), groups.end(),
+            [](const auto& x, const auto& y) { return x.distance < y.distance; });
+  return groups;
+}
+
+std::filesystem::path resolve_mesh(const std::string& mesh, const std::filesystem::path& base_dir) {
+  const std::filesystem::path written(mesh);
+  const std::filesystem::path relative = written.is_absolute() ? written : base_dir / written;
+  if (std::filesystem::is_regular_file(relative))
+    return std::filesystem::absolute(relative).lexically_normal();
+  if (auto found = find_mesh(written.filename().string())) return *found;
+  return {};
+}
+
+bool fcl_available() {
+#ifdef BVHLAB_HAVE_FCL
+  return true;
+#else
+  return false;
+#endif
+}
+
+}  // namespace
+
+std::vector<std::string> hierarchy_bv_names() {
+  std::vector<std::string> names = volume_names();
+  names.emplace_back("fcl_obb");
+  names.emplace_back("fcl_obbrss");
+  return names;
+}
+
+std::string StrategyVariant::budget_label() const {
+  std::string out;
+  if (budget.max_bv_tests) out += "bv_tests=" + std::to_string(budget.max_bv_tests);
+  if (budget.deadline_us > 0)
+    out += (out.empty() ? "" : ";") + std::string("deadline_us=") + number_text(budget.deadline_us);
+  return out;
+}
+
+std::string StrategyVariant::label() const {
+  std::string out(to_string(kind));
+  if (p_min >= 0) out += " p_min=" + number_text(p_min);
+  if (!budget.unlimited()) out += " " + budget_label();
+  return out;
+}
+
+std::vector<StrategyVariant> expand(const StrategySpec& spec) {
+  std::vector<StrategyVariant> out;
+  switch (spec.kind) {
+    case StrategyKind::Exact:
+    case StrategyKind::GuidedExact:
+      out.push_back({spec.kind, -1, {}, 0.5});
+      break;
+    case StrategyKind::Adb:
+      for (double p : spec.p_min) out.push_back({spec.kind, p, {}, 0.5});
+      break;
+    case StrategyKind::TimeCritical:
+      for (const Budget& b : spec.budgets)
+        out.push_back(
+            {spec.kind, spec.p_min.empty() ? 0.9 : spec.p_min.front(), b, spec.best_effort_threshold});
+      break;
+  }
+  return out;
+}
+
+const SceneObject* Scene::object(std::string_view name) const {
+  for (const auto& o : objects)
+    if (o.name == name) return &o;
+  return nullptr;
+}
+
+const HierarchySpec* Scene::hierarchy(std::string_view name) const {
+  for (const auto& h : hierarchies)
+    if (h.name == name) return &h;
+  return nullptr;
+}
+
+bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
+  if (!s.hierarchies.empty() &&
+      std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
+    return false;
+  return !h.is_fcl() || s.kind == StrategyKind::Exact;
+}
+
+bool Scene::needs_annotation(const HierarchySpec& h) const {
+  return std::any_of(strategies.begin(), strategies.end(),
+                     [&](const StrategySpec& s) { return s.needs_annotation() && applies(s, h); });
+}
+
+std::vector<PoseGroup> load_pose_file(const std::filesystem::path& file) {
+  const std::string source = file.string();
+  return parse_poses(parse_json(read_text(file, "pose"), source), source);
+}
+
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_dir,
+                  std::string_view source_name) {
+  const std::string source(source_name);
+  const json document = parse_json(json_text, source);
+  const Node root(document, "", source);
+  root.expect_object({"name", "description", "objects", "pairs", "hierarchies", "annotation", "strategies",
+                      "workload", "report"});
+  Scene scene;
+  scene.name = root.has("name") ? root.child("name").string() : "scene";
+
+  // Objects.
+  const Node objects = root.child("objects");
+  for (std::size_t i = 0, n = objects.array_size(); i < n; ++i) {
+    const Node o = objects.child(i);
+    o.expect_object({"mesh", "name", "optional", "normalize", "scale", "placement"});
+    SceneObject obj;
+    obj.mesh = o.child("mesh").string();
+    if (obj.mesh.empty()) o.child("mesh").fail("expected a mesh path or catalog name; got \"\"");
+    obj.name = o.has("name") ? o.child("name").string() : std::filesystem::path(obj.mesh).stem().string();
+    if (obj.name.empty()) o.child("name").fail("expected a non-empty name");
+    if (scene.object(obj.name))
+      (o.has("name") ? o.child("name") : o.child("mesh"))
+          .fail("duplicate object name \"" + obj.name + "\" (give each object its own \"name\")");
+    if (o.has("optional")) obj.optional = o.child("optional").boolean();
+    if (o.has("normalize")) obj.normalize = o.child("normalize").boolean();
+    if (o.has("scale")) {
+      obj.scale = o.child("scale").number(0, 1e12);
+      if (!(obj.scale > 0)) o.child("scale").fail("expected a positive number; " + o.child("scale").got());
+    }
+    if (o.has("placement")) obj.placement = parse_transform(o.child("placement"));
+    obj.path = resolve_mesh(obj.mesh, base_dir);
+    if (obj.path.empty() && !obj.optional)
+      o.child("mesh").fail(
+          "mesh \"" + obj.mesh + "\" not found relative to " + base_dir.string() +
+          " nor in the mesh catalog (bundled meshes/ or the fetched-mesh cache; fetch it with "
+          "meshes/fetch.sh, or mark the object \"optional\": true)");
+    scene.objects.push_back(std::move(obj));
+  }
+
+  // Pairs.
+  if (root.has("pairs")) {
+    const Node pairs = root.child("pairs");
+    for (std::size_t i = 0, n = pairs.array_size(); i < n; ++i) {
+      const Node p = pairs.child(i);
+      if (!p.value().is_array() || p.value().size() != 2)
+        p.fail("expected [\"object A\", \"object B\"]; " + p.got());
+      ScenePair pair{p.child(std::size_t{0}).string(), p.child(1).string()};
+      for (std::size_t k = 0; k < 2; ++k) {
+        const std::string& nm = k ? pair.b : pair.a;
+        if (!scene.object(nm)) {
+          std::vector<std::string> names;
+          for (const auto& o : scene.objects) names.push_back(o.name);
+          p.child(k).fail("no object named \"" + nm + "\"; expected one of " + join(names));
+        }
+      }
+      scene.pairs.push_back(pair);
+    }
+  } else {
+    for (const auto& o : scene.objects) scene.pairs.push_back({o.name, o.name});
+  }
+
+  // Hierarchies.
+  const std::vector<std::string> bv_names = hierarchy_bv_names();
+  const Node hierarchies = root.child("hierarchies");
+  for (std::size_t i = 0, n = hierarchies.array_size(); i < n; ++i) {
+    const Node h = hierarchies.child(i);
+    h.expect_object({"bv", "name", "split", "max_leaf_triangles", "optional"});
+    HierarchySpec spec;
+    const bool optional = h.has("optional") && h.child("optional").boolean();
+    const std::string bv = h.child("bv").string();
+    const bool known = std::find(bv_names.begin(), bv_names.end(), bv) != bv_names.end();
+    const bool missing_fcl = bv.rfind("fcl_", 0) == 0 && !fcl_available();
+    if (optional && (!known || missing_fcl)) {
+      scene.notes.push_back("hierarchy " + (h.has("name") ? h.child("name").string() : bv) + " skipped: " +
+                            (missing_fcl ? "this build has no FCL (BVHLAB_WITH_FCL=OFF)"
+                                         : "\"" + bv + "\" is not a registered bounding volume"));
+      continue;
+    }
+    spec.bv = h.child("bv").choice(bv_names);
+    if (missing_fcl)
+      h.child("bv").fail("\"" + spec.bv + "\" needs a build with FCL (configure with -DBVHLAB_WITH_FCL=ON)");
+    spec.name = h.has("name") ? h.child("name").string() : spec.bv;
+    if (spec.name.empty()) h.child("name").fail("expected a non-empty name");
+    if (scene.hierarchy(spec.name))
+      (h.has("name") ? h.child("name") : h.child("bv"))
+          .fail("duplicate hierarchy name \"" + spec.name + "\" (give each hierarchy its own \"name\")");
+    if (h.has("split")) {
+      if (spec.is_fcl()) h.child("split").fail("FCL builds its own hierarchy; \"split\" does not apply");
+      spec.build.split = split_method_from_string(h.child("split").choice({"sah", "median"}));
+    }
+    if (h.has("max_leaf_triangles")) {
+      if (spec.is_fcl())
+        h.child("max_leaf_triangles").fail("FCL builds its own hierarchy; this does not apply");
+      spec.build.max_leaf_triangles =
+          static_cast<std::uint32_t>(h.child("max_leaf_triangles").integer(1, 255));
+    }
+    scene.hierarchies.push_back(std::move(spec));
+  }
+  if (scene.hierarchies.empty()) hierarchies.fail("no hierarchy is available in this build");
+
+  // Annotation.
+  if (root.has("annotation")) {
+    const Node a = root.child("annotation");
+    a.expect_object({"type", "grid", "tau"});
+    scene.annotation.adb = a.child("type").choice({"none", "adb"}) == "adb";
+    if (!scene.annotation.adb && (a.has("grid") || a.has("tau")))
+      (a.has("grid") ? a.child("grid") : a.child("tau")).fail("only an \"adb\" annotation takes this field");
+    if (a.has("grid")) scene.annotation.grid = static_cast<int>(a.child("grid").integer(2, 4));
+    if (a.has("tau")) {
+      const Node t = a.child("tau");
+      scene.annotation.tau = t.number(0, 1e6);
+      try {
+        (void)lb_for_tau(scene.annotation.tau);
+      } catch (const std::invalid_argument& e) {
+        t.fail(std::string("no LB value for this tau (") + e.what() + ")");
+      }
+    }
+  }
+
+  // A name of a hierarchy left out above may still be referred to: it is skipped there too.
+  auto skipped_hierarchy = [&](const std::string& name) {
+    return std::any_of(scene.notes.begin(), scene.notes.end(), [&](const std::string& note) {
+      return note.rfind("hierarchy " + name + " skipped", 0) == 0;
+    });
+  };
+
+  // Strategies.
+  const Node strategies = root.child("strategies");
+  for (std::size_t i = 0, n = strategies.array_size(); i < n; ++i) {
+    const Node s = strategies.child(i);
+    if (!s.value().is_object()) s.fail("expected an object; " + s.got());
+    const std::string type = s.child("type").choice({"exact", "guided_exact", "adb", "time_critical"});
+    StrategySpec spec;
+    if (type == "exact") {
+      s.expect_object({"type", "hierarchies"});
+      spec.kind = StrategyKind::Exact;
+    } else if (type == "guided_exact") {
+      s.expect_object({"type", "hierarchies"});
+      spec.kind = StrategyKind::GuidedExact;
+    } else if (type == "adb") {
+      s.expect_object({"type", "p_min", "hierarchies"});
+      spec.kind = StrategyKind::Adb;
+      const Node p = s.child("p_min");
+      spec.p_min = p.value().is_array() ? p.numbers(0, 0, 1) : std::vector<double>{p.number(0, 1)};
+      if (spec.p_min.empty()) p.fail("expected at least one p_min");
+    } else {
+      s.expect_object({"type", "p_min", "budgets", "best_effort_threshold", "hierarchies"});
+      spec.kind = StrategyKind::TimeCritical;
+      spec.p_min = {s.has("p_min") ? s.child("p_min").number(0, 1) : 0.9};
+      if (s.has("best_effort_threshold"))
+        spec.best_effort_threshold = s.child("best_effort_threshold").number(0, 1);
+      const Node budgets = s.child("budgets");
+      for (std::size_t k = 0, m = budgets.array_size(); k < m; ++k) {
+        const Node b = budgets.child(k);
+        b.expect_object({"bv_tests", "deadline_us"});
+        Budget budget;
+        if (b.has("bv_tests"))
+          budget.max_bv_tests = static_cast<std::uint64_t>(b.child("bv_tests").integer(1, 1LL << 40));
+        if (b.has("deadline_us")) {
+          budget.deadline_us = b.child("deadline_us").number(0, 1e9);
+          if (!(budget.deadline_us > 0))
+            b.child("deadline_us").fail("expected a positive number of microseconds");
+        }
+        if (budget.unlimited()) b.fail("expected \"bv_tests\" and/or \"deadline_us\"");
+        spec.budgets.push_back(budget);
+      }
+    }
+    if (s.has("hierarchies")) {
+      const Node hs = s.child("hierarchies");
+      for (std::size_t k = 0, m = hs.array_size(); k < m; ++k) {
+        std::vector<std::string> names;
+        for (const auto& h : scene.hierarchies) names.push_back(h.name);
+        const std::string written = hs.child(k).string();
+        if (skipped_hierarchy(written)) continue;
+        const std::string name = hs.child(k).choice(names);
+        if (scene.hierarchy(name)->is_fcl() && spec.kind != StrategyKind::Exact)
+          hs.child(k).fail("\"" + type + "\" needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only");
+        spec.hierarchies.push_back(name);
+      }
+      if (spec.hierarchies.empty()) {  // every hierarchy it names was optional and left out
+        scene.notes.push_back("strategy /strategies/" + std::to_string(i) + " (" + type +
+                              ") skipped: none of its hierarchies is available");
+        continue;
+      }
+    }
+    if (spec.needs_annotation() && !scene.annotation.adb)
+      s.child("type").fail(
+          "\"" + type +
+          "\" needs the ADB annotation; add \"annotation\": {\"type\": \"adb\", \"grid\": 2, "
+          "\"tau\": 0.5}");
+    const bool applies_somewhere =
+        std::any_of(scene.hierarchies.begin(), scene.hierarchies.end(),
+                    [&](const HierarchySpec& h) { return scene.applies(spec, h); });
+    if (!applies_somewhere)
+      s.fail("\"" + type + "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\" only)");
+    scene.strategies.push_back(std::move(spec));
+  }
+  if (scene.annotation.adb && std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
+                                           [&](const HierarchySpec& h) { return scene.needs_annotation(h); }))
+    root.child("annotation")
+        .fail("an ADB annotation is set but no strategy uses it (it would cost time for nothing)");
+
+  // Workload.
+  if (root.has("workload")) {
+    const Node w = root.child("workload");
+    if (!w.value().is_object()) w.fail("expected an object; " + w.got());
+    const bool protocol = !w.has("type") || w.child("type").choice({"protocol", "poses"}) == "protocol";
+    if (protocol) {
+      w.expect_object({"type", "distances", "steps"});
+      if (w.has("distances")) {
+        scene.workload.distances = w.child("distances").numbers(0, 0, 1e6);
+        if (scene.workload.distances.empty()) w.child("distances").fail("expected at least one distance");
+      }
+      if (w.has("steps")) scene.workload.steps = static_cast<int>(w.child("steps").integer(1, 10'000'000));
+    } else {
+      w.expect_object({"type", "file"});
+      scene.workload.kind = WorkloadSpec::Kind::PoseFile;
+      const Node f = w.child("file");
+      std::filesystem::path file(f.string());
+      if (!file.is_absolute()) file = base_dir / file;
+      scene.workload.pose_file = file;
+      std::string text;
+      try {
+        text = read_text(file, "pose");
+        scene.workload.groups = parse_poses(parse_json(text, file.string()), file.string());
+      } catch (const SceneError& e) {
+        f.fail(e.what());
+      }
+      scene.workload.identity = "poses:" + ContentHash().update(text).hex();
+    }
+  }
+  if (scene.workload.kind == WorkloadSpec::Kind::Protocol) {
+    std::string identity = "protocol:steps=" + std::to_string(scene.workload.steps) + ":d=";
+    for (double d : scene.workload.distances) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.17g,", d);
+      identity += buf;
+      scene.workload.groups.push_back({d, protocol_poses(d, scene.workload.steps)});
+    }
+    scene.workload.identity = identity;
+  }
+
+  // Report.
+  ReportSpec& report = scene.report;
+  if (root.has("report")) {
+    const Node r = root.child("report");
+    r.expect_object({"quality_distances", "cgal_sample", "operating_point", "baseline"});
+    if (r.has("quality_distances")) {
+      const auto q = r.child("quality_distances").numbers(2, 0, 1e6);
+      if (q[0] > q[1]) r.child("quality_distances").fail("expected [min, max] with min <= max");
+      report.quality_min = q[0];
+      report.quality_max = q[1];
+    }
+    if (r.has("cgal_sample"))
+      report.cgal_sample = static_cast<int>(r.child("cgal_sample").integer(0, 1'000'000));
+    if (r.has("operating_point")) {
+      const Node op = r.child("operating_point");
+      op.expect_object({"hierarchy", "p_min"});
+      std::vector<std::string> annotated;
+      for (const auto& h : scene.hierarchies)
+        if (scene.needs_annotation(h)) annotated.push_back(h.name);
+      if (annotated.empty()) op.fail("an operating point needs an \"adb\" strategy on some hierarchy");
+      if (op.has("hierarchy") && !skipped_hierarchy(op.child("hierarchy").string()))
+        report.operating_hierarchy = op.child("hierarchy").choice(annotated);
+      if (op.has("p_min")) report.operating_p_min = op.child("p_min").number(0, 1);
+    }
+    if (r.has("baseline")) {
+      const Node b = r.child("baseline");
+      b.expect_object({"hierarchy", "strategy"});
+      std::vector<std::string> names;
+      for (const auto& h : scene.hierarchies) names.push_back(h.name);
+      if (b.has("hierarchy") && !skipped_hierarchy(b.child("hierarchy").string()))
+        report.baseline_hierarchy = b.child("hierarchy").choice(names);
+      if (b.has("strategy"))
+        report.baseline_strategy = b.child("strategy").choice({"exact", "guided_exact"}) == "exact"
+                                       ? StrategyKind::Exact
+                                       : StrategyKind::GuidedExact;
+    }
+  }
+  // Defaults and cross-checks of the report's choices against what the scene runs.
+  std::vector<double> adb_p_min;
+  for (const auto& s : scene.strategies)
+    if (s.kind == StrategyKind::Adb) adb_p_min.insert(adb_p_min.end(), s.p_min.begin(), s.p_min.end());
+  if (report.operating_hierarchy.empty())
+    for (const auto& h : scene.hierarchies)
+      if (report.operating_hierarchy.empty() && scene.needs_annotation(h))
+        report.operating_hierarchy = h.name;
+  if (report.operating_p_min < 0 && !adb_p_min.empty()) {
+    std::sort(adb_p_min.begin(), adb_p_min.end());
+    report.operating_p_min = adb_p_min.back();
+    for (double p : adb_p_min)
+      if (p <= 0.9) report.operating_p_min = p;
+  } else if (report.operating_p_min >= 0 &&
+             std::find(adb_p_min.begin(), adb_p_min.end(), report.operating_p_min) == adb_p_min.end()) {
+    root.child("report").child("operating_point").child("p_min").fail("no \"adb\" strategy runs this p_min");
+  }
+  if (report.baseline_hierarchy.empty()) {
+    report.baseline_hierarchy = scene.hierarchies.front().name;
+    for (const auto& h : scene.hierarchies)
+      if (h.bv == "dop24") {
+        report.baseline_hierarchy = h.name;
+        break;
+      }
+  }
+  return scene;
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  const std::string text = read_text(file, "scene");
+  Scene scene = parse_scene(text, std::filesystem::absolute(file).parent_path(), file.string());
+  scene.file = file;
+  if (scene.name == "scene") scene.name = file.stem().string();
+  return scene;
+}
+
+}  // namespace bvhlab

@@ -1,0 +1,162 @@
+// A scene file says what one experiment needs: objects, hierarchies, annotation, strategies, workload and
+// what the report should single out. Only what it names is built, annotated, loaded and run.
+//
+// Format (JSON; every field except "objects", "hierarchies" and "strategies" is optional):
+//   {
+//     "name": "demo",
+//     "objects": [ {"mesh": "jeep1.ms3d", "name": "jeep", "optional": false, "normalize": true,
+//                   "scale": 1.0, "placement": {"translation": [0,0,0], "axis_angle_deg": [0,0,1, 0]}} ],
+//     "pairs": [["jeep", "jeep"]],                  // default: every object against a copy of itself
+//     "hierarchies": [ {"bv": "aabb", "name": "aabb", "split": "sah", "max_leaf_triangles": 1},
+//                      {"bv": "fcl_obbrss", "optional": true} ],   // optional: skipped if this build lacks
+//                      it
+//     "annotation": {"type": "adb", "grid": 2, "tau": 0.5},     // or {"type": "none"} (the default)
+//     "strategies": [ {"type": "exact"}, {"type": "guided_exact"},
+//                     {"type": "adb", "p_min": [0.5, 0.9]},
+//                     {"type": "time_critical", "p_min": 0.9, "budgets": [{"bv_tests": 200}, {"deadline_us":
+//                     20}]} ],
+//     "workload": {"type": "protocol", "distances": [0.4, 0.6], "steps": 500}
+//              or {"type": "poses", "file": "poses.json"},
+//     "report": {"quality_distances": [1.2, 2.0], "cgal_sample": 64,
+//                "operating_point": {"hierarchy": "aabb", "p_min": 0.9},
+//                "baseline": {"hierarchy": "dop24", "strategy": "exact"}}
+//   }
+// Mesh paths are taken relative to the scene file first, then looked up by file name in the mesh catalog
+// (bundled meshes/ and the fetched-mesh cache). Strategies run on every hierarchy they apply to, or on the
+// ones listed in their "hierarchies" field. A pose file holds {"poses": [{"translation": [x,y,z],
+// "rotation": [[...],[...],[...]] or "axis_angle_deg": [ax,ay,az,deg], "group": d}, ...]}; "group" (default:
+// the length of the translation) is the value the report files the pose under in its "distance" column.
+#pragma once
+
+#include "bvh/topology.hpp"
+#include "traversal/adb.hpp"
+#include "volumes/geometry.hpp"
+
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bvhlab {
+
+/// A refused scene or pose file. what() starts with the file, then the JSON pointer of the bad field:
+/// "demo.json: /hierarchies/1/bv: expected one of aabb, fcl_obb, fcl_obbrss; got \"abb\"".
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct SceneObject {
+  std::string name;            ///< label in reports; default: the mesh file's stem
+  std::string mesh;            ///< as written in the scene
+  std::filesystem::path path;  ///< resolved file; empty when not found (then `optional` must be true)
+  bool optional = false;       ///< a missing mesh skips the object (with a message) instead of failing
+  bool normalize = true;       ///< the protocol normalisation: centre to origin, longest side 2
+  double scale = 1;            ///< uniform scale applied after normalisation
+  RigidTransform placement;    ///< applied to the vertices after scaling
+};
+
+/// Two objects queried against each other: A stays put, B moves by the workload's poses.
+struct ScenePair {
+  std::string a, b;  ///< object names
+  [[nodiscard]] std::string label() const { return a == b ? a : a + "|" + b; }
+};
+
+struct HierarchySpec {
+  std::string name;  ///< label in reports; default: the BV name
+  std::string bv;    ///< a registered BV name, or fcl_obb / fcl_obbrss
+  BuildOptions build;
+  [[nodiscard]] bool is_fcl() const { return bv.rfind("fcl_", 0) == 0; }
+};
+
+struct AnnotationSpec {
+  bool adb = false;
+  int grid = 2;      ///< cells per axis, 2..4
+  double tau = 0.5;  ///< area threshold, fraction of the cell face area
+};
+
+enum class StrategyKind { Exact, GuidedExact, Adb, TimeCritical };
+std::string_view to_string(StrategyKind kind);
+
+/// One entry of "strategies"; expands into one run per p_min (adb) or per budget (time_critical).
+struct StrategySpec {
+  StrategyKind kind = StrategyKind::Exact;
+  std::vector<double> p_min;             ///< adb: the list; time_critical: exactly one value
+  std::vector<Budget> budgets;           ///< time_critical only
+  double best_effort_threshold = 0.5;    ///< time_critical only
+  std::vector<std::string> hierarchies;  ///< restricts the strategy to these; empty: all it applies to
+  [[nodiscard]] bool needs_annotation() const { return kind != StrategyKind::Exact; }
+};
+
+/// One concrete way to answer a query: the unit of a results row.
+struct StrategyVariant {
+  StrategyKind kind = StrategyKind::Exact;
+  double p_min = -1;  ///< < 0: not applicable
+  Budget budget;
+  double best_effort_threshold = 0.5;
+  [[nodiscard]] std::string budget_label() const;  ///< "" or "bv_tests=200" or "deadline_us=20"
+  [[nodiscard]] std::string label() const;         ///< e.g. "adb p_min=0.9"
+};
+std::vector<StrategyVariant> expand(const StrategySpec& spec);
+
+/// Poses filed under one value of the report's "distance" column.
+struct PoseGroup {
+  double distance = 0;
+  std::vector<RigidTransform> poses;
+};
+
+struct WorkloadSpec {
+  enum class Kind { Protocol, PoseFile } kind = Kind::Protocol;
+  std::vector<double> distances{0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0};
+  int steps = 5000;
+  std::filesystem::path pose_file;  ///< PoseFile only (resolved)
+  std::vector<PoseGroup> groups;    ///< the poses, generated or read while parsing
+  /// Identifies the pose set for the ground-truth cache (protocol parameters or the file's content hash).
+  std::string identity;
+};
+
+struct ReportSpec {
+  double quality_min = 1.2, quality_max = 2.0;  ///< distances the time-versus-quality summary uses
+  int cgal_sample = 64;                         ///< poses per object pair cross-checked against CGAL
+  std::string operating_hierarchy;              ///< default: the first annotated hierarchy
+  double operating_p_min = -1;                  ///< default: the largest p_min <= 0.9, else the largest
+  std::string baseline_hierarchy;               ///< default: dop24 if present, else the first hierarchy
+  StrategyKind baseline_strategy = StrategyKind::Exact;
+};
+
+struct Scene {
+  std::string name;
+  std::filesystem::path file;  ///< where it was read from (empty for a string)
+  std::vector<SceneObject> objects;
+  std::vector<ScenePair> pairs;
+  std::vector<HierarchySpec> hierarchies;
+  AnnotationSpec annotation;
+  std::vector<StrategySpec> strategies;
+  WorkloadSpec workload;
+  ReportSpec report;
+  /// What the parser left out on purpose (an optional hierarchy this build cannot provide), for the report.
+  std::vector<std::string> notes;
+
+  [[nodiscard]] const SceneObject* object(std::string_view name) const;
+  [[nodiscard]] const HierarchySpec* hierarchy(std::string_view name) const;
+  /// Whether strategy `s` runs on hierarchy `h` (an FCL hierarchy only takes exact).
+  [[nodiscard]] bool applies(const StrategySpec& s, const HierarchySpec& h) const;
+  /// Whether any strategy on `h` needs the ADB annotation: only then is `h` annotated.
+  [[nodiscard]] bool needs_annotation(const HierarchySpec& h) const;
+};
+
+/// Names a scene may use for "bv": the registered volumes, then fcl_obb and fcl_obbrss.
+std::vector<std::string> hierarchy_bv_names();
+
+/// Parses and checks a scene. Relative paths resolve against `base_dir`. Throws SceneError.
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_dir,
+                  std::string_view source_name = "<scene>");
+/// Reads a scene file; paths resolve against its folder. Throws SceneError (also for an unreadable file).
+Scene load_scene(const std::filesystem::path& file);
+
+/// Reads an explicit pose file (format above). Throws SceneError naming the file and the JSON path.
+std::vector<PoseGroup> load_pose_file(const std::filesystem::path& file);
+
+}  // namespace bvhlab

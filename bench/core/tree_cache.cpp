@@ -1,0 +1,109 @@
+#include "bench/core/tree_cache.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <random>
+#include <sstream>
+
+namespace bvhlab {
+
+namespace tree_cache_detail {
+
+std::vector<std::byte> read_file_bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open " + file.string());
+  std::vector<char> chars((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw std::runtime_error("read error in " + file.string());
+  std::vector<std::byte> bytes(chars.size());
+  std::memcpy(bytes.data(), chars.data(), chars.size());
+  return bytes;
+}
+
+void write_file_bytes(const std::filesystem::path& file, std::span<const std::byte> bytes) {
+  std::filesystem::create_directories(file.parent_path());
+  // A unique temporary name: two runs may fill the same cache at once; the last rename wins, whole.
+  std::random_device entropy;
+  const auto temp =
+      file.parent_path() / ("." + file.filename().string() + "." + std::to_string(entropy()) + ".part");
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + temp.string());
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!out) {
+      out.close();
+      std::filesystem::remove(temp);
+      throw std::runtime_error("write error in " + temp.string());
+    }
+  }
+  std::filesystem::rename(temp, file);
+}
+
+}  // namespace tree_cache_detail
+
+TreeCache::TreeCache(std::filesystem::path dir, std::function<void(const std::string&)> log)
+    : dir_(std::move(dir)), log_(std::move(log)) {}
+
+std::filesystem::path TreeCache::tree_file(const std::string& key, std::string_view bv) const {
+  return dir_ / (std::string(bv) + "-" + ContentHash().update(key).hex() + ".tree");
+}
+
+std::filesystem::path TreeCache::meta_file(const std::filesystem::path& tree_file) {
+  auto meta = tree_file;
+  meta += ".meta.json";
+  return meta;
+}
+
+std::vector<std::byte> TreeCache::read_checked_payload(const std::string& key,
+                                                       const std::filesystem::path& file,
+                                                       CachedTreeTimes* times) const {
+  nlohmann::json meta;
+  try {
+    const auto meta_bytes = tree_cache_detail::read_file_bytes(meta_file(file));
+    meta = nlohmann::json::parse(reinterpret_cast<const char*>(meta_bytes.data()),
+                                 reinterpret_cast<const char*>(meta_bytes.data()) + meta_bytes.size());
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(std::string("unreadable meta file: ") + e.what());
+  }
+  if (!meta.is_object() || !meta.contains("key") || !meta["key"].is_string() || meta["key"] != key)
+    throw std::runtime_error("stale: the entry was made for another key");
+  if (!meta.contains("payload_bytes") || !meta.contains("payload_hash") ||
+      !meta["payload_bytes"].is_number_unsigned() || !meta["payload_hash"].is_string())
+    throw std::runtime_error("meta file lacks the payload's size or checksum");
+  std::vector<std::byte> payload = tree_cache_detail::read_file_bytes(file);
+  if (payload.size() != meta["payload_bytes"].get<std::size_t>())
+    throw std::runtime_error("payload has " + std::to_string(payload.size()) + " bytes, the meta file says " +
+                             std::to_string(meta["payload_bytes"].get<std::size_t>()));
+  if (ContentHash::to_hex(hash_bytes(payload)) != meta["payload_hash"].get<std::string>())
+    throw std::runtime_error("payload checksum mismatch");
+  if (times) {
+    times->build_seconds = meta.value("build_seconds", 0.0);
+    times->annotate_seconds = meta.value("annotate_seconds", 0.0);
+  }
+  return payload;
+}
+
+void TreeCache::write_entry(const std::string& key, const std::filesystem::path& file,
+                            std::span<const std::byte> payload, const CachedTreeTimes& times) const {
+  nlohmann::json meta = {{"key", key},
+                         {"payload_bytes", payload.size()},
+                         {"payload_hash", ContentHash::to_hex(hash_bytes(payload))},
+                         {"build_seconds", times.build_seconds},
+                         {"annotate_seconds", times.annotate_seconds}};
+  const std::string text = meta.dump(2) + "\n";
+  // Payload first, meta last: a crash in between leaves a meta-less entry, which load() rejects.
+  std::filesystem::remove(meta_file(file));
+  tree_cache_detail::write_file_bytes(file, payload);
+  tree_cache_detail::write_file_bytes(meta_file(file), std::as_bytes(std::span(text.data(), text.size())));
+}
+
+void TreeCache::say(const std::string& message) const {
+  if (log_)
+    log_(message);
+  else
+    std::cerr << message << '\n';
+}
+
+}  // namespace bvhlab

@@ -1,0 +1,229 @@
+// On-disk cache of preprocessed trees, keyed by the mesh's checksum and every option that shapes the tree.
+//
+// Each entry is two files: `<bv>-<key hash>.tree`, a tree in the saved-tree format (adb/saved_tree.hpp,
+// without polygons, so `bvhlab query` can read it too), and `<same>.meta.json`, which records the full key,
+// the payload's size and checksum, and how long the tree took to build and annotate. An entry is trusted only
+// if the meta file names the same key, the payload has the recorded size and checksum, the saved-tree reader
+// accepts it, and the decoded tree passes structural checks against the mesh (triangle ids a permutation,
+// node ranges consistent, every leaf volume containing its triangles, annotation sized and in range).
+// Anything else is a stale or corrupt entry: it is reported, rebuilt by the caller and overwritten.
+#pragma once
+
+#include "adb/tree.hpp"
+#if __has_include("adb/saved_tree.hpp")
+#include "adb/saved_tree.hpp"
+#define BVHLAB_TREE_CACHE_SAVED_TREE 1
+#endif
+#include "bench/core/content_hash.hpp"
+#include "bvh/mesh.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+
+struct CachedTreeTimes {
+  double build_seconds = 0, annotate_seconds = 0;
+};
+
+#ifndef BVHLAB_TREE_CACHE_SAVED_TREE
+// TEMPORARY stand-in until adb/saved_tree.hpp lands: raw arrays, no versioning beyond a magic word.
+template <class BV, DensityPolicy D>
+std::vector<std::byte> save_tree_to_buffer(const Tree<BV, D>& tree) {
+  std::vector<std::byte> out;
+  auto put = [&](const void* p, std::size_t n) {
+    const auto* b = static_cast<const std::byte*>(p);
+    out.insert(out.end(), b, b + n);
+  };
+  auto put_vec = [&](const auto& v) {
+    const std::uint64_t n = v.size();
+    put(&n, 8);
+    put(v.data(), n * sizeof(v[0]));
+  };
+  put("TMPTREE1", 8);
+  put_vec(tree.bvh.nodes());
+  put_vec(tree.bvh.volumes());
+  put_vec(tree.bvh.triangle_ids());
+  if constexpr (D::annotated) {
+    put_vec(tree.density.possible_collision_cells);
+    put(&tree.density.tau, 8);
+  }
+  return out;
+}
+template <class BV, DensityPolicy D>
+Tree<BV, D> load_tree_from_buffer(std::span<const std::byte> in) {
+  std::size_t at = 0;
+  auto get = [&](void* p, std::size_t n) {
+    if (in.size() - at < n) throw std::runtime_error("truncated tree");
+    std::memcpy(p, in.data() + at, n);
+    at += n;
+  };
+  auto get_vec = [&](auto& v) {
+    std::uint64_t n = 0;
+    get(&n, 8);
+    if (n > in.size()) throw std::runtime_error("bad length");
+    v.resize(n);
+    get(v.data(), n * sizeof(v[0]));
+  };
+  char magic[8];
+  get(magic, 8);
+  if (std::memcmp(magic, "TMPTREE1", 8) != 0) throw std::runtime_error("bad magic");
+  std::vector<TreeNode> nodes;
+  std::vector<BV> volumes;
+  std::vector<std::uint32_t> ids;
+  get_vec(nodes);
+  get_vec(volumes);
+  get_vec(ids);
+  if (nodes.empty() || volumes.size() != nodes.size()) throw std::runtime_error("bad node count");
+  (void)node_triangle_ranges(nodes);  // throws on children out of order, before anything walks the tree
+  Tree<BV, D> tree{Bvh<BV>::from_parts(std::move(nodes), std::move(volumes), std::move(ids)), {}};
+  if constexpr (D::annotated) {
+    get_vec(tree.density.possible_collision_cells);
+    get(&tree.density.tau, 8);
+  }
+  if (at != in.size()) throw std::runtime_error("trailing bytes");
+  return tree;
+}
+#endif
+
+namespace tree_cache_detail {
+
+/// Checks a decoded tree against its mesh and re-attaches the polygons (saved trees carry none).
+/// Throws std::runtime_error naming the first defect.
+template <class BV, DensityPolicy D>
+Tree<BV, D> attach_polygons(const Tree<BV, D>& saved, const Mesh& mesh) {
+  const Bvh<BV>& bvh = saved.bvh;
+  const std::size_t n = mesh.triangles.size();
+  const auto& ids = bvh.triangle_ids();
+  if (bvh.nodes().empty()) throw std::runtime_error("the tree has no nodes");
+  if (bvh.volumes().size() != bvh.nodes().size()) throw std::runtime_error("node and volume counts differ");
+  if (ids.size() != n)
+    throw std::runtime_error("the tree covers " + std::to_string(ids.size()) + " triangles, the mesh has " +
+                             std::to_string(n));
+  std::vector<bool> seen(n, false);
+  for (std::uint32_t id : ids) {
+    if (id >= n || seen[id]) throw std::runtime_error("triangle ids are not a permutation of the mesh's");
+    seen[id] = true;
+  }
+  const auto ranges = node_triangle_ranges(bvh.nodes());  // throws on a malformed topology
+  if (ranges.front() != std::pair<std::uint32_t, std::uint32_t>{0, static_cast<std::uint32_t>(n)})
+    throw std::runtime_error("the root does not cover every triangle");
+  std::vector<TrianglePoints> triangles;
+  triangles.reserve(n);
+  for (std::uint32_t id : ids) triangles.push_back(mesh.triangle(id));
+  // Volumes stored relative to their parent (hierarchical BVs) are checked through their decoded boxes.
+  std::vector<Box> boxes;
+  if constexpr (requires { bvh.node_boxes(); }) boxes = bvh.node_boxes();
+  for (std::size_t i = 0; i < bvh.nodes().size(); ++i) {
+    const auto node = static_cast<std::uint32_t>(i);
+    if (!bvh.node(node).is_leaf()) continue;
+    for (std::uint32_t t = ranges[i].first; t < ranges[i].second; ++t)
+      for (const Vec3& v : triangles[t]) {
+        bool inside = false;
+        if constexpr (requires { bvh.volume(node).contains(v); })
+          inside = bvh.volume(node).contains(v);
+        else
+          inside = boxes[i].contains(v);
+        if (!inside)
+          throw std::runtime_error("leaf " + std::to_string(i) + "'s volume does not contain its triangles");
+      }
+  }
+  Bvh<BV> with_polygons = [&] {
+    if constexpr (requires { bvh.root_volume(); })
+      return Bvh<BV>::from_parts(bvh.nodes(), bvh.volumes(), ids, std::move(triangles), bvh.root_volume());
+    else
+      return Bvh<BV>::from_parts(bvh.nodes(), bvh.volumes(), ids, std::move(triangles));
+  }();
+  Tree<BV, D> out{std::move(with_polygons), saved.density};
+  if constexpr (D::annotated) {
+    const auto& pc = saved.density.possible_collision_cells;
+    if (pc.size() != bvh.nodes().size()) throw std::runtime_error("annotation and node counts differ");
+    if (std::any_of(pc.begin(), pc.end(), [](std::uint8_t c) { return c > D::cells; }))
+      throw std::runtime_error("a possible-collision-cell count exceeds the grid's cells");
+  }
+  return out;
+}
+
+std::vector<std::byte> read_file_bytes(const std::filesystem::path& file);
+/// Writes via a temporary file and a rename, so a reader never sees half a file.
+void write_file_bytes(const std::filesystem::path& file, std::span<const std::byte> bytes);
+
+}  // namespace tree_cache_detail
+
+class TreeCache {
+ public:
+  /// `dir` empty: a disabled cache (every load misses, stores do nothing).
+  explicit TreeCache(std::filesystem::path dir, std::function<void(const std::string&)> log = {});
+
+  [[nodiscard]] bool enabled() const { return !dir_.empty(); }
+  [[nodiscard]] std::filesystem::path tree_file(const std::string& key, std::string_view bv) const;
+
+  struct Counts {
+    std::size_t hits = 0, misses = 0, rejected = 0, stored = 0;
+  };
+  [[nodiscard]] const Counts& counts() const { return counts_; }
+
+  /// The tree stored under `key`, checked and with `mesh`'s polygons re-attached; nullopt on a miss or when
+  /// the entry is stale or corrupt (then it is logged and counted as rejected). An annotated tree must carry
+  /// `expected_tau`.
+  template <class BV, DensityPolicy D>
+  std::optional<Tree<BV, D>> load(const std::string& key, const Mesh& mesh, CachedTreeTimes* times = nullptr,
+                                  double expected_tau = 0) {
+    if (!enabled()) return std::nullopt;
+    const auto file = tree_file(key, BV::name());
+    if (!std::filesystem::exists(file) && !std::filesystem::exists(meta_file(file))) {
+      ++counts_.misses;
+      return std::nullopt;
+    }
+    try {
+      const std::vector<std::byte> payload = read_checked_payload(key, file, times);
+      const Tree<BV, D> saved = load_tree_from_buffer<BV, D>(payload);
+      if constexpr (D::annotated)
+        if (saved.density.tau != expected_tau)
+          throw std::runtime_error("annotated with tau " + std::to_string(saved.density.tau) + ", expected " +
+                                   std::to_string(expected_tau));
+      Tree<BV, D> tree = tree_cache_detail::attach_polygons(saved, mesh);
+      ++counts_.hits;
+      return tree;
+    } catch (const std::exception& e) {
+      ++counts_.rejected;
+      say("tree cache: rejected " + file.filename().string() + " (" + e.what() + "); rebuilding");
+      return std::nullopt;
+    }
+  }
+
+  /// Saves `tree` (without polygons) under `key`. A failure to write is logged, never fatal.
+  template <class BV, DensityPolicy D>
+  void store(const std::string& key, const Tree<BV, D>& tree, const CachedTreeTimes& times) {
+    if (!enabled()) return;
+    const auto file = tree_file(key, BV::name());
+    try {
+      const std::vector<std::byte> payload = save_tree_to_buffer(tree);
+      write_entry(key, file, payload, times);
+      ++counts_.stored;
+    } catch (const std::exception& e) {
+      say("tree cache: could not store " + file.string() + " (" + e.what() + ")");
+    }
+  }
+
+ private:
+  static std::filesystem::path meta_file(const std::filesystem::path& tree_file);
+  std::vector<std::byte> read_checked_payload(const std::string& key, const std::filesystem::path& file,
+                                              CachedTreeTimes* times) const;
+  void write_entry(const std::string& key, const std::filesystem::path& file,
+                   std::span<const std::byte> payload, const CachedTreeTimes& times) const;
+  void say(const std::string& message) const;
+
+  std::filesystem::path dir_;
+  std::function<void(const std::string&)> log_;
+  Counts counts_;
+};
+
+}  // namespace bvhlab

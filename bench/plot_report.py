@@ -1,0 +1,294 @@
+#!/usr/bin/env python3
+"""Draws the five figures of a bvhlab report from its results.csv and calibration.csv.
+
+    plot_report.py REPORT_DIR [--quality-min 1.2] [--quality-max 2.0]
+                   [--operating-hierarchy aabb] [--operating-p-min 0.9]
+
+Figures (PNG, in REPORT_DIR):
+  fig1_time_vs_distance.png   mean time per query against distance, every hierarchy
+  fig2_errors_vs_distance.png false-positive and false-negative rates against distance
+  fig3_error_vs_time.png      error against mean time over p_min (the Pareto curve)
+  fig4_calibration.png        reported probability against observed collision frequency
+  fig5_time_vs_size.png       mean time per query against model size
+`bvhlab report` runs this; it needs only matplotlib and the standard library.
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+DISTANCE_LABEL = "distance d of B's centre (model units; each model scaled to [-1, 1]³)"
+TIME_LABEL = "mean time per query (µs)"
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def num(value):
+    return float(value) if value not in ("", None) else math.nan
+
+
+def series_label(row):
+    label = row["strategy"]
+    if row["p_min"]:
+        label += f" p_min={float(row['p_min']):g}"
+    if row["budget"]:
+        label += " " + row["budget"].replace("bv_tests=", "budget ").replace("deadline_us=", "deadline µs ")
+    return label
+
+
+def series_key(row):
+    return (row["hierarchy"], row["strategy"], row["p_min"], row["budget"])
+
+
+def meshes_of(rows):
+    seen = []
+    for r in rows:
+        if r["mesh"] not in seen:
+            seen.append(r["mesh"])
+    return seen
+
+
+def grouped(rows):
+    """{(hierarchy, strategy, p_min, budget): [rows sorted by distance]}, in first-appearance order."""
+    out = {}
+    for r in rows:
+        out.setdefault(series_key(r), []).append(r)
+    for k in out:
+        if "distance" in out[k][0]:
+            out[k].sort(key=lambda r: num(r["distance"]))
+    return out
+
+
+def aggregate(rows, lo, hi):
+    """Query-weighted means over distances in [lo, hi] of one series' rows."""
+    picked = [r for r in rows if lo - 1e-12 <= num(r["distance"]) <= hi + 1e-12 and int(r["queries"]) > 0]
+    q = sum(int(r["queries"]) for r in picked)
+    if q == 0:
+        return None
+
+    def mean(col):
+        return sum(num(r[col]) * int(r["queries"]) for r in picked) / q
+
+    return {
+        "time": mean("mean_time_us"),
+        "fp": mean("fp_rate"),
+        "fn": mean("fn_rate"),
+        "bytes": num(picked[0]["bytes_per_triangle"]),
+        "queries": q,
+    }
+
+
+def subplots(n, width=6.0, height=4.2, rows=1):
+    fig, axes = plt.subplots(rows, n, figsize=(width * n, height * rows), squeeze=False, constrained_layout=True)
+    return fig, axes
+
+
+def legend_below(fig, axes):
+    handles, labels = [], []
+    for ax in axes.flat:
+        for h, l in zip(*ax.get_legend_handles_labels()):
+            if l not in labels:
+                handles.append(h)
+                labels.append(l)
+    if handles:
+        # Below the axes, outside the figure: savefig(bbox_inches="tight") grows the canvas to include it
+        # (matplotlib 3.6 has no "outside" legend placement).
+        fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=min(3, len(labels)),
+                   fontsize=9, frameon=False)
+
+
+def style_for(hierarchy, strategy, hierarchies):
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colour = colours[hierarchies.index(hierarchy) % len(colours)]
+    line = {"exact": "-", "guided_exact": "--", "adb": ":", "time_critical": "-."}.get(strategy, "-")
+    marker = {"exact": "o", "guided_exact": "s", "adb": "^", "time_critical": "D"}.get(strategy, "o")
+    return colour, line, marker
+
+
+def is_operating(row, args):
+    return (row["strategy"] == "adb" and row["hierarchy"] == args.operating_hierarchy and row["p_min"]
+            and abs(float(row["p_min"]) - args.operating_p_min) < 1e-12)
+
+
+def figure_time_vs_distance(rows, args, out):
+    meshes = meshes_of(rows)
+    hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
+    fig, axes = subplots(len(meshes))
+    for ax, mesh in zip(axes[0], meshes):
+        for key, series in grouped([r for r in rows if r["mesh"] == mesh]).items():
+            first = series[0]
+            if first["strategy"] not in ("exact", "guided_exact") and not is_operating(first, args):
+                continue
+            colour, line, marker = style_for(first["hierarchy"], first["strategy"], hierarchies)
+            ax.plot([num(r["distance"]) for r in series], [num(r["mean_time_us"]) for r in series], line,
+                    marker=marker, color=colour, label=f"{first['hierarchy']}: {series_label(first)}")
+        ax.set_yscale("log")
+        ax.set_title(f"{mesh}: time per query")
+        ax.set_xlabel(DISTANCE_LABEL, fontsize=9)
+        ax.set_ylabel(TIME_LABEL)
+        ax.grid(True, which="both", alpha=0.3)
+    legend_below(fig, axes)
+    fig.savefig(out, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def figure_errors_vs_distance(rows, args, out):
+    meshes = meshes_of(rows)
+    inexact = [r for r in rows if r["strategy"] in ("adb", "time_critical")]
+    fig, axes = subplots(len(meshes), rows=2, height=3.6)
+    cmap = plt.get_cmap("viridis")
+    for col, mesh in enumerate(meshes):
+        series_list = list(grouped([r for r in inexact if r["mesh"] == mesh]).values())
+        for i, series in enumerate(series_list):
+            first = series[0]
+            colour = cmap(i / max(1, len(series_list) - 1) * 0.9)
+            marker = "^" if first["strategy"] == "adb" else "D"
+            label = f"{first['hierarchy']}: {series_label(first)}"
+            d = [num(r["distance"]) for r in series]
+            axes[0][col].plot(d, [100 * num(r["fp_rate"]) for r in series], marker=marker, color=colour, label=label)
+            axes[1][col].plot(d, [100 * num(r["fn_rate"]) for r in series], marker=marker, color=colour, label=label)
+        axes[0][col].set_title(f"{mesh}: false positives")
+        axes[1][col].set_title(f"{mesh}: false negatives")
+        for row in (0, 1):
+            ax = axes[row][col]
+            ax.set_xlabel(DISTANCE_LABEL, fontsize=9)
+            ax.set_ylabel(("false-positive" if row == 0 else "false-negative") + " rate (% of queries)")
+            ax.set_ylim(bottom=-1)
+            ax.grid(True, alpha=0.3)
+        if not series_list:
+            axes[0][col].text(0.5, 0.5, "no inexact strategy", ha="center", transform=axes[0][col].transAxes)
+    legend_below(fig, axes)
+    fig.savefig(out, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def figure_error_vs_time(rows, args, out):
+    meshes = meshes_of(rows)
+    hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
+    fig, axes = subplots(len(meshes))
+    for ax, mesh in zip(axes[0], meshes):
+        groups = grouped([r for r in rows if r["mesh"] == mesh])
+        curves = {}
+        for key, series in groups.items():
+            first = series[0]
+            agg = aggregate(series, args.quality_min, args.quality_max)
+            if agg is None:
+                continue
+            if first["strategy"] == "adb":
+                curves.setdefault(first["hierarchy"], []).append((float(first["p_min"]), agg))
+                continue
+            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies)
+            ax.plot([agg["time"]], [100 * (agg["fp"] + agg["fn"])], marker, color=colour, markersize=8,
+                    linestyle="none", label=f"{first['hierarchy']}: {series_label(first)}")
+        for hierarchy, points in curves.items():
+            points.sort(key=lambda p: p[0])
+            colour, line, marker = style_for(hierarchy, "adb", hierarchies)
+            xs = [p[1]["time"] for p in points]
+            ys = [100 * (p[1]["fp"] + p[1]["fn"]) for p in points]
+            ax.plot(xs, ys, "-", marker="^", color=colour, label=f"{hierarchy}: adb over p_min")
+            for (p, _), x, y in zip(points, xs, ys):
+                ax.annotate(f"{p:g}", (x, y), textcoords="offset points", xytext=(5, 4), fontsize=8, color=colour)
+        ax.set_xscale("log")
+        ax.set_title(f"{mesh}: error vs time, d in [{args.quality_min:g}, {args.quality_max:g}]"
+                     if args.quality_min > -1e299 else f"{mesh}: error vs time, all distances")
+        ax.set_xlabel(TIME_LABEL + ", log scale")
+        ax.set_ylabel("wrong answers (FP + FN, % of queries)")
+        ax.set_ylim(bottom=-1)
+        ax.grid(True, which="both", alpha=0.3)
+    legend_below(fig, axes)
+    fig.savefig(out, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def figure_calibration(calibration, args, out):
+    meshes = meshes_of(calibration) or ["(no ADB strategy)"]
+    fig, axes = subplots(len(meshes), width=5.2, height=4.6)
+    cmap = plt.get_cmap("viridis")
+    for ax, mesh in zip(axes[0], meshes):
+        ax.plot([0, 1], [0, 1], "--", color="grey", label="perfect calibration")
+        series = grouped([c for c in calibration if c["mesh"] == mesh and c["strategy"] == "adb"])
+        for i, (key, bins) in enumerate(series.items()):
+            used = [b for b in bins if int(b["count"]) > 0]
+            if not used:
+                continue
+            colour = cmap(i / max(1, len(series) - 1) * 0.9)
+            xs = [num(b["mean_probability"]) for b in used]
+            ys = [num(b["collision_frequency"]) for b in used]
+            sizes = [12 + 60 * math.sqrt(int(b["count"]) / max(int(c["count"]) for c in used)) for b in used]
+            first = bins[0]
+            ax.plot(xs, ys, "-", color=colour, alpha=0.6)
+            ax.scatter(xs, ys, s=sizes, color=colour, label=f"{first['hierarchy']}: p_min={float(first['p_min']):g}")
+        ax.set_xlim(-0.02, 1.02)
+        ax.set_ylim(-0.02, 1.02)
+        ax.set_aspect("equal")
+        ax.set_title(f"{mesh}: calibration (bins of 0.1)")
+        ax.set_xlabel("probability reported by ADB (bin mean)")
+        ax.set_ylabel("observed collision frequency")
+        ax.grid(True, alpha=0.3)
+        if not calibration:
+            ax.text(0.5, 0.5, "no ADB answers", ha="center", transform=ax.transAxes)
+    legend_below(fig, axes)
+    fig.suptitle("marker area grows with the number of answers in the bin", fontsize=9, color="grey")
+    fig.savefig(out, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def figure_time_vs_size(rows, args, out):
+    meshes = meshes_of(rows)
+    hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
+    fig, axes = subplots(len(meshes))
+    for ax, mesh in zip(axes[0], meshes):
+        for key, series in grouped([r for r in rows if r["mesh"] == mesh]).items():
+            first = series[0]
+            if first["strategy"] not in ("exact", "guided_exact") and not is_operating(first, args):
+                continue
+            agg = aggregate(series, -1e300, 1e300)
+            if agg is None or not math.isfinite(agg["bytes"]):
+                continue
+            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies)
+            label = f"{first['hierarchy']}: {series_label(first)}"
+            ax.plot([agg["bytes"]], [agg["time"]], marker, color=colour, markersize=9, linestyle="none", label=label)
+        ax.set_yscale("log")
+        ax.set_title(f"{mesh}: time vs model size (all distances)")
+        ax.set_xlabel("model size (bytes per triangle, without polygons)")
+        ax.set_ylabel(TIME_LABEL)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.margins(x=0.15)
+    legend_below(fig, axes)
+    fig.savefig(out, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("report_dir")
+    parser.add_argument("--quality-min", type=float, default=1.2)
+    parser.add_argument("--quality-max", type=float, default=2.0)
+    parser.add_argument("--operating-hierarchy", default="")
+    parser.add_argument("--operating-p-min", type=float, default=-1)
+    args = parser.parse_args()
+
+    rows = read_csv(os.path.join(args.report_dir, "results.csv"))
+    if not rows:
+        sys.exit("plot_report.py: results.csv has no rows")
+    calibration_path = os.path.join(args.report_dir, "calibration.csv")
+    calibration = read_csv(calibration_path) if os.path.exists(calibration_path) else []
+
+    figure_time_vs_distance(rows, args, os.path.join(args.report_dir, "fig1_time_vs_distance.png"))
+    figure_errors_vs_distance(rows, args, os.path.join(args.report_dir, "fig2_errors_vs_distance.png"))
+    figure_error_vs_time(rows, args, os.path.join(args.report_dir, "fig3_error_vs_time.png"))
+    figure_calibration(calibration, args, os.path.join(args.report_dir, "fig4_calibration.png"))
+    figure_time_vs_size(rows, args, os.path.join(args.report_dir, "fig5_time_vs_size.png"))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,63 @@
+// The report folder: results.csv / results.json / calibration.csv from a run, five PNG figures drawn by
+// bench/plot_report.py (matplotlib), and a README.md with the tables, the figures and the operating point.
+#pragma once
+
+#include "bench/run.hpp"
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+
+/// The figures plot_report.py draws, in order, with the README's caption for each.
+struct FigureSpec {
+  std::string file, caption;
+};
+const std::vector<FigureSpec>& report_figures();
+
+/// One (mesh, hierarchy, strategy, p_min, budget) series aggregated over a range of distances, weighting each
+/// distance by its number of queries.
+struct SeriesSummary {
+  std::string mesh, hierarchy, bv, annotation, strategy, budget;
+  double p_min = -1;
+  std::size_t queries = 0;
+  double mean_time_us = 0, max_time_us = 0, fp_rate = 0, fn_rate = 0;
+  double bv_tests_per_query = 0, triangle_tests_per_query = 0, bytes_per_triangle = 0;
+};
+/// Series over distances in [lo, hi], in the order the rows first appear.
+std::vector<SeriesSummary> summarize(const std::vector<ResultRow>& rows, double lo, double hi);
+
+/// The operating point of one mesh pair: ADB at the scene's chosen (hierarchy, p_min) against the baseline.
+struct OperatingPoint {
+  std::string mesh;
+  SeriesSummary adb, baseline;
+  double speedup = 0;  ///< baseline mean time / ADB mean time
+};
+std::vector<OperatingPoint> operating_points(const RunOutput& run);
+
+struct ReportOptions {
+  bool figures = true;           ///< run the plot script
+  std::filesystem::path python;  ///< empty: $BVHLAB_PYTHON, /usr/bin/python3, python3 (first with matplotlib)
+  std::filesystem::path plot_script;  ///< empty: bench/plot_report.py in the source tree
+};
+
+struct ReportFiles {
+  std::filesystem::path dir, results_csv, results_json, calibration_csv, readme;
+  std::vector<std::filesystem::path> figures;  ///< the PNGs that exist after plotting
+  std::string plot_error;                      ///< why the figures are missing, if they are
+};
+
+/// Writes everything into `dir` (created if needed). Plotting problems are reported in plot_error and in the
+/// README, never thrown: the numbers stay usable without matplotlib.
+ReportFiles write_report(const RunOutput& run, const std::filesystem::path& dir,
+                         const ReportOptions& options = {});
+
+/// The README's text (exposed for tests). `figures_ok` says whether the figures were drawn.
+std::string report_readme(const RunOutput& run, bool figures_ok, const std::string& plot_error = {});
+
+/// A short results section for the project README: the operating point and the figure list.
+std::string report_snippet(const RunOutput& run, const std::filesystem::path& report_dir);
+
+}  // namespace bvhlab

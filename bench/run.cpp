@@ -1,0 +1,1158 @@
+#include "bench/run.hpp"
+
+#include "adb/annotate.hpp"
+#include "bench/core/content_hash.hpp"
+#include "bench/core/ground_truth.hpp"
+#include "bench/core/registry.hpp"
+#include "bench/core/tree_cache.hpp"
+#include "bvh/mesh_io.hpp"
+#include "traversal/adb.hpp"
+#include "traversal/exact.hpp"
+
+#ifdef BVHLAB_HAVE_FCL
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/narrowphase/collision.h>
+#endif
+
+#include <nlohmann/json.hpp>
+
+#include <sys/utsname.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#ifndef BVHLAB_BUILD_TYPE
+#define BVHLAB_BUILD_TYPE "unknown"
+#endif
+
+namespace bvhlab {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using LogFn = std::function<void(const std::string&)>;
+constexpr double kNotApplicable = std::numeric_limits<double>::quiet_NaN();
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string g17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Progress bar on stderr: redrawn in place on a terminal, a line per tenth otherwise.
+
+class Progress {
+ public:
+  Progress(bool enabled, std::size_t total)
+      : enabled_(enabled && total > 0), total_(total), tty_(isatty(2)) {}
+  void advance(std::size_t done, const std::string& label) {
+    if (!enabled_) return;
+    done_ += done;
+    const double fraction = std::min(1.0, double(done_) / double(total_));
+    if (tty_) {
+      const auto now = Clock::now();
+      if (done_ < total_ && now - last_ < std::chrono::milliseconds(100)) return;
+      last_ = now;
+      const int width = 30, filled = static_cast<int>(fraction * width);
+      std::fprintf(stderr, "\r[%s%s] %3d%%  %-48.48s", std::string(filled, '#').c_str(),
+                   std::string(width - filled, '.').c_str(), static_cast<int>(fraction * 100), label.c_str());
+      if (done_ >= total_) std::fputc('\n', stderr);
+    } else {
+      const int tenth = static_cast<int>(fraction * 10);
+      if (tenth > printed_tenth_) {
+        printed_tenth_ = tenth;
+        std::fprintf(stderr, "  %3d%% of the queries done (%s)\n", tenth * 10, label.c_str());
+      }
+    }
+    std::fflush(stderr);
+  }
+
+ private:
+  bool enabled_;
+  std::size_t total_, done_ = 0;
+  bool tty_;
+  int printed_tenth_ = 0;
+  Clock::time_point last_{};
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// Objects, hierarchies and the strategies' timed series.
+
+struct ObjectData {
+  const SceneObject* spec = nullptr;
+  Mesh mesh;
+  std::string key;  ///< mesh checksum and every transform applied to it
+};
+
+struct QueryRecord {
+  bool collides = false, exact = true, budget_exhausted = false;
+  double probability = 0, micros = 0;
+  Counters counters;
+};
+
+template <class Query>
+void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
+                  Query&& query) {
+  out.clear();
+  out.reserve(poses.size());
+  bool sink = false;
+  for (std::size_t k = 0; k < poses.size() && k < static_cast<std::size_t>(std::max(warmup, 0)); ++k)
+    sink ^= query(poses[k]).collides;
+  for (const RigidTransform& pose : poses) {
+    const auto start = Clock::now();
+    const Result r = query(pose);
+    const auto stop = Clock::now();
+    out.push_back({r.collides, r.exact, r.budget_exhausted, r.probability,
+                   std::chrono::duration<double, std::micro>(stop - start).count(), r.counters});
+  }
+  if (sink && out.empty()) std::fputc(' ', stderr);  // keeps the warm-up from being optimised away
+}
+
+class PreparedHierarchy {
+ public:
+  virtual ~PreparedHierarchy() = default;
+  virtual void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
+                   std::vector<QueryRecord>& out) const = 0;
+  /// Exact first-contact answer (the ground truth's source).
+  [[nodiscard]] virtual bool exact_collides(const RigidTransform& pose) const = 0;
+  [[nodiscard]] virtual bool has_counters() const { return true; }
+  /// One untimed query with the full result (witness, contacts).
+  [[nodiscard]] virtual Result query(const StrategyVariant& variant, const RigidTransform& pose,
+                                     ContactMode mode) const = 0;
+  ModelInfo model;  ///< A's tree
+};
+
+template <class BV, DensityPolicy D>
+class BvhlabHierarchy final : public PreparedHierarchy {
+ public:
+  BvhlabHierarchy(std::shared_ptr<const Tree<BV, D>> a, std::shared_ptr<const Tree<BV, D>> b,
+                  std::shared_ptr<const AdbModel> adb_model)
+      : a_(std::move(a)), b_(std::move(b)), adb_model_(std::move(adb_model)) {}
+
+  void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
+           std::vector<QueryRecord>& out) const override {
+    if (variant.kind == StrategyKind::Exact) {
+      timed_series(poses, warmup, out,
+                   [&](const RigidTransform& p) { return query_exact(a_->bvh, b_->bvh, p); });
+      return;
+    }
+    if constexpr (D::annotated) {
+      const AdbOptions options = adb_options(variant);
+      timed_series(poses, warmup, out,
+                   [&](const RigidTransform& p) { return query_adb(*a_, *b_, p, *adb_model_, options); });
+    } else {
+      throw std::logic_error("runner: strategy " + variant.label() + " reached a tree without annotation");
+    }
+  }
+  [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose,
+                             ContactMode mode) const override {
+    if (variant.kind == StrategyKind::Exact) return query_exact(a_->bvh, b_->bvh, pose, mode);
+    if constexpr (D::annotated)
+      return query_adb(*a_, *b_, pose, *adb_model_, adb_options(variant));
+    else
+      throw std::invalid_argument("strategy " + variant.label() + " needs an ADB-annotated tree");
+  }
+  [[nodiscard]] bool exact_collides(const RigidTransform& pose) const override {
+    return query_exact(a_->bvh, b_->bvh, pose).collides;
+  }
+
+ private:
+  static AdbOptions adb_options(const StrategyVariant& variant) {
+    AdbOptions options;
+    options.p_min = variant.p_min >= 0 ? variant.p_min : 1.0;
+    options.budget = variant.budget;
+    options.best_effort_threshold = variant.best_effort_threshold;
+    options.exact_leaves = variant.kind == StrategyKind::GuidedExact;
+    options.validate();
+    return options;
+  }
+  std::shared_ptr<const Tree<BV, D>> a_, b_;
+  std::shared_ptr<const AdbModel> adb_model_;
+};
+
+#ifdef BVHLAB_HAVE_FCL
+template <class FclBV>
+class FclHierarchy final : public PreparedHierarchy {
+ public:
+  using Model = fcl::BVHModel<FclBV>;
+  FclHierarchy(std::shared_ptr<const Model> a, std::shared_ptr<const Model> b)
+      : a_(std::move(a)), b_(std::move(b)) {}
+
+  void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
+           std::vector<QueryRecord>& out) const override {
+    if (variant.kind != StrategyKind::Exact)
+      throw std::logic_error("runner: FCL hierarchies run the exact strategy only");
+    timed_series(poses, warmup, out, [&](const RigidTransform& p) { return query(p); });
+  }
+  [[nodiscard]] bool exact_collides(const RigidTransform& pose) const override {
+    return query(pose).collides;
+  }
+  [[nodiscard]] bool has_counters() const override { return false; }
+  [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose,
+                             ContactMode mode) const override {
+    if (variant.kind != StrategyKind::Exact || mode != ContactMode::First)
+      throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only");
+    return query(pose);
+  }
+
+ private:
+  Result query(const RigidTransform& pose) const {
+    const fcl::CollisionRequestd request(1, false);
+    fcl::Transform3d tf = fcl::Transform3d::Identity();
+    tf.linear() = pose.rotation;
+    tf.translation() = pose.translation;
+    fcl::CollisionResultd result;
+    fcl::collide(a_.get(), fcl::Transform3d::Identity(), b_.get(), tf, request, result);
+    Result r;
+    r.collides = result.isCollision();
+    r.probability = r.collides ? 1 : 0;
+    return r;
+  }
+  std::shared_ptr<const Model> a_, b_;
+};
+#endif
+
+template <class F>
+void with_grid(int grid, F&& f) {
+  switch (grid) {
+    case 2:
+      f(std::integral_constant<int, 2>{});
+      break;
+    case 3:
+      f(std::integral_constant<int, 3>{});
+      break;
+    case 4:
+      f(std::integral_constant<int, 4>{});
+      break;
+    default:
+      throw std::invalid_argument("grid " + std::to_string(grid) + " is not one of 2, 3, 4");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Trees: from the run's memory, else the disk cache, else built (and then cached).
+
+class TreeStore {
+ public:
+  TreeStore(const std::filesystem::path& cache_dir, RunStats& stats, LogFn log, unsigned threads)
+      : cache_(cache_dir.empty() ? cache_dir : cache_dir / "trees", log),
+        stats_(stats),
+        log_(std::move(log)),
+        threads_(threads) {}
+
+  template <class BV>
+  std::shared_ptr<const Tree<BV, NoDensity>> plain(const ObjectData& object, const HierarchySpec& h,
+                                                   ModelInfo* info = nullptr) {
+    const std::string key = plain_key<BV>(object, h);
+    if (auto hit = memo_.find(key); hit != memo_.end()) {
+      if (info) *info = infos_.at(key);
+      return std::static_pointer_cast<const Tree<BV, NoDensity>>(hit->second);
+    }
+    const auto start = Clock::now();
+    CachedTreeTimes times;
+    std::optional<Tree<BV, NoDensity>> tree = cache_.load<BV, NoDensity>(key, object.mesh, &times);
+    const bool from_cache = tree.has_value();
+    if (!tree) {
+      log_("building " + std::string(BV::name()) + " tree of " + object.spec->name + " (" +
+           std::to_string(object.mesh.triangle_count()) + " triangles)");
+      BuildOptions options = h.build;
+      options.threads = threads_;
+      tree.emplace(Tree<BV, NoDensity>{Bvh<BV>::build(object.mesh, options), {}});
+      ++stats_.trees_built;
+      times.build_seconds = tree->bvh.stats().build_seconds;
+      cache_.store(key, *tree, times);
+    }
+    stats_.preprocess_seconds += seconds_since(start);
+    auto shared = std::make_shared<const Tree<BV, NoDensity>>(std::move(*tree));
+    remember(key, shared, describe(*shared, object, h, "none", times, from_cache), info);
+    return shared;
+  }
+
+  template <class BV, int G>
+  std::shared_ptr<const Tree<BV, AdbDensity<G>>> annotated(const ObjectData& object, const HierarchySpec& h,
+                                                           double tau, ModelInfo* info = nullptr) {
+    const std::string annotation = "adb g=" + std::to_string(G) + " tau=" + g17(tau);
+    const std::string key = plain_key<BV>(object, h) + "|" + annotation;
+    using T = Tree<BV, AdbDensity<G>>;
+    if (auto hit = memo_.find(key); hit != memo_.end()) {
+      if (info) *info = infos_.at(key);
+      return std::static_pointer_cast<const T>(hit->second);
+    }
+    CachedTreeTimes times;
+    auto start = Clock::now();
+    std::optional<T> tree = cache_.load<BV, AdbDensity<G>>(key, object.mesh, &times, tau);
+    stats_.preprocess_seconds += seconds_since(start);
+    const bool from_cache = tree.has_value();
+    if (!tree) {
+      ModelInfo plain_info;
+      Bvh<BV> bvh = plain<BV>(object, h, &plain_info)->bvh;  // a copy: annotate() takes its tree
+      start = Clock::now();
+      log_("annotating " + std::string(BV::name()) + " tree of " + object.spec->name + " (" + annotation +
+           ")");
+      AnnotateOptions options;
+      options.tau = tau;
+      options.threads = threads_;
+      AnnotateStats annotate_stats;
+      if constexpr (requires { annotate<G>(std::move(bvh), options, &annotate_stats); })
+        tree.emplace(annotate<G>(std::move(bvh), options, &annotate_stats));
+      else
+        throw std::invalid_argument("the ADB annotation does not support " + std::string(BV::name()) +
+                                    " trees");
+      ++stats_.trees_annotated;
+      stats_.annotation_clip_calls += annotate_stats.clip_calls;
+      times.build_seconds = plain_info.build_seconds;
+      times.annotate_seconds = annotate_stats.seconds;
+      cache_.store(key, *tree, times);
+      stats_.preprocess_seconds += seconds_since(start);
+    }
+    auto shared = std::make_shared<const T>(std::move(*tree));
+    remember(key, shared, describe(*shared, object, h, annotation, times, from_cache), info);
+    return shared;
+  }
+
+#ifdef BVHLAB_HAVE_FCL
+  template <class FclBV>
+  std::shared_ptr<const fcl::BVHModel<FclBV>> fcl_model(const ObjectData& object, const HierarchySpec& h,
+                                                        ModelInfo* info) {
+    const std::string key = "fcl|" + h.bv + "|" + object.key;
+    using Model = fcl::BVHModel<FclBV>;
+    if (auto hit = memo_.find(key); hit != memo_.end()) {
+      *info = infos_.at(key);
+      return std::static_pointer_cast<const Model>(hit->second);
+    }
+    log_("building " + h.bv + " model of " + object.spec->name);
+    const auto start = Clock::now();
+    auto model = std::make_shared<Model>();
+    std::vector<fcl::Vector3d> points(object.mesh.vertices.begin(), object.mesh.vertices.end());
+    std::vector<fcl::Triangle> triangles;
+    triangles.reserve(object.mesh.triangles.size());
+    for (const auto& t : object.mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+    model->beginModel();
+    model->addSubModel(points, triangles);
+    model->endModel();
+    ++stats_.fcl_models_built;
+    ModelInfo m;
+    m.object = object.spec->name;
+    m.hierarchy = h.name;
+    m.bv = h.bv;
+    m.annotation = "none";
+    m.triangles = object.mesh.triangle_count();
+    m.nodes = static_cast<std::size_t>(model->getNumBVs());
+    m.model_bytes = double(m.nodes) * double(sizeof(fcl::BVNode<FclBV>));
+    m.bytes_per_triangle = m.triangles ? m.model_bytes / double(m.triangles) : 0;
+    m.build_seconds = seconds_since(start);
+    stats_.preprocess_seconds += m.build_seconds;
+    remember(key, std::shared_ptr<const Model>(model), m, info);
+    return model;
+  }
+#endif
+
+  [[nodiscard]] std::vector<ModelInfo> models() const {
+    std::vector<ModelInfo> out;
+    for (const auto& key : order_) out.push_back(infos_.at(key));
+    return out;
+  }
+  [[nodiscard]] const TreeCache& cache() const {
+    return cache_;
+  }
+
+ private:
+  template <class BV>
+  static std::string plain_key(const ObjectData& object, const HierarchySpec& h) {
+    return "bvhlab-tree v1|" + object.key + "|bv=" + std::string(BV::name()) +
+           "|split=" + std::string(to_string(h.build.split)) +
+           "|leaf=" + std::to_string(h.build.max_leaf_triangles);
+  }
+
+  template <class T>
+  static ModelInfo describe(const T& tree, const ObjectData& object, const HierarchySpec& h,
+                            const std::string& annotation, const CachedTreeTimes& times, bool from_cache) {
+    const BvhStats s = tree.bvh.stats();
+    ModelInfo m;
+    m.object = object.spec->name;
+    m.hierarchy = h.name;
+    m.bv = h.bv;
+    m.annotation = annotation;
+    m.triangles = s.triangles;
+    m.nodes = s.nodes;
+    m.depth = s.depth;
+    // Nodes and volumes, plus one byte of pc per node when annotated; polygons are not counted (an ADB query
+    // does not need them).
+    m.model_bytes = double(s.nodes * s.bytes_per_node) + (annotation == "none" ? 0.0 : double(s.nodes));
+    m.bytes_per_triangle = s.triangles ? m.model_bytes / double(s.triangles) : 0;
+    m.build_seconds = times.build_seconds;
+    m.annotate_seconds = times.annotate_seconds;
+    m.from_cache = from_cache;
+    return m;
+  }
+
+  void remember(const std::string& key, std::shared_ptr<const void> value, const ModelInfo& info,
+                ModelInfo* out) {
+    memo_[key] = std::move(value);
+    infos_[key] = info;
+    order_.push_back(key);
+    if (out) *out = info;
+  }
+
+  TreeCache cache_;
+  RunStats& stats_;
+  LogFn log_;
+  unsigned threads_;
+  std::map<std::string, std::shared_ptr<const void>> memo_;
+  std::map<std::string, ModelInfo> infos_;
+  std::vector<std::string> order_;
+};
+
+std::unique_ptr<PreparedHierarchy> prepare(const Scene& scene, const HierarchySpec& h, const ObjectData& a,
+                                           const ObjectData& b, TreeStore& store,
+                                           const std::shared_ptr<const AdbModel>& adb_model) {
+  std::unique_ptr<PreparedHierarchy> out;
+  ModelInfo info;
+  if (h.is_fcl()) {
+#ifdef BVHLAB_HAVE_FCL
+    if (h.bv == "fcl_obb") {
+      auto ma = store.fcl_model<fcl::OBBd>(a, h, &info);
+      ModelInfo ignored;
+      auto mb = store.fcl_model<fcl::OBBd>(b, h, &ignored);
+      out = std::make_unique<FclHierarchy<fcl::OBBd>>(ma, mb);
+    } else {
+      auto ma = store.fcl_model<fcl::OBBRSSd>(a, h, &info);
+      ModelInfo ignored;
+      auto mb = store.fcl_model<fcl::OBBRSSd>(b, h, &ignored);
+      out = std::make_unique<FclHierarchy<fcl::OBBRSSd>>(ma, mb);
+    }
+#else
+    throw std::invalid_argument("hierarchy " + h.name + " needs FCL, which this build lacks");
+#endif
+  } else if (scene.needs_annotation(h)) {
+    // with_volume's value-returning form cannot pass a move-only result out, so assign inside the call.
+    with_volume(h.bv, [&]<class BV>(std::type_identity<BV>) {
+      with_grid(scene.annotation.grid, [&]<int G>(std::integral_constant<int, G>) {
+        auto ta = store.annotated<BV, G>(a, h, scene.annotation.tau, &info);
+        auto tb = &a == &b ? ta : store.annotated<BV, G>(b, h, scene.annotation.tau);
+        out = std::make_unique<BvhlabHierarchy<BV, AdbDensity<G>>>(ta, tb, adb_model);
+      });
+    });
+  } else {
+    with_volume(h.bv, [&]<class BV>(std::type_identity<BV>) {
+      auto ta = store.plain<BV>(a, h, &info);
+      auto tb = &a == &b ? ta : store.plain<BV>(b, h);
+      out = std::make_unique<BvhlabHierarchy<BV, NoDensity>>(ta, tb, nullptr);
+    });
+  }
+  out->model = info;
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Ground truth: exact answers per pose group, cached on disk, cross-checked against CGAL on a sample.
+
+using Truth = std::vector<std::vector<std::uint8_t>>;  // [group][pose] -> 0/1
+
+class TruthCache {
+ public:
+  explicit TruthCache(std::filesystem::path dir) : dir_(std::move(dir)) {}
+
+  std::optional<Truth> load(const std::string& key, const WorkloadSpec& workload, std::string* why) const {
+    if (dir_.empty()) return std::nullopt;
+    const auto file = file_of(key);
+    if (!std::filesystem::exists(file)) return std::nullopt;
+    try {
+      const std::vector<std::byte> bytes = tree_cache_detail::read_file_bytes(file);
+      Reader in{bytes};
+      if (in.take(8) != std::string_view("BVHLGT01")) throw std::runtime_error("not a ground-truth file");
+      if (in.u64() != ContentHash().update(key).digest())
+        throw std::runtime_error("stale: made for another key");
+      const std::uint64_t groups = in.u64();
+      if (groups != workload.groups.size()) throw std::runtime_error("stale: wrong number of pose groups");
+      Truth truth(groups);
+      for (std::size_t g = 0; g < groups; ++g) {
+        const std::uint64_t n = in.u64();
+        if (n != workload.groups[g].poses.size()) throw std::runtime_error("stale: wrong number of poses");
+        const std::string_view bits = in.take((n + 7) / 8);
+        truth[g].resize(n);
+        for (std::size_t i = 0; i < n; ++i)
+          truth[g][i] = (static_cast<unsigned char>(bits[i / 8]) >> (i % 8)) & 1;
+      }
+      const std::size_t body = in.position;
+      if (in.u64() != hash_bytes(std::span(bytes).first(body))) throw std::runtime_error("checksum mismatch");
+      if (in.position != bytes.size()) throw std::runtime_error("trailing bytes");
+      return truth;
+    } catch (const std::exception& e) {
+      *why = file.filename().string() + ": " + e.what();
+      return std::nullopt;
+    }
+  }
+
+  void store(const std::string& key, const Truth& truth, const LogFn& log) const {
+    if (dir_.empty()) return;
+    std::string out = "BVHLGT01";
+    auto put = [&](std::uint64_t v) {
+      for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+    };
+    put(ContentHash().update(key).digest());
+    put(truth.size());
+    for (const auto& group : truth) {
+      put(group.size());
+      std::string bits((group.size() + 7) / 8, '\0');
+      for (std::size_t i = 0; i < group.size(); ++i)
+        if (group[i]) bits[i / 8] = static_cast<char>(bits[i / 8] | (1 << (i % 8)));
+      out += bits;
+    }
+    put(hash_bytes(std::as_bytes(std::span(out.data(), out.size()))));
+    try {
+      tree_cache_detail::write_file_bytes(file_of(key), std::as_bytes(std::span(out.data(), out.size())));
+    } catch (const std::exception& e) {
+      log(std::string("truth cache: could not store (") + e.what() + ")");
+    }
+  }
+
+  [[nodiscard]] std::filesystem::path file_of(const std::string& key) const {
+    return dir_ / (ContentHash().update(key).hex() + ".truth");
+  }
+
+ private:
+  struct Reader {
+    std::span<const std::byte> bytes;
+    std::size_t position = 0;
+    std::string_view take(std::size_t n) {
+      if (bytes.size() - position < n) throw std::runtime_error("truncated");
+      std::string_view out(reinterpret_cast<const char*>(bytes.data()) + position, n);
+      position += n;
+      return out;
+    }
+    std::uint64_t u64() {
+      const std::string_view raw = take(8);
+      std::uint64_t v = 0;
+      for (int i = 7; i >= 0; --i)
+        v = (v << 8) | static_cast<unsigned char>(raw[static_cast<std::size_t>(i)]);
+      return v;
+    }
+  };
+  std::filesystem::path dir_;
+};
+
+Truth compute_truth(const WorkloadSpec& workload, const PreparedHierarchy& exact, unsigned threads) {
+  Truth truth(workload.groups.size());
+  for (std::size_t g = 0; g < workload.groups.size(); ++g) {
+    const auto& poses = workload.groups[g].poses;
+    truth[g].assign(poses.size(), 0);
+    const unsigned workers =
+        std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(poses.size() / 64 + 1)));
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < workers; ++w)
+      pool.emplace_back([&, w] {
+        for (std::size_t i = w; i < poses.size(); i += workers) truth[g][i] = exact.exact_collides(poses[i]);
+      });
+    for (auto& t : pool) t.join();
+  }
+  return truth;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Objects.
+
+ObjectData load_object(const SceneObject& spec) {
+  ObjectData out;
+  out.spec = &spec;
+  out.mesh = load_scene_object(spec);
+  const RigidTransform& p = spec.placement;
+  std::string key = "mesh=" + ContentHash::to_hex(hash_file(spec.path)) +
+                    "|normalize=" + (spec.normalize ? "1" : "0") + "|scale=" + g17(spec.scale) +
+                    "|placement=";
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) key += g17(p.rotation(i, j)) + ",";
+  for (int i = 0; i < 3; ++i) key += g17(p.translation(i)) + ",";
+  out.key = key;
+  return out;
+}
+
+struct CalibrationAccumulator {
+  std::array<std::size_t, 10> count{};
+  std::array<double, 10> probability_sum{};
+  std::array<std::size_t, 10> colliding{};
+};
+
+std::string run_command(const std::string& command) {
+  std::string out;
+  if (FILE* pipe = popen(command.c_str(), "r")) {
+    char buf[256];
+    while (std::fgets(buf, sizeof buf, pipe)) out += buf;
+    pclose(pipe);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------
+
+Mesh load_scene_object(const SceneObject& object) {
+  if (object.path.empty()) throw MeshError(object.mesh + ": mesh not found");
+  Mesh mesh = load_mesh(object.path).mesh;
+  if (object.normalize) normalize_to_unit_cube(mesh);
+  for (Vec3& v : mesh.vertices) v = object.placement.apply(v * object.scale);
+  return mesh;
+}
+
+QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRequest& request,
+                       const RigidTransform& pose, const RunOptions& options) {
+  QueryOutcome outcome;
+  const LogFn log = options.log ? options.log : LogFn([](const std::string& m) { std::cerr << m << '\n'; });
+  Scene scene;  // a one-hierarchy, one-strategy scene, so prepare() decides annotation as a run would
+  scene.hierarchies = {request.hierarchy};
+  scene.annotation = request.annotation;
+  StrategySpec strategy;
+  strategy.kind = request.strategy.kind;
+  scene.strategies = {strategy};
+  if (strategy.needs_annotation() && !request.annotation.adb)
+    throw std::invalid_argument("strategy " + std::string(to_string(strategy.kind)) +
+                                " needs the ADB annotation");
+  if (request.hierarchy.is_fcl() && strategy.kind != StrategyKind::Exact)
+    throw std::invalid_argument("FCL hierarchies answer exact queries only");
+  const unsigned threads =
+      options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  TreeStore store(options.cache_dir, outcome.stats, log, threads);
+  std::shared_ptr<const AdbModel> adb_model;
+  if (request.annotation.adb)
+    adb_model = std::make_shared<const AdbModel>(request.annotation.grid, request.annotation.tau);
+  const ObjectData object_a = load_object(a);
+  const ObjectData object_b = &a == &b ? ObjectData{} : load_object(b);
+  const ObjectData& ob = &a == &b ? object_a : object_b;
+  auto hierarchy = prepare(scene, request.hierarchy, object_a, ob, store, adb_model);
+  const ContactMode mode = request.all_contacts ? ContactMode::All : ContactMode::First;
+  const auto start = Clock::now();
+  outcome.result = hierarchy->query(request.strategy, pose, mode);
+  outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+  const auto models = store.models();
+  outcome.model_a = hierarchy->model;
+  outcome.model_b = models.back();
+  return outcome;
+}
+
+BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hierarchy,
+                             const AnnotationSpec& annotation, const std::filesystem::path& output,
+                             unsigned threads) {
+  if (hierarchy.is_fcl()) throw std::invalid_argument("FCL models cannot be saved as bvhlab trees");
+  BuildOutcome outcome;
+  RunStats stats;
+  TreeStore store(
+      {}, stats, [](const std::string&) {},
+      threads ? threads : std::max(1u, std::thread::hardware_concurrency()));
+  const ObjectData data = load_object(object);
+  std::vector<std::byte> bytes;
+  with_volume(hierarchy.bv, [&]<class BV>(std::type_identity<BV>) {
+    if (annotation.adb) {
+      with_grid(annotation.grid, [&]<int G>(std::integral_constant<int, G>) {
+        bytes = save_tree_to_buffer(*store.annotated<BV, G>(data, hierarchy, annotation.tau, &outcome.model));
+      });
+    } else {
+      bytes = save_tree_to_buffer(*store.plain<BV>(data, hierarchy, &outcome.model));
+    }
+  });
+  tree_cache_detail::write_file_bytes(output, bytes);
+  outcome.file_bytes = std::filesystem::file_size(output);
+  return outcome;
+}
+
+Environment detect_environment() {
+  Environment env;
+  std::string cpu;
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);)
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  utsname host{};
+  std::string os =
+      uname(&host) == 0 ? std::string(host.sysname) + " " + host.release + " " + host.machine : "";
+  env.machine = (cpu.empty() ? std::string("unknown CPU") : cpu) + ", " +
+                std::to_string(std::thread::hardware_concurrency()) + " threads, " + os;
+#if defined(__clang__)
+  env.compiler = std::string("clang ") + __clang_version__;
+#elif defined(__GNUC__)
+  env.compiler = std::string("gcc ") + __VERSION__;
+#else
+  env.compiler = "unknown";
+#endif
+  env.build_type = BVHLAB_BUILD_TYPE;
+#ifdef BVHLAB_SOURCE_DIR
+  env.git_commit = run_command("git -C '" + std::string(BVHLAB_SOURCE_DIR) +
+                               "' describe --always --dirty --abbrev=12 2>/dev/null");
+#endif
+  if (env.git_commit.empty()) env.git_commit = "unknown";
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  env.timestamp = stamp;
+  return env;
+}
+
+RunOutput run_scene(const Scene& scene, const RunOptions& options) {
+  const auto wall_start = Clock::now();
+  RunOutput output;
+  output.scene_name = scene.name;
+  output.scene_file = scene.file;
+  output.scene = scene;
+  output.environment = detect_environment();
+  RunStats& stats = output.stats;
+  const LogFn log = options.log ? options.log : LogFn([](const std::string& m) { std::cerr << m << '\n'; });
+  const unsigned threads =
+      options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+
+  TreeStore store(options.cache_dir, stats, log, threads);
+  const TruthCache truth_cache(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "truth");
+  std::shared_ptr<const AdbModel> adb_model;
+  if (scene.annotation.adb)
+    adb_model = std::make_shared<const AdbModel>(scene.annotation.grid, scene.annotation.tau);
+
+  for (const std::string& note : scene.notes) {
+    stats.skipped.push_back(note);
+    log(note);
+  }
+  // Objects: loaded on first use; an optional object without a mesh is skipped with its pairs.
+  std::map<std::string, ObjectData> objects;
+  std::vector<const ScenePair*> pairs;
+  for (const ScenePair& pair : scene.pairs) {
+    bool usable = true;
+    for (const std::string& name : {pair.a, pair.b}) {
+      const SceneObject& spec = *scene.object(name);
+      if (spec.path.empty()) {
+        usable = false;
+        const std::string why =
+            "object " + spec.name + " skipped: mesh \"" + spec.mesh +
+            "\" not found (bundled meshes/ or the mesh cache; fetch it with meshes/fetch.sh)";
+        if (std::find(stats.skipped.begin(), stats.skipped.end(), why) == stats.skipped.end()) {
+          stats.skipped.push_back(why);
+          log(why);
+        }
+      }
+    }
+    if (usable) pairs.push_back(&pair);
+  }
+  auto object = [&](const std::string& name) -> const ObjectData& {
+    auto it = objects.find(name);
+    if (it == objects.end()) {
+      const auto start = Clock::now();
+      it = objects.emplace(name, load_object(*scene.object(name))).first;
+      ++stats.meshes_loaded;
+      stats.preprocess_seconds += seconds_since(start);
+    }
+    return it->second;
+  };
+
+  // What runs where: (hierarchy, variants) in scene order.
+  std::vector<std::pair<const HierarchySpec*, std::vector<StrategyVariant>>> plan;
+  for (const HierarchySpec& h : scene.hierarchies) {
+    std::vector<StrategyVariant> variants;
+    for (const StrategySpec& s : scene.strategies)
+      if (scene.applies(s, h))
+        for (const StrategyVariant& v : expand(s)) variants.push_back(v);
+    if (!variants.empty()) plan.emplace_back(&h, std::move(variants));
+  }
+  std::size_t total_queries = 0;
+  for (const auto& [h, variants] : plan)
+    for (const auto& group : scene.workload.groups) total_queries += variants.size() * group.poses.size();
+  total_queries *= pairs.size();
+
+  Progress progress(options.progress, total_queries);
+  std::map<std::string, CalibrationAccumulator> calibration;
+  std::map<std::string, CalibrationBin> calibration_keys;
+  std::vector<std::string> calibration_order;
+  std::vector<QueryRecord> records;
+
+  for (const ScenePair* pair : pairs) {
+    const ObjectData& a = object(pair->a);
+    const ObjectData& b = object(pair->b);
+    const std::string label = pair->label();
+
+    std::vector<std::unique_ptr<PreparedHierarchy>> prepared;
+    for (const auto& [h, variants] : plan) prepared.push_back(prepare(scene, *h, a, b, store, adb_model));
+
+    // Ground truth from the disk cache, else from the exact traversal on the first bvhlab hierarchy.
+    const auto truth_start = Clock::now();
+    const std::string truth_key = "truth v1|A=" + a.key + "|B=" + b.key + "|" + scene.workload.identity;
+    std::string why;
+    std::optional<Truth> truth = truth_cache.load(truth_key, scene.workload, &why);
+    if (truth) {
+      ++stats.truth_cache_hits;
+    } else {
+      if (!why.empty()) {
+        ++stats.truth_cache_rejected;
+        log("truth cache: rejected " + why + "; recomputing");
+      }
+      const PreparedHierarchy* exact = nullptr;
+      for (std::size_t i = 0; i < plan.size() && !exact; ++i)
+        if (!plan[i].first->is_fcl()) exact = prepared[i].get();
+      std::unique_ptr<PreparedHierarchy> fallback;
+      if (!exact) {  // an FCL-only scene: the truth still comes from bvhlab's exact traversal
+        HierarchySpec aabb;
+        aabb.bv = aabb.name = "aabb";
+        fallback = std::make_unique<BvhlabHierarchy<Aabb, NoDensity>>(store.plain<Aabb>(a, aabb),
+                                                                      store.plain<Aabb>(b, aabb), nullptr);
+        exact = fallback.get();
+      }
+      log("computing the ground truth of " + label + " (exact traversal)");
+      truth = compute_truth(scene.workload, *exact, threads);
+      ++stats.truth_computed;
+      truth_cache.store(truth_key, *truth, log);
+    }
+    // Cross-check against CGAL on poses spread evenly over the whole workload.
+    std::size_t total_poses = 0;
+    for (const auto& group : scene.workload.groups) total_poses += group.poses.size();
+    const std::size_t sample =
+        std::min<std::size_t>(static_cast<std::size_t>(scene.report.cgal_sample), total_poses);
+    if (sample > 0) {
+      const CgalGroundTruth cgal(a.mesh, b.mesh);
+      for (std::size_t k = 0; k < sample; ++k) {
+        std::size_t index = (2 * k + 1) * total_poses / (2 * sample);
+        std::size_t g = 0;
+        while (index >= scene.workload.groups[g].poses.size())
+          index -= scene.workload.groups[g++].poses.size();
+        const bool expected = (*truth)[g][index];
+        if (cgal.collides(scene.workload.groups[g].poses[index]) != expected) {
+          ++stats.cgal_mismatches;
+          log("ground truth: CGAL disagrees on " + label + " at distance " +
+              g17(scene.workload.groups[g].distance) + ", pose " + std::to_string(index) + " (truth says " +
+              (expected ? "collision" : "none") + ")");
+        }
+        ++stats.cgal_checked;
+      }
+    }
+    stats.truth_seconds += seconds_since(truth_start);
+    for (std::size_t g = 0; g < scene.workload.groups.size(); ++g) {
+      TruthSummary summary{label, scene.workload.groups[g].distance, (*truth)[g].size(), 0};
+      for (auto t : (*truth)[g]) summary.colliding += t;
+      output.truth.push_back(summary);
+    }
+
+    // The timed queries: every hierarchy and strategy on the same poses, distance by distance.
+    for (std::size_t g = 0; g < scene.workload.groups.size(); ++g) {
+      const PoseGroup& group = scene.workload.groups[g];
+      const auto& expected = (*truth)[g];
+      for (std::size_t i = 0; i < plan.size(); ++i) {
+        const HierarchySpec& h = *plan[i].first;
+        const PreparedHierarchy& hierarchy = *prepared[i];
+        for (const StrategyVariant& variant : plan[i].second) {
+          hierarchy.run(variant, group.poses, options.warmup_queries, records);
+          ResultRow row;
+          row.mesh = label;
+          row.hierarchy = h.name;
+          row.bv = h.bv;
+          row.annotation = hierarchy.model.annotation;
+          row.strategy = std::string(to_string(variant.kind));
+          row.p_min = variant.kind == StrategyKind::Adb || variant.kind == StrategyKind::TimeCritical
+                          ? variant.p_min
+                          : -1;
+          row.budget = variant.budget_label();
+          row.distance = group.distance;
+          row.queries = records.size();
+          row.model_bytes = hierarchy.model.model_bytes;
+          row.bytes_per_triangle = hierarchy.model.bytes_per_triangle;
+          std::size_t fp = 0, fn = 0, truth_yes = 0, answer_yes = 0, inexact = 0, exhausted = 0;
+          double sum_us = 0, max_us = 0;
+          Counters counters;
+          const bool calibrate =
+              variant.kind == StrategyKind::Adb || variant.kind == StrategyKind::TimeCritical;
+          const std::string cal_key = label + "\x1f" + h.name + "\x1f" + variant.label();
+          for (std::size_t k = 0; k < records.size(); ++k) {
+            const QueryRecord& r = records[k];
+            const bool truly = expected[k] != 0;
+            fp += r.collides && !truly;
+            fn += !r.collides && truly;
+            truth_yes += truly;
+            answer_yes += r.collides;
+            inexact += !r.exact;
+            exhausted += r.budget_exhausted;
+            sum_us += r.micros;
+            max_us = std::max(max_us, r.micros);
+            counters += r.counters;
+            if (calibrate) {
+              auto& acc = calibration[cal_key];
+              const std::size_t bin =
+                  std::min<std::size_t>(9, static_cast<std::size_t>(std::max(0.0, r.probability) * 10));
+              ++acc.count[bin];
+              acc.probability_sum[bin] += r.probability;
+              acc.colliding[bin] += truly;
+            }
+          }
+          if (calibrate && !calibration_keys.count(cal_key)) {
+            calibration_keys[cal_key] = CalibrationBin{label, h.name, row.strategy, row.budget, row.p_min};
+            calibration_order.push_back(cal_key);
+          }
+          const double n = std::max<double>(1.0, double(records.size()));
+          row.truth_colliding_rate = double(truth_yes) / n;
+          row.answer_colliding_rate = double(answer_yes) / n;
+          row.fp_rate = double(fp) / n;
+          row.fn_rate = double(fn) / n;
+          row.inexact_rate = double(inexact) / n;
+          row.budget_exhausted_rate = double(exhausted) / n;
+          row.mean_time_us = sum_us / n;
+          row.max_time_us = max_us;
+          if (hierarchy.has_counters()) {
+            row.bv_tests_per_query = double(counters.bv_tests) / n;
+            row.triangle_tests_per_query = double(counters.triangle_tests) / n;
+            row.nodes_visited_per_query = double(counters.nodes_visited) / n;
+          } else {
+            row.bv_tests_per_query = row.triangle_tests_per_query = row.nodes_visited_per_query =
+                kNotApplicable;
+          }
+          stats.queries += records.size();
+          stats.query_seconds += sum_us * 1e-6;
+          output.rows.push_back(row);
+          progress.advance(records.size(), label + " d=" + g17(group.distance).substr(0, 6) + " " + h.name +
+                                               " " + variant.label());
+        }
+      }
+    }
+  }
+
+  for (const std::string& key : calibration_order) {
+    const auto& acc = calibration.at(key);
+    for (std::size_t bin = 0; bin < 10; ++bin) {
+      CalibrationBin out = calibration_keys.at(key);
+      out.bin_low = double(bin) / 10;
+      out.bin_high = double(bin + 1) / 10;
+      out.count = acc.count[bin];
+      out.mean_probability =
+          acc.count[bin] ? acc.probability_sum[bin] / double(acc.count[bin]) : kNotApplicable;
+      out.collision_frequency =
+          acc.count[bin] ? double(acc.colliding[bin]) / double(acc.count[bin]) : kNotApplicable;
+      output.calibration.push_back(out);
+    }
+  }
+  output.models = store.models();
+  const auto& counts = store.cache().counts();
+  stats.tree_cache_hits = counts.hits;
+  stats.tree_cache_rejected = counts.rejected;
+  stats.tree_cache_stored = counts.stored;
+  stats.wall_seconds = seconds_since(wall_start);
+  return output;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Writers.
+
+namespace {
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+std::string csv_number(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+std::string csv_p_min(double p) {
+  return p < 0 ? "" : csv_number(p);
+}
+
+nlohmann::json json_number(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+std::ofstream open_output(const std::filesystem::path& file) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream out(file, std::ios::trunc);
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  return out;
+}
+
+}  // namespace
+
+const std::vector<std::string>& results_csv_columns() {
+  static const std::vector<std::string> columns{"mesh",
+                                                "hierarchy",
+                                                "bv",
+                                                "annotation",
+                                                "strategy",
+                                                "p_min",
+                                                "budget",
+                                                "distance",
+                                                "queries",
+                                                "truth_colliding_rate",
+                                                "answer_colliding_rate",
+                                                "mean_time_us",
+                                                "max_time_us",
+                                                "fp_rate",
+                                                "fn_rate",
+                                                "inexact_rate",
+                                                "budget_exhausted_rate",
+                                                "bv_tests_per_query",
+                                                "triangle_tests_per_query",
+                                                "nodes_visited_per_query",
+                                                "model_bytes",
+                                                "bytes_per_triangle",
+                                                "machine",
+                                                "compiler",
+                                                "build_type",
+                                                "git_commit"};
+  return columns;
+}
+
+void write_results_csv(const RunOutput& run, const std::filesystem::path& file) {
+  std::ofstream out = open_output(file);
+  const auto& columns = results_csv_columns();
+  for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
+  out << '\n';
+  const Environment& env = run.environment;
+  for (const ResultRow& r : run.rows) {
+    const std::vector<std::string> fields{csv_field(r.mesh),
+                                          csv_field(r.hierarchy),
+                                          csv_field(r.bv),
+                                          csv_field(r.annotation),
+                                          r.strategy,
+                                          csv_p_min(r.p_min),
+                                          csv_field(r.budget),
+                                          csv_number(r.distance),
+                                          std::to_string(r.queries),
+                                          csv_number(r.truth_colliding_rate),
+                                          csv_number(r.answer_colliding_rate),
+                                          csv_number(r.mean_time_us),
+                                          csv_number(r.max_time_us),
+                                          csv_number(r.fp_rate),
+                                          csv_number(r.fn_rate),
+                                          csv_number(r.inexact_rate),
+                                          csv_number(r.budget_exhausted_rate),
+                                          csv_number(r.bv_tests_per_query),
+                                          csv_number(r.triangle_tests_per_query),
+                                          csv_number(r.nodes_visited_per_query),
+                                          csv_number(r.model_bytes),
+                                          csv_number(r.bytes_per_triangle),
+                                          csv_field(env.machine),
+                                          csv_field(env.compiler),
+                                          csv_field(env.build_type),
+                                          csv_field(env.git_commit)};
+    for (std::size_t i = 0; i < fields.size(); ++i) out << (i ? "," : "") << fields[i];
+    out << '\n';
+  }
+  if (!out) throw std::runtime_error(file.string() + ": write error");
+}
+
+void write_calibration_csv(const RunOutput& run, const std::filesystem::path& file) {
+  std::ofstream out = open_output(file);
+  out << "mesh,hierarchy,strategy,p_min,budget,bin_low,bin_high,count,mean_probability,collision_frequency\n";
+  for (const CalibrationBin& c : run.calibration)
+    out << csv_field(c.mesh) << ',' << csv_field(c.hierarchy) << ',' << c.strategy << ','
+        << csv_p_min(c.p_min) << ',' << csv_field(c.budget) << ',' << csv_number(c.bin_low) << ','
+        << csv_number(c.bin_high) << ',' << c.count << ',' << csv_number(c.mean_probability) << ','
+        << csv_number(c.collision_frequency) << '\n';
+  if (!out) throw std::runtime_error(file.string() + ": write error");
+}
+
+void write_results_json(const RunOutput& run, const std::filesystem::path& file) {
+  using nlohmann::json;
+  const Environment& env = run.environment;
+  const RunStats& s = run.stats;
+  json doc;
+  doc["scene"] = {{"name", run.scene_name}, {"file", run.scene_file.string()}};
+  doc["environment"] = {{"machine", env.machine},
+                        {"compiler", env.compiler},
+                        {"build_type", env.build_type},
+                        {"git_commit", env.git_commit},
+                        {"timestamp", env.timestamp}};
+  doc["stats"] = {{"meshes_loaded", s.meshes_loaded},
+                  {"trees_built", s.trees_built},
+                  {"trees_annotated", s.trees_annotated},
+                  {"annotation_clip_calls", s.annotation_clip_calls},
+                  {"tree_cache_hits", s.tree_cache_hits},
+                  {"tree_cache_rejected", s.tree_cache_rejected},
+                  {"tree_cache_stored", s.tree_cache_stored},
+                  {"fcl_models_built", s.fcl_models_built},
+                  {"truth_computed", s.truth_computed},
+                  {"truth_cache_hits", s.truth_cache_hits},
+                  {"truth_cache_rejected", s.truth_cache_rejected},
+                  {"cgal_checked", s.cgal_checked},
+                  {"cgal_mismatches", s.cgal_mismatches},
+                  {"queries", s.queries},
+                  {"preprocess_seconds", s.preprocess_seconds},
+                  {"truth_seconds", s.truth_seconds},
+                  {"query_seconds", s.query_seconds},
+                  {"wall_seconds", s.wall_seconds},
+                  {"skipped", s.skipped}};
+  json models = json::array();
+  for (const ModelInfo& m : run.models)
+    models.push_back({{"object", m.object},
+                      {"hierarchy", m.hierarchy},
+                      {"bv", m.bv},
+                      {"annotation", m.annotation},
+                      {"triangles", m.triangles},
+                      {"nodes", m.nodes},
+                      {"depth", m.depth},
+                      {"model_bytes", m.model_bytes},
+                      {"bytes_per_triangle", m.bytes_per_triangle},
+                      {"build_seconds", m.build_seconds},
+                      {"annotate_seconds", m.annotate_seconds},
+                      {"from_cache", m.from_cache}});
+  doc["models"] = models;
+  json truth = json::array();
+  for (const TruthSummary& t : run.truth)
+    truth.push_back(
+        {{"mesh", t.mesh}, {"distance", t.distance}, {"poses", t.poses}, {"colliding", t.colliding}});
+  doc["ground_truth"] = truth;
+  json rows = json::array();
+  for (const ResultRow& r : run.rows)
+    rows.push_back({{"mesh", r.mesh},
+                    {"hierarchy", r.hierarchy},
+                    {"bv", r.bv},
+                    {"annotation", r.annotation},
+                    {"strategy", r.strategy},
+                    {"p_min", r.p_min < 0 ? json(nullptr) : json(r.p_min)},
+                    {"budget", r.budget},
+                    {"distance", r.distance},
+                    {"queries", r.queries},
+                    {"truth_colliding_rate", r.truth_colliding_rate},
+                    {"answer_colliding_rate", r.answer_colliding_rate},
+                    {"mean_time_us", r.mean_time_us},
+                    {"max_time_us", r.max_time_us},
+                    {"fp_rate", r.fp_rate},
+                    {"fn_rate", r.fn_rate},
+                    {"inexact_rate", r.inexact_rate},
+                    {"budget_exhausted_rate", r.budget_exhausted_rate},
+                    {"bv_tests_per_query", json_number(r.bv_tests_per_query)},
+                    {"triangle_tests_per_query", json_number(r.triangle_tests_per_query)},
+                    {"nodes_visited_per_query", json_number(r.nodes_visited_per_query)},
+                    {"model_bytes", r.model_bytes},
+                    {"bytes_per_triangle", r.bytes_per_triangle}});
+  doc["rows"] = rows;
+  json cal = json::array();
+  for (const CalibrationBin& c : run.calibration)
+    cal.push_back({{"mesh", c.mesh},
+                   {"hierarchy", c.hierarchy},
+                   {"strategy", c.strategy},
+                   {"p_min", c.p_min < 0 ? json(nullptr) : json(c.p_min)},
+                   {"budget", c.budget},
+                   {"bin_low", c.bin_low},
+                   {"bin_high", c.bin_high},
+                   {"count", c.count},
+                   {"mean_probability", json_number(c.mean_probability)},
+                   {"collision_frequency", json_number(c.collision_frequency)}});
+  doc["calibration"] = cal;
+  std::ofstream out = open_output(file);
+  out << doc.dump(1) << '\n';
+  if (!out) throw std::runtime_error(file.string() + ": write error");
+}
+
+}  // namespace bvhlab

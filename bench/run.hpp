@@ -1,0 +1,150 @@
+// The scene runner: builds (or loads from the cache) exactly the trees a scene asks for, computes or loads
+// the exact ground truth, times every strategy on the same poses in this process, and aggregates one row per
+// (mesh pair, hierarchy, strategy variant, distance).
+#pragma once
+
+#include "bench/core/scene.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+
+struct RunOptions {
+  /// Root of the on-disk cache (trees/ and truth/ below it). Empty: nothing is read from or written to disk.
+  std::filesystem::path cache_dir;
+  bool progress = false;  ///< a progress bar on stderr
+  /// Receives messages (skipped objects, rejected cache entries, what is being built). Default: stderr.
+  std::function<void(const std::string&)> log;
+  unsigned threads = 0;    ///< preprocessing threads; 0: hardware concurrency
+  int warmup_queries = 3;  ///< untimed queries before each timed series (caches, branch predictors)
+};
+
+/// Evidence of what the run did, for the "only what is needed" rule and the cache.
+struct RunStats {
+  std::size_t meshes_loaded = 0;
+  std::size_t trees_built = 0;            ///< bvhlab hierarchies built from a mesh
+  std::size_t trees_annotated = 0;        ///< ADB annotations computed (CGAL clipping)
+  std::size_t annotation_clip_calls = 0;  ///< CGAL clipping calls made by those annotations
+  std::size_t tree_cache_hits = 0;        ///< trees (plain or annotated) loaded from the disk cache
+  std::size_t tree_cache_rejected = 0;    ///< cache entries found stale or corrupt, then rebuilt
+  std::size_t tree_cache_stored = 0;
+  std::size_t fcl_models_built = 0;
+  std::size_t truth_computed = 0;  ///< pose sets whose ground truth was computed
+  std::size_t truth_cache_hits = 0;
+  std::size_t truth_cache_rejected = 0;
+  std::size_t cgal_checked = 0;     ///< poses cross-checked against CGAL
+  std::size_t cgal_mismatches = 0;  ///< of those, where CGAL disagreed with the ground truth
+  std::size_t queries = 0;          ///< timed queries
+  double preprocess_seconds = 0;
+  double truth_seconds = 0;
+  double query_seconds = 0;  ///< sum of the timed queries only
+  double wall_seconds = 0;
+  std::vector<std::string> skipped;  ///< objects or pairs left out, with the reason
+};
+
+/// One row of results.csv.
+struct ResultRow {
+  std::string mesh;                       ///< the pair's label: "jeep1", or "a|b" for two different objects
+  std::string hierarchy, bv, annotation;  ///< annotation: "none" or "adb g=2 tau=0.5"
+  std::string strategy;                   ///< exact, guided_exact, adb, time_critical
+  double p_min = -1;                      ///< < 0: not applicable (written as an empty field)
+  std::string budget;                     ///< "" or "bv_tests=200" / "deadline_us=20"
+  double distance = 0;
+  std::size_t queries = 0;
+  double truth_colliding_rate = 0, answer_colliding_rate = 0;
+  double mean_time_us = 0, max_time_us = 0;
+  double fp_rate = 0, fn_rate = 0;
+  double inexact_rate = 0, budget_exhausted_rate = 0;
+  double bv_tests_per_query = 0, triangle_tests_per_query = 0, nodes_visited_per_query = 0;
+  double model_bytes = 0, bytes_per_triangle = 0;  ///< of one object's tree (A's)
+};
+
+/// One probability bin of one ADB-type series, over all its distances.
+struct CalibrationBin {
+  std::string mesh, hierarchy, strategy, budget;
+  double p_min = -1;
+  double bin_low = 0, bin_high = 0;
+  std::size_t count = 0;
+  double mean_probability = 0;
+  double collision_frequency = 0;  ///< fraction of the bin's queries that truly collide
+};
+
+/// A tree (or FCL model) the run used, with its preprocessing cost.
+struct ModelInfo {
+  std::string object, hierarchy, bv, annotation;
+  std::size_t triangles = 0, nodes = 0, depth = 0;
+  double model_bytes = 0, bytes_per_triangle = 0;
+  double build_seconds = 0,
+         annotate_seconds = 0;  ///< as measured when it was built (cached trees keep theirs)
+  bool from_cache = false;
+};
+
+/// Ground truth colliding fraction per (pair, distance), for the cross-check with meshes/README.md.
+struct TruthSummary {
+  std::string mesh;
+  double distance = 0;
+  std::size_t poses = 0, colliding = 0;
+};
+
+struct Environment {
+  std::string machine, compiler, build_type, git_commit, timestamp;
+};
+Environment detect_environment();
+
+struct RunOutput {
+  std::string scene_name;
+  std::filesystem::path scene_file;
+  Scene scene;
+  Environment environment;
+  RunStats stats;
+  std::vector<ResultRow> rows;
+  std::vector<CalibrationBin> calibration;
+  std::vector<ModelInfo> models;
+  std::vector<TruthSummary> truth;
+};
+
+/// Runs a parsed scene. Throws for I/O and model errors; an optional object whose mesh is missing is
+/// skipped (recorded in stats.skipped).
+RunOutput run_scene(const Scene& scene, const RunOptions& options);
+
+/// An object's mesh as a run loads it: normalised (if asked), scaled and placed. Throws MeshError.
+Mesh load_scene_object(const SceneObject& object);
+
+/// One query between two objects, with the trees a scene with this one hierarchy would use (and the same
+/// cache).
+struct QueryRequest {
+  HierarchySpec hierarchy;
+  AnnotationSpec annotation;  ///< must be adb for every strategy but exact
+  StrategyVariant strategy;
+  bool all_contacts = false;  ///< exact strategy: list every intersecting triangle pair
+};
+struct QueryOutcome {
+  Result result;
+  double micros = 0;  ///< the query alone, trees already built
+  ModelInfo model_a, model_b;
+  RunStats stats;
+};
+QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRequest& request,
+                       const RigidTransform& pose, const RunOptions& options);
+
+/// Builds (and, if asked, annotates) one object's tree and saves it, without polygons, in the saved-tree
+/// format.
+struct BuildOutcome {
+  ModelInfo model;
+  std::uintmax_t file_bytes = 0;
+};
+BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hierarchy,
+                             const AnnotationSpec& annotation, const std::filesystem::path& output,
+                             unsigned threads = 0);
+
+/// The CSV header of results.csv, in order. The schema test holds the writer to it.
+const std::vector<std::string>& results_csv_columns();
+void write_results_csv(const RunOutput& run, const std::filesystem::path& file);
+void write_calibration_csv(const RunOutput& run, const std::filesystem::path& file);
+void write_results_json(const RunOutput& run, const std::filesystem::path& file);
+
+}  // namespace bvhlab
