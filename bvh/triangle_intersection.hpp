@@ -6,9 +6,12 @@
 namespace bvhlab {
 
 /// Fast test; agrees with triangles_intersect_exact on every input, degenerate triangles included.
+/// Out-of-line wrapper of triangles_intersect_fast (bvh/triangle_intersection_fast.hpp, inlineable).
+/// Throws std::invalid_argument for NaN or infinite coordinates.
 bool triangles_intersect(const TrianglePoints& p, const TrianglePoints& q);
 
 /// Ground truth: CGAL's exact predicates (Epick); degenerate triangles become segments or points.
+/// Throws std::invalid_argument for NaN or infinite coordinates.
 bool triangles_intersect_exact(const TrianglePoints& p, const TrianglePoints& q);
 
 }  // namespace bvhlab

@@ -1,0 +1,615 @@
+// Property tests: the fast triangle test against CGAL ground truth on random and adversarial families,
+// plus hand-written cases with known answers. Every family uses a fixed seed.
+#include "bvh/triangle_intersection.hpp"
+#include "bvh/triangle_intersection_fast.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <string>
+
+namespace bvhlab {
+namespace {
+
+using Rng = std::mt19937_64;
+
+// Full counts in optimised builds; a tenth where assertions are on (Debug: CGAL checks everything).
+#ifdef NDEBUG
+constexpr std::size_t kScale = 1;
+#else
+constexpr std::size_t kScale = 10;
+#endif
+
+double uniform(Rng& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+long long integer(Rng& rng, long long lo, long long hi) {
+  return std::uniform_int_distribution<long long>(lo, hi)(rng);
+}
+bool coin(Rng& rng) {
+  return integer(rng, 0, 1) == 1;
+}
+Vec3 uniform_point(Rng& rng, double lo, double hi) {
+  return {uniform(rng, lo, hi), uniform(rng, lo, hi), uniform(rng, lo, hi)};
+}
+Vec3 integer_point(Rng& rng, long long lo, long long hi) {
+  return Vec3{double(integer(rng, lo, hi)), double(integer(rng, lo, hi)), double(integer(rng, lo, hi))};
+}
+Vec3 random_unit(Rng& rng) {
+  std::normal_distribution<double> normal;
+  Vec3 v{normal(rng), normal(rng), normal(rng)};
+  return v / v.norm();
+}
+// One of the 6 vertex orders, reflections included (they flip the orientation the test must not rely on).
+TrianglePoints permuted(const TrianglePoints& t, Rng& rng) {
+  static constexpr int kOrders[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+  const auto& o = kOrders[integer(rng, 0, 5)];
+  return {t[o[0]], t[o[1]], t[o[2]]};
+}
+TrianglePoints translated(const TrianglePoints& t, const Vec3& by) {
+  return {t[0] + by, t[1] + by, t[2] + by};
+}
+TrianglePoints scaled(const TrianglePoints& t, double s) {
+  return {t[0] * s, t[1] * s, t[2] * s};
+}
+bool exactly_degenerate(const TrianglePoints& t) {  // for small-integer triangles only (products exact)
+  return (t[1] - t[0]).cross(t[2] - t[0]).isZero(0.0);
+}
+
+struct Pair {
+  TrianglePoints p, q;
+  std::optional<bool> known;  // the answer by construction, when the family guarantees one
+};
+using Generator = std::function<Pair(Rng&)>;
+
+std::string describe(const TrianglePoints& t) {
+  std::ostringstream out;
+  char buffer[96];
+  for (const Vec3& v : t) {
+    std::snprintf(buffer, sizeof buffer, "(%a, %a, %a) ", v.x(), v.y(), v.z());
+    out << buffer;
+  }
+  return out.str();
+}
+
+struct FamilyStats {
+  std::size_t pairs = 0, intersecting = 0, undecided = 0, disagreements = 0, known = 0, known_wrong = 0;
+  std::string first_problem;
+};
+
+// Per pair: ground truth, the fast test as the traversal calls it, the filter's own verdict, and the fast
+// test again on the swapped pair with both vertex orders permuted (symmetry and orientation handling).
+FamilyStats run_family(const char* name, std::uint64_t seed, std::size_t count, const Generator& generate) {
+  Rng rng(seed);
+  FamilyStats stats;
+  for (std::size_t i = 0; i < count; ++i) {
+    const Pair pair = generate(rng);
+    const bool exact = triangles_intersect_exact(pair.p, pair.q);
+    const bool fast = triangles_intersect(pair.p, pair.q);
+    const FilteredVerdict verdict =
+        triangles_intersect_filtered(pair.p[0], pair.p[1], pair.p[2], pair.q[0], pair.q[1], pair.q[2]);
+    const bool swapped = triangles_intersect_fast(permuted(pair.q, rng), permuted(pair.p, rng));
+    const bool filter_wrong =
+        verdict != FilteredVerdict::undecided && (verdict == FilteredVerdict::intersecting) != exact;
+    ++stats.pairs;
+    stats.intersecting += exact;
+    stats.undecided += verdict == FilteredVerdict::undecided;
+    if (fast != exact || swapped != exact || filter_wrong) {
+      if (stats.disagreements++ == 0)
+        stats.first_problem = "exact=" + std::to_string(exact) + " fast=" + std::to_string(fast) +
+                              " swapped=" + std::to_string(swapped) + " P=" + describe(pair.p) +
+                              " Q=" + describe(pair.q);
+    }
+    if (pair.known) {
+      ++stats.known;
+      if (*pair.known != exact && stats.known_wrong++ == 0 && stats.first_problem.empty())
+        stats.first_problem =
+            "ground truth contradicts construction: P=" + describe(pair.p) + " Q=" + describe(pair.q);
+    }
+  }
+  std::printf(
+      "[family] %-24s pairs=%zu intersecting=%.3f undecided=%.4f disagreements=%zu known=%zu "
+      "known_wrong=%zu\n",
+      name, stats.pairs, double(stats.intersecting) / double(stats.pairs),
+      double(stats.undecided) / double(stats.pairs), stats.disagreements, stats.known, stats.known_wrong);
+  return stats;
+}
+
+// Runs a family and checks: zero disagreements, ground truth matches every constructed answer, and both
+// outcomes occur often enough for the family to mean something.
+void check_family(const char* name, std::uint64_t seed, std::size_t count, const Generator& generate,
+                  double min_fraction = 0.05) {
+  const FamilyStats stats = run_family(name, seed, count / kScale, generate);
+  ::testing::Test::RecordProperty(std::string(name) + "_pairs", std::to_string(stats.pairs));
+  ::testing::Test::RecordProperty(std::string(name) + "_intersecting", std::to_string(stats.intersecting));
+  ::testing::Test::RecordProperty(std::string(name) + "_undecided", std::to_string(stats.undecided));
+  EXPECT_EQ(stats.disagreements, 0u) << stats.first_problem;
+  EXPECT_EQ(stats.known_wrong, 0u) << stats.first_problem;
+  const double fraction = double(stats.intersecting) / double(stats.pairs);
+  EXPECT_GE(fraction, min_fraction) << name << ": too few intersecting pairs for a meaningful family";
+  EXPECT_LE(fraction, 1.0 - min_fraction) << name << ": too few disjoint pairs for a meaningful family";
+}
+
+// ---- generators ------------------------------------------------------------------------------------
+
+// A random well-shaped triangle: random plane orientation, circumradius 0.3..0.6, perturbed angles.
+TrianglePoints random_triangle(Rng& rng, const Vec3& centre) {
+  const Vec3 a = random_unit(rng);
+  const Vec3 b = a.cross(random_unit(rng)).normalized();
+  const Vec3 c = a.cross(b);
+  const double radius = uniform(rng, 0.3, 0.6), phase = uniform(rng, 0, 2 * std::numbers::pi);
+  TrianglePoints t;
+  for (int k = 0; k < 3; ++k) {
+    const double angle = phase + 2 * std::numbers::pi * k / 3 + uniform(rng, -0.6, 0.6);
+    t[k] = centre + radius * (std::cos(angle) * b + std::sin(angle) * c);
+  }
+  return t;
+}
+
+// Two triangles whose centres lie in a common box: about half intersect.
+Pair general_pair(Rng& rng) {
+  const TrianglePoints p = random_triangle(rng, uniform_point(rng, 0.0, 0.5));
+  return {p, random_triangle(rng, uniform_point(rng, 0.0, 0.5)), std::nullopt};
+}
+
+// An exactly representable plane: integer origin and integer basis, times a power of two. Lattice
+// points (i, j) map to exact doubles, so coplanarity and touching are exact, not rounded.
+struct LatticePlane {
+  Vec3 origin, e1, e2;
+  double unit = 1.0;
+  static LatticePlane random(Rng& rng) {
+    LatticePlane plane;
+    do {
+      plane.e1 = integer_point(rng, -9, 9);
+      plane.e2 = integer_point(rng, -9, 9);
+    } while (plane.e1.cross(plane.e2).isZero(0.0));
+    plane.origin = integer_point(rng, -1000, 1000);
+    plane.unit = std::ldexp(1.0, int(integer(rng, -20, 20)));
+    return plane;
+  }
+  [[nodiscard]] Vec3 at(const Eigen::Vector2d& ij) const {
+    return (origin + ij.x() * e1 + ij.y() * e2) * unit;
+  }
+  [[nodiscard]] TrianglePoints map(const std::array<Eigen::Vector2d, 3>& t) const {
+    return {at(t[0]), at(t[1]), at(t[2])};
+  }
+};
+using Tri2 = std::array<Eigen::Vector2d, 3>;
+Eigen::Vector2d lattice2(Rng& rng, long long r) {
+  return {double(integer(rng, -r, r)), double(integer(rng, -r, r))};
+}
+double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+bool degenerate2(const Tri2& t) {
+  return cross2(t[1] - t[0], t[2] - t[0]) == 0.0;
+}
+Tri2 random_tri2(Rng& rng, long long r) {
+  Tri2 t;
+  do t = {lattice2(rng, r), lattice2(rng, r), lattice2(rng, r)};
+  while (degenerate2(t));
+  return t;
+}
+Tri2 shifted2(const Tri2& t, const Eigen::Vector2d& by) {
+  return {t[0] + by, t[1] + by, t[2] + by};
+}
+
+// Half of the pairs touch exactly (known: true); the other half move Q by one small lattice step, which
+// makes it overlap or separate.
+Pair coplanar_touching(Rng& rng, const std::function<Tri2(Rng&, const Tri2&)>& touching_q) {
+  const LatticePlane plane = LatticePlane::random(rng);
+  Tri2 p = random_tri2(rng, 20);
+  p = {2.0 * p[0], 2.0 * p[1], 2.0 * p[2]};  // even coordinates: edge midpoints are lattice points
+  Tri2 q;
+  do q = touching_q(rng, p);
+  while (degenerate2(q));
+  std::optional<bool> known = true;
+  if (coin(rng)) {
+    Eigen::Vector2d step = Eigen::Vector2d::Zero();
+    do step = lattice2(rng, 2);
+    while (step.isZero(0.0));
+    q = shifted2(q, step);
+    known.reset();
+  }
+  return {permuted(plane.map(p), rng), permuted(plane.map(q), rng), known};
+}
+
+// Q in the cone opposite P's corner p[0]: the two meet only at that vertex.
+Tri2 touch_at_vertex(Rng& rng, const Tri2& p) {
+  const auto opposite = [&]() -> Eigen::Vector2d {
+    Eigen::Vector2d w = Eigen::Vector2d::Zero();
+    do w = -double(integer(rng, 0, 3)) * (p[1] - p[0]) - double(integer(rng, 0, 3)) * (p[2] - p[0]);
+    while (w.isZero(0.0));
+    return p[0] + w;
+  };
+  return {p[0], opposite(), opposite()};
+}
+
+// Q's vertex at the midpoint of P's edge p0p1, the rest strictly beyond that edge.
+Tri2 touch_vertex_on_edge(Rng& rng, const Tri2& p) {
+  const Eigen::Vector2d mid = (p[0] + p[1]) / 2.0;
+  const auto beyond = [&]() -> Eigen::Vector2d {
+    return mid + double(integer(rng, -2, 2)) * (p[1] - p[0]) / 2.0 -
+           double(integer(rng, 1, 3)) * (p[2] - mid);
+  };
+  return {mid, beyond(), beyond()};
+}
+
+// Q shares P's edge p0p1, or half of it, and lies beyond it.
+Tri2 touch_along_edge(Rng& rng, const Tri2& p) {
+  const Eigen::Vector2d mid = (p[0] + p[1]) / 2.0;
+  const Eigen::Vector2d beyond =
+      mid + double(integer(rng, -2, 2)) * (p[1] - p[0]) - double(integer(rng, 1, 3)) * (p[2] - mid);
+  switch (integer(rng, 0, 2)) {
+    case 0:
+      return {p[0], p[1], beyond};
+    case 1:
+      return {p[0], mid, beyond};
+    default:
+      return {mid, p[1], beyond};
+  }
+}
+
+// Sharing non-coplanar: exact sharing half the time (known: true), else Q moved by a small random vector.
+Pair sharing(Rng& rng, int shared) {
+  const Pair base = general_pair(rng);
+  TrianglePoints q = base.q;
+  const TrianglePoints p = base.p;
+  q[0] = p[0];
+  if (shared == 2) q[1] = p[1];
+  std::optional<bool> known = true;
+  if (coin(rng)) {
+    q = translated(q, random_unit(rng) * std::pow(10.0, uniform(rng, -12, -2)));
+    known.reset();
+  }
+  return {permuted(p, rng), permuted(q, rng), known};
+}
+
+// Integer triangle P = m * G and a lattice point q0 = a G0 + b G1 + c G2 (a + b + c = m) exactly on its
+// face or an edge; Q's other vertices on one side. Half the time Q moves one unit along an axis.
+// With `collapse`, Q becomes a point, a segment or a collinear triple that still contains q0.
+Pair vertex_on_face(Rng& rng, bool collapse) {
+  std::array<Vec3, 3> g;
+  do g = {integer_point(rng, -40, 40), integer_point(rng, -40, 40), integer_point(rng, -40, 40)};
+  while (exactly_degenerate(g));
+  long long a, b, c;
+  do {
+    a = integer(rng, 0, 5);
+    b = integer(rng, 0, 5);
+    c = integer(rng, 0, 5);
+  } while (int(a > 0) + int(b > 0) + int(c > 0) < 2);
+  const double m = double(a + b + c);
+  const TrianglePoints p = {m * g[0], m * g[1], m * g[2]};
+  const Vec3 q0 = double(a) * g[0] + double(b) * g[1] + double(c) * g[2];
+  const Vec3 normal = (p[1] - p[0]).cross(p[2] - p[0]);  // small integers: exact
+  const double side = coin(rng) ? 1.0 : -1.0;
+  const auto off_plane = [&]() -> Vec3 {
+    Vec3 v = Vec3::Zero();
+    do v = integer_point(rng, -30, 30);
+    while (side * normal.dot(v) <= 0.0);
+    return q0 + v;
+  };
+  TrianglePoints q = {q0, off_plane(), off_plane()};
+  if (collapse) {
+    switch (integer(rng, 0, 2)) {
+      case 0:
+        q = {q0, q0, q0};
+        break;
+      case 1:
+        q = {q0, q[1], q[1]};
+        break;
+      default:
+        q = {q[1], q0 + 2.0 * (q[1] - q0), q0};
+    }
+  }
+  std::optional<bool> known = true;
+  if (coin(rng)) {
+    Vec3 step = Vec3::Zero();
+    step[integer(rng, 0, 2)] = coin(rng) ? 1.0 : -1.0;
+    q = translated(q, step);
+    known.reset();
+  }
+  const double unit = std::ldexp(1.0, int(integer(rng, -30, 30)));
+  return {permuted(scaled(p, unit), rng), permuted(scaled(q, unit), rng), known};
+}
+
+// Q almost in P's plane: each vertex 1e-15..1e-12 (relative to unit size) off it, on a random side.
+Pair near_parallel(Rng& rng) {
+  const TrianglePoints p = general_pair(rng).p;
+  const Vec3 n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+  TrianglePoints q;
+  for (Vec3& v : q) {
+    const double offset = (coin(rng) ? 1.0 : -1.0) * std::pow(10.0, uniform(rng, -15, -12));
+    v = p[0] + uniform(rng, -0.5, 1.2) * (p[1] - p[0]) + uniform(rng, -0.5, 1.2) * (p[2] - p[0]) + offset * n;
+  }
+  return {p, q, std::nullopt};
+}
+
+// Q's vertex at a barycentric point of P computed in double: on the face up to rounding.
+Pair vertex_near_face(Rng& rng) {
+  const Pair base = general_pair(rng);
+  const TrianglePoints& p = base.p;
+  const double a = uniform(rng, 0, 1), b = uniform(rng, 0, 1 - a);
+  const Vec3 on_face = p[0] + a * (p[1] - p[0]) + b * (p[2] - p[0]);
+  const Vec3 n = (p[1] - p[0]).cross(p[2] - p[0]);
+  const double side = coin(rng) ? 1.0 : -1.0;
+  TrianglePoints q = {on_face, on_face + uniform_point(rng, -0.5, 0.5),
+                      on_face + uniform_point(rng, -0.5, 0.5)};
+  for (int i = 1; i < 3; ++i)
+    if (side * n.dot(q[i] - on_face) < 0) q[i] = on_face - (q[i] - on_face);
+  return {p, permuted(q, rng), std::nullopt};
+}
+
+// Degenerate "triangles" on a small integer grid, so coincidences are frequent and exact.
+TrianglePoints degenerate_triangle(Rng& rng, long long grid) {
+  const Vec3 a = integer_point(rng, 0, grid);
+  switch (integer(rng, 0, 3)) {
+    case 0:  // a point
+      return {a, a, a};
+    case 1: {  // a repeated vertex
+      return {a, a, integer_point(rng, 0, grid)};
+    }
+    default: {  // three collinear points, middle one anywhere in the order, possibly repeated
+      Vec3 d = Vec3::Zero();
+      do d = integer_point(rng, -1, 1);
+      while (d.isZero(0.0));
+      return {a + double(integer(rng, -2, 2)) * d, a + double(integer(rng, -2, 2)) * d,
+              a + double(integer(rng, -2, 2)) * d};
+    }
+  }
+}
+TrianglePoints grid_triangle(Rng& rng, long long grid) {
+  TrianglePoints t;
+  do t = {integer_point(rng, 0, grid), integer_point(rng, 0, grid), integer_point(rng, 0, grid)};
+  while (exactly_degenerate(t));
+  return t;
+}
+
+// A triangle whose third vertex is the rounded point a + t (b - a): almost, rarely exactly, a segment.
+Pair near_degenerate(Rng& rng) {
+  const Pair base = general_pair(rng);
+  TrianglePoints p = base.p;
+  p[2] = p[0] + uniform(rng, -0.5, 1.5) * (p[1] - p[0]);
+  return {permuted(p, rng), base.q, std::nullopt};
+}
+
+Generator rescaled(double scale, Vec3 offset) {
+  return [scale, offset](Rng& rng) {
+    const Pair base = general_pair(rng);
+    return Pair{translated(scaled(base.p, scale), offset), translated(scaled(base.q, scale), offset),
+                std::nullopt};
+  };
+}
+
+// ---- families ------------------------------------------------------------------------------------------
+
+TEST(TriangleFamilies, GeneralPosition) {
+  check_family("general_position", 1, 200'000, general_pair);
+  // The filter must actually decide general-position pairs (else "fast" would be CGAL with extra steps).
+  const FamilyStats stats = run_family("general_position_small", 11, 20'000 / kScale, general_pair);
+  EXPECT_LT(double(stats.undecided) / double(stats.pairs), 0.001);
+}
+
+TEST(TriangleFamilies, CoplanarOverlapping) {
+  check_family("coplanar_overlapping", 2, 60'000, [](Rng& rng) {
+    const LatticePlane plane = LatticePlane::random(rng);
+    const Tri2 p = random_tri2(rng, 20);
+    const Tri2 q = shifted2(random_tri2(rng, 20), lattice2(rng, 15));
+    return Pair{plane.map(p), plane.map(q), std::nullopt};
+  });
+}
+
+TEST(TriangleFamilies, CoplanarTouchingAtVertex) {
+  check_family("coplanar_touch_vertex", 3, 60'000,
+               [](Rng& rng) { return coplanar_touching(rng, touch_at_vertex); });
+  check_family("coplanar_vertex_on_edge", 4, 40'000,
+               [](Rng& rng) { return coplanar_touching(rng, touch_vertex_on_edge); });
+}
+
+TEST(TriangleFamilies, CoplanarTouchingAlongEdge) {
+  check_family("coplanar_touch_edge", 5, 60'000,
+               [](Rng& rng) { return coplanar_touching(rng, touch_along_edge); });
+}
+
+TEST(TriangleFamilies, SharedEdge) {
+  check_family("shared_edge", 6, 80'000, [](Rng& rng) { return sharing(rng, 2); });
+}
+
+TEST(TriangleFamilies, SharedVertex) {
+  check_family("shared_vertex", 7, 80'000, [](Rng& rng) { return sharing(rng, 1); });
+}
+
+TEST(TriangleFamilies, VertexExactlyOnFace) {
+  check_family("vertex_on_face", 8, 80'000, [](Rng& rng) { return vertex_on_face(rng, false); });
+}
+
+TEST(TriangleFamilies, VertexNearFace) {
+  check_family("vertex_near_face", 9, 80'000, vertex_near_face);
+}
+
+TEST(TriangleFamilies, NearParallel) {
+  check_family("near_parallel", 10, 80'000, near_parallel);
+}
+
+TEST(TriangleFamilies, DegenerateAgainstTriangle) {
+  check_family("degenerate_vs_triangle", 12, 60'000, [](Rng& rng) {
+    return Pair{degenerate_triangle(rng, 4), grid_triangle(rng, 4), std::nullopt};
+  });
+  check_family("near_degenerate", 13, 40'000, near_degenerate);
+  check_family("degenerate_on_face", 19, 40'000, [](Rng& rng) { return vertex_on_face(rng, true); });
+}
+
+TEST(TriangleFamilies, DegenerateAgainstDegenerate) {
+  check_family("degenerate_vs_degenerate", 14, 60'000, [](Rng& rng) {
+    return Pair{degenerate_triangle(rng, 2), degenerate_triangle(rng, 2), std::nullopt};
+  });
+}
+
+TEST(TriangleFamilies, TinyFarFromOrigin) {
+  check_family("tiny_far", 15, 60'000, [](Rng& rng) {
+    const Vec3 offset = Vec3::Constant(1e6) + uniform_point(rng, -1e5, 1e5);
+    return rescaled(1e-3, offset)(rng);
+  });
+}
+
+TEST(TriangleFamilies, Scales) {
+  check_family("scale_1e-6", 16, 50'000, rescaled(1e-6, Vec3::Zero()));
+  check_family("scale_1e6", 17, 50'000, rescaled(1e6, Vec3::Zero()));
+}
+
+TEST(TriangleFamilies, ExtremeMagnitudes) {
+  // Products underflow (2^-1000) or overflow (2^1000): the filter must decline, never misjudge.
+  check_family("extreme_magnitudes", 18, 40'000, [](Rng& rng) {
+    const double scale = std::ldexp(1.0, int(integer(rng, -1020, 1020)));
+    return rescaled(scale, Vec3::Zero())(rng);
+  });
+}
+
+// ---- the orientation filter alone, on mixed magnitudes --------------------------------------------------
+
+int cgal_orientation(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  using P = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  const auto point = [](const Vec3& v) { return P(v.x(), v.y(), v.z()); };
+  // CGAL's orientation(a, b, c, d) is sign det[b - a, c - a, d - a], the convention of certified_orient.
+  return int(CGAL::orientation(point(a), point(b), point(c), point(d)));
+}
+
+TEST(TriangleFilter, CertifiedOrientNeverContradictsCgal) {
+  Rng rng(21);
+  const auto coordinate = [&rng](int min_exponent, int max_exponent) {
+    return std::ldexp(uniform(rng, -1, 1), int(integer(rng, min_exponent, max_exponent)));
+  };
+  std::size_t decided = 0, wrong = 0, total = 300'000 / kScale;
+  for (std::size_t i = 0; i < total; ++i) {
+    Vec3 a, b, c, d;
+    const double scale = std::ldexp(1.0, int(integer(rng, -1000, 1000)));
+    switch (i % 4) {
+      case 0:  // general position at one random scale, overflow and underflow included
+        for (Vec3* v : {&a, &b, &c, &d}) *v = uniform_point(rng, -1, 1) * scale;
+        break;
+      case 1:  // almost coplanar: the rounded d lies within rounding of the plane
+        for (Vec3* v : {&a, &b, &c}) *v = uniform_point(rng, -1, 1) * scale;
+        d = a + uniform(rng, -1, 2) * (b - a) + uniform(rng, -1, 2) * (c - a);
+        break;
+      case 2:  // every coordinate at its own magnitude; products stay mostly in range
+        for (Vec3* v : {&a, &b, &c, &d})
+          *v = Vec3{coordinate(-340, 340), coordinate(-340, 340), coordinate(-340, 340)};
+        break;
+      default:  // every coordinate at its own magnitude, subnormals and overflow included
+        for (Vec3* v : {&a, &b, &c, &d})
+          *v = Vec3{coordinate(-1074, 1023), coordinate(-1074, 1023), coordinate(-1074, 1023)};
+    }
+    const int filtered = tri_detail::certified_orient(a, b, c, d);
+    if (filtered == 0) continue;
+    ++decided;
+    wrong += filtered != cgal_orientation(a, b, c, d);
+  }
+  std::printf("[filter] orient3d samples=%zu decided=%zu wrong=%zu\n", total, decided, wrong);
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_GT(decided, total / 4);  // the filter is not vacuous
+}
+
+TEST(TriangleFilter, SubnormalProductDoesNotFakeASign) {
+  // n = (b - a) x (c - a) = (0, -s, s*s') where s*s' = 9 * 2^-1080 rounds to 0, and w_z = 2^60 scales that
+  // lost term above the other one: true sign +, naive double evaluation -3 * 2^-1022 with a tiny relative
+  // bound. The absolute underflow term must make the filter decline.
+  const double s = 3 * std::ldexp(1.0, -540);
+  const Vec3 a(0, 0, 0), b(s, 0, 0), c(0, s, 1), d(0, std::ldexp(1.0, -482), std::ldexp(1.0, 60));
+  ASSERT_EQ(cgal_orientation(a, b, c, d), 1);
+  EXPECT_NE(tri_detail::certified_orient(a, b, c, d), -1);
+}
+
+// ---- hand-written cases ----------------------------------------------------------------------------------
+
+const Vec3 kO(0, 0, 0), kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1);
+
+void expect_both(const TrianglePoints& p, const TrianglePoints& q, bool expected, const char* what) {
+  EXPECT_EQ(triangles_intersect_exact(p, q), expected) << what << " (exact)";
+  EXPECT_EQ(triangles_intersect(p, q), expected) << what << " (fast)";
+  EXPECT_EQ(triangles_intersect_fast(q, p), expected) << what << " (fast, swapped)";
+}
+
+TEST(TriangleHandCases, TouchingCountsAsIntersecting) {
+  const TrianglePoints p = {kO, kX, kY};
+  expect_both(p, {kO, kX, kZ}, true, "shared edge, perpendicular");
+  expect_both(p, {kX, kO, Vec3(0.5, -1, 0)}, true, "shared edge, coplanar, other side");
+  expect_both(p, {kO, Vec3(-1, 0, 0), Vec3(0, 0, 1)}, true, "shared vertex only");
+  expect_both(p, p, true, "identical");
+  expect_both(p, {Vec3(0.25, 0.25, 0), Vec3(0.25, 0.25, 1), Vec3(1, 1, 1)}, true, "vertex on face");
+  expect_both(p, {Vec3(0.5, 0.5, 0), Vec3(0.5, 0.5, 1), Vec3(1, 1, 1)}, true, "vertex on hypotenuse");
+  expect_both(p, {Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(3, 3, 0)}, true, "piercing");
+}
+
+TEST(TriangleHandCases, TinyGapsSeparate) {
+  const TrianglePoints p = {kO, kX, kY};
+  const Vec3 up(0, 0, 1e-300);
+  expect_both(p, translated(p, up), false, "parallel copy 1e-300 above");
+  expect_both(p, {Vec3(0.25, 0.25, 1e-300), Vec3(0.25, 0.25, 1), Vec3(1, 1, 1)}, false,
+              "vertex 1e-300 above the face");
+  expect_both(p, {Vec3(0.25, 0.25, -1e-300), Vec3(0.25, 0.25, 1), Vec3(1, 1, 1)}, true,
+              "vertex 1e-300 below the face: pierces");
+  const double gap = std::nextafter(1.0, 2.0) - 1.0;
+  expect_both(p, {Vec3(0.5 + gap, 0.5, -1), Vec3(0.5 + gap, 0.5, 1), Vec3(2, 2, 0)}, false,
+              "edge crossing one ulp beyond the hypotenuse");
+  expect_both(p, {Vec3(0.5, 0.5, -1), Vec3(0.5, 0.5, 1), Vec3(2, 2, 0)}, true,
+              "edge crossing the hypotenuse");
+}
+
+TEST(TriangleHandCases, ExtremeScales) {
+  for (const double scale : {1e-300, 1e-200, 1e200, 1e300}) {
+    const TrianglePoints p = scaled({kO, kX, kY}, scale);
+    expect_both(p, scaled({Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(3, 3, 0)}, scale), true,
+                "piercing, scaled");
+    expect_both(p, scaled({Vec3(0.7, 0.7, -1), Vec3(0.7, 0.7, 1), Vec3(3, 3, 0)}, scale), false,
+                "missing, scaled");
+  }
+}
+
+TEST(TriangleHandCases, DegenerateTriangles) {
+  const TrianglePoints p = {kO, kX, kY};
+  expect_both(p, {Vec3(1, 0, -1), Vec3(0.5, 0, -1), Vec3(0.25, 0.25, 0.5)}, true, "crossing triangle");
+  const TrianglePoints collinear = {Vec3(-1, 0.25, 0), Vec3(-2, 0.25, 0), Vec3(0.5, 0.25, 0)};
+  expect_both(p, collinear, true, "collinear, middle vertex first, reaching into the face");
+  const TrianglePoints collinear_out = {Vec3(-0.5, 0.25, 0), Vec3(-1, 0.25, 0), Vec3(-2, 0.25, 0)};
+  expect_both(p, collinear_out, false, "collinear, outside");
+  const TrianglePoints vertical = {Vec3(0.2, 0.2, 0), Vec3(0.2, 0.2, 3), Vec3(0.2, 0.2, 1)};
+  expect_both(p, vertical, true, "vertical segment ending on the face, middle vertex last");
+  expect_both(p, translated(vertical, Vec3(0, 0, 1e-300)), false, "vertical segment 1e-300 above");
+  expect_both(p, {Vec3(0.2, 0.2, 0), Vec3(0.2, 0.2, 0), Vec3(0.2, 0.2, 0)}, true, "point on face");
+  expect_both(p, {Vec3(0.2, 0.2, 1e-300), Vec3(0.2, 0.2, 1e-300), Vec3(0.2, 0.2, 1e-300)}, false,
+              "point off face");
+  const TrianglePoints s1 = {Vec3(0, 0, 0), Vec3(2, 2, 2), Vec3(1, 1, 1)};
+  expect_both(s1, {Vec3(0, 2, 0), Vec3(2, 0, 2), Vec3(0, 2, 0)}, true, "segments crossing at (1,1,1)");
+  expect_both(s1, {Vec3(0, 2, 0), Vec3(2, 0, 2.5), Vec3(0, 2, 0)}, false, "skew segments");
+  expect_both(s1, {Vec3(2, 2, 2), Vec3(3, 3, 3), Vec3(4, 4, 4)}, true, "collinear segments sharing an end");
+  expect_both(s1, {Vec3(2.5, 2.5, 2.5), Vec3(3, 3, 3), Vec3(4, 4, 4)}, false, "collinear segments apart");
+  expect_both(s1, {Vec3(1.5, 1.5, 1.5), Vec3(1.5, 1.5, 1.5), Vec3(1.5, 1.5, 1.5)}, true, "point on segment");
+  expect_both(s1, {Vec3(1.5, 1.5, 1.6), Vec3(1.5, 1.5, 1.6), Vec3(1.5, 1.5, 1.6)}, false,
+              "point off segment");
+  expect_both({kX, kX, kX}, {kX, kX, kX}, true, "equal points");
+  expect_both({kX, kX, kX}, {kY, kY, kY}, false, "different points");
+}
+
+TEST(TriangleHandCases, NonFiniteInputIsRejected) {
+  const TrianglePoints p = {kO, kX, kY};
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  EXPECT_THROW((void)triangles_intersect_exact(p, {kO, Vec3(nan, 0, 0), kZ}), std::invalid_argument);
+  EXPECT_THROW((void)triangles_intersect(p, {kO, Vec3(nan, 0, 0), kZ}), std::invalid_argument);
+  EXPECT_THROW((void)triangles_intersect({Vec3(inf, 0, 0), kX, kY}, p), std::invalid_argument);
+  EXPECT_THROW((void)triangles_intersect_fast({Vec3(5, 5, 5), Vec3(6, 5, 5), Vec3(5, 5, inf)}, p),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace bvhlab
