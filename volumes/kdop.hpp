@@ -139,13 +139,17 @@ struct Tables {
 /// Bvh computes it for every node at build time.
 template <std::size_t Axes>
 double clipped_box_volume(const std::array<Vec3, 2 * Axes>& normals,
-                          const std::array<double, 2 * Axes>& offsets, const Box& box) {
+                          const std::array<double, 2 * Axes>& world_offsets, const Box& world_box) {
   struct Face {
     std::size_t plane, begin, count;
   };
-  const double scale =
-      box.extent().maxCoeff() + box.min.cwiseAbs().maxCoeff() + box.max.cwiseAbs().maxCoeff();
-  const double tol = 1e-12 * scale;
+  // Work about the box's centre: sum d_m * area_m cancels badly for a small polytope far from the origin.
+  const Vec3 center = world_box.center();
+  const Box box{world_box.min - center, world_box.max - center};
+  std::array<double, 2 * Axes> offsets;
+  for (std::size_t m = 0; m < 2 * Axes; ++m) offsets[m] = world_offsets[m] - normals[m].dot(center);
+  const double tol = 1e-12 * (world_box.extent().maxCoeff() + world_box.min.cwiseAbs().maxCoeff() +
+                              world_box.max.cwiseAbs().maxCoeff());
   // Scratch reused across calls (Bvh calls this once per node).
   thread_local std::vector<Vec3> points, next_points, cap;
   thread_local std::vector<Face> faces, next_faces;

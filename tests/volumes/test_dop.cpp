@@ -1,0 +1,244 @@
+// k-DOP specifics: Zachmann's re-alignment bound against the exact support of the transformed DOP, the
+// prototype's non-simple vertices, the volume against an independent vertex enumeration, split directions.
+// Also OBB and sphere properties that hold by construction of their fits.
+#include "volume_models.hpp"
+
+#include <gtest/gtest.h>
+
+#include <iostream>
+#include <numbers>
+
+namespace bvhlab::volume_tests {
+namespace {
+
+/// Every vertex of {x : n_m . x <= d_m}, by brute force over plane triples (reference, O(k^4)).
+template <std::size_t Planes>
+std::vector<Vec3> polytope_vertices(const std::array<Vec3, Planes>& normals,
+                                    const std::array<double, Planes>& d) {
+  std::vector<Vec3> out;
+  for (std::size_t i = 0; i < Planes; ++i)
+    for (std::size_t j = i + 1; j < Planes; ++j)
+      for (std::size_t l = j + 1; l < Planes; ++l) {
+        Mat3 m;
+        m << normals[i].transpose(), normals[j].transpose(), normals[l].transpose();
+        if (std::abs(m.determinant()) < 1e-9) continue;
+        const Vec3 x = m.partialPivLu().solve(Vec3(d[i], d[j], d[l]));
+        bool feasible = true;
+        for (std::size_t k = 0; k < Planes && feasible; ++k)
+          feasible = normals[k].dot(x) <= d[k] + 1e-10 * (1 + std::abs(d[k]));
+        if (feasible) out.push_back(x);
+      }
+  return out;
+}
+
+/// Volume from the vertices: sum over faces of d_m * area / 3, each face's vertices ordered by angle.
+template <std::size_t Planes>
+double reference_volume(const std::array<Vec3, Planes>& normals, std::array<double, Planes> d,
+                        const Vec3& center) {
+  for (std::size_t m = 0; m < Planes; ++m)
+    d[m] -= normals[m].dot(center);  // about the centre: no cancellation
+  const auto vertices = polytope_vertices(normals, d);
+  double volume = 0;
+  for (std::size_t m = 0; m < Planes; ++m) {
+    const Vec3 e1 = normals[m].unitOrthogonal(), e2 = normals[m].cross(e1);
+    std::vector<Eigen::Vector2d> face;
+    for (const Vec3& x : vertices)
+      if (std::abs(normals[m].dot(x) - d[m]) < 1e-9) face.emplace_back(e1.dot(x), e2.dot(x));
+    if (face.size() < 3) continue;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& p : face) mean += p;
+    mean /= double(face.size());
+    std::sort(face.begin(), face.end(), [&](const auto& a, const auto& b) {
+      return std::atan2(a.y() - mean.y(), a.x() - mean.x()) < std::atan2(b.y() - mean.y(), b.x() - mean.x());
+    });
+    double twice_area = 0;
+    for (std::size_t k = 0; k < face.size(); ++k) {
+      const auto& p = face[k];
+      const auto& q = face[(k + 1) % face.size()];
+      twice_area += p.x() * q.y() - p.y() * q.x();
+    }
+    volume += d[m] * std::abs(twice_area) / 6;
+  }
+  return volume;
+}
+
+template <class BV>
+class DopTest : public ::testing::Test {};
+using DopModels = ::testing::Types<Dop<6>, Dop<14>, Dop<18>, Dop<26>, Dop24>;
+TYPED_TEST_SUITE(DopTest, DopModels, ModelName);
+
+template <class BV>
+std::array<double, BV::kPlanes> offsets_of(const BV& v) {
+  std::array<double, BV::kPlanes> d;
+  for (std::size_t m = 0; m < BV::kPlanes; ++m) d[m] = v.offsets[m];
+  return d;
+}
+
+TYPED_TEST(DopTest, RealignedSupportBoundsTheExactSupport) {
+  // For each plane of A, the context's bound on B's support must be >= the exact support of B's transformed
+  // DOP (its vertices mapped by the pose), and equal to it at the identity. Also reports the mean excess.
+  using BV = TypeParam;
+  const auto& normals = BV::tables().normals;
+  std::mt19937_64 rng(41);
+  double excess_sum = 0, width_sum = 0;
+  int checked = 0;
+  for (const PointSet& set : sample_point_sets(8)) {
+    const BV b = BV::fit(set.points);
+    const auto d = offsets_of(b);
+    const auto vertices = polytope_vertices(normals, d);
+    ASSERT_FALSE(vertices.empty()) << set.label;
+    const double scale = 1 + b.bounding_box().extent().norm() + b.bounding_box().max.cwiseAbs().maxCoeff();
+    for (int k = 0; k < 12; ++k) {
+      RigidTransform pose;
+      pose.rotation = k == 0 ? Mat3::Identity() : random_rotation(rng);
+      pose.translation = k % 2 ? gaussian_vec(rng) : Vec3::Zero();
+      const typename BV::PairContext c = BV::make_context(pose);
+      for (std::size_t m = 0; m < BV::kPlanes; ++m) {
+        double exact = -std::numeric_limits<double>::infinity();
+        for (const Vec3& x : vertices) exact = std::max(exact, normals[m].dot(pose.apply(x)));
+        const double shift = m < BV::kAxes ? c.axis_shift[m] : -c.axis_shift[m - BV::kAxes];
+        double bound = shift;
+        for (int j = 0; j < 3; ++j) {
+          ASSERT_GE(c.coefficients[m][j], -1e-12) << "coefficient outside the normal cone";
+          bound += c.coefficients[m][j] * d[c.planes[m][j]];
+        }
+        ASSERT_GE(bound, exact - 1e-9 * scale) << set.label << ", pose " << k << ", plane " << m;
+        if (k == 0) {
+          // At the identity the bound is B's own offset (which float rounding may leave a hair off the
+          // polytope, so compare with the offset, not the vertex support).
+          ASSERT_NEAR(bound, d[m], 1e-12 * scale) << set.label << ": identity must be exact";
+        }
+        excess_sum += bound - exact;
+        ++checked;
+      }
+      width_sum += b.bounding_box().extent().sum() / 3 * BV::kPlanes;
+    }
+  }
+  std::cout << BV::name() << ": mean support over-estimate / mean width = " << excess_sum / width_sum
+            << " over " << checked << " plane bounds\n";
+  ::testing::Test::RecordProperty("support_overestimate_ratio", std::to_string(excess_sum / width_sum));
+}
+
+TYPED_TEST(DopTest, VolumeMatchesVertexEnumeration) {
+  using BV = TypeParam;
+  for (const PointSet& set : sample_point_sets(9)) {
+    const BV v = BV::fit(set.points);
+    const double reference =
+        std::clamp(reference_volume(BV::tables().normals, offsets_of(v), v.bounding_box().center()), 0.0,
+                   v.bounding_box().volume());
+    EXPECT_NEAR(v.volume(), reference, 1e-9 * (1 + v.bounding_box().volume())) << set.label;
+  }
+}
+
+TYPED_TEST(DopTest, KnownVolumes) {
+  using BV = TypeParam;
+  std::vector<Vec3> cube, octahedron;
+  for (int k = 0; k < 8; ++k) cube.emplace_back(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
+  for (int a = 0; a < 3; ++a)
+    for (int s : {-1, 1}) octahedron.push_back(s * Vec3::Unit(a));
+  // Offsets along diagonals are irrational, so float rounding widens them by ~1e-7 relative.
+  EXPECT_NEAR(BV::fit(cube).volume(), 8, 1e-12);
+  // Every set contains x, y, z; the 14- and 26-DOP contain all corner diagonals, so they fit the octahedron.
+  const double octahedron_volume = BV::fit(octahedron).volume();
+  if (BV::name() == "dop14" || BV::name() == "dop26") {
+    EXPECT_NEAR(octahedron_volume, 4.0 / 3.0, 1e-6);
+  } else if (BV::name() == "dop6") {
+    EXPECT_NEAR(octahedron_volume, 8, 1e-12);
+  }
+  EXPECT_GE(octahedron_volume, 4.0 / 3.0 - 1e-12);
+}
+
+TEST(DopRealignment, NonSimplePrototypeVerticesUseATripleWhoseConeHoldsTheDirection) {
+  // The four corner diagonals alone: the prototype is an octahedron, four planes meet at each vertex.
+  const dop_detail::DirectionSet<4> set{{{{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}}}};
+  const dop_detail::Tables<4> tables(set);
+  ASSERT_EQ(tables.vertices.size(), 6u);
+  for (const auto& v : tables.vertices) EXPECT_EQ(v.triples.size(), 4u);
+  std::mt19937_64 rng(43);
+  for (int k = 0; k < 2000; ++k) {
+    Vec3 v = gaussian_vec(rng).normalized();
+    if (k < 6) v = (k % 2 ? -1.0 : 1.0) * Vec3::Unit(k / 2);  // exactly at a vertex: every triple ties
+    std::array<std::uint8_t, 3> planes;
+    std::array<double, 3> lambda;
+    tables.realign(v, planes, lambda);
+    Vec3 combination = Vec3::Zero();
+    double prototype_support = -std::numeric_limits<double>::infinity();
+    for (const auto& vertex : tables.vertices)
+      prototype_support = std::max(prototype_support, v.dot(vertex.position));
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_GE(lambda[j], -1e-12) << "direction " << v.transpose();
+      combination += lambda[j] * tables.normals[planes[j]];
+    }
+    EXPECT_LT((combination - v).norm(), 1e-12);
+    EXPECT_NEAR(lambda[0] + lambda[1] + lambda[2], prototype_support, 1e-12);
+  }
+}
+
+TEST(DopSplitDirections, Dop24OffersItsAxesOthersTheCoordinateAxes) {
+  const auto dop24 = split_directions_of<Dop24>();
+  ASSERT_EQ(dop24.size(), 12u);
+  for (std::size_t i = 0; i < dop24.size(); ++i) {
+    EXPECT_NEAR(dop24[i].norm(), 1, 1e-15);
+    for (std::size_t j = 0; j < i; ++j)
+      EXPECT_LT(std::abs(dop24[i].dot(dop24[j])), 1 - 1e-6) << "parallel axes";
+  }
+  EXPECT_EQ(split_directions_of<Dop<26>>().size(), 3u);
+}
+
+TEST(DopStorage, BytesPerVolume) {
+  EXPECT_EQ(sizeof(Dop<6>), 24u);
+  EXPECT_EQ(sizeof(Dop<14>), 56u);
+  EXPECT_EQ(sizeof(Dop<18>), 72u);
+  EXPECT_EQ(sizeof(Dop<26>), 104u);
+  EXPECT_EQ(sizeof(Dop24), 96u);
+  EXPECT_EQ(sizeof(Obb), 40u);
+  EXPECT_EQ(sizeof(Sphere), 16u);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+
+TEST(ObbFit, NeverLargerThanTheAabbAndRecoversARotatedBox) {
+  for (const PointSet& set : sample_point_sets(10)) {
+    const Obb obb = Obb::fit(set.points);
+    const Aabb aabb = Aabb::fit(set.points);
+    // The coordinate frame is one of the fit's candidates; only float rounding and the widening by ~5e-7 of
+    // the size and 2^-24 of the position (which give flat sets a sliver of volume) differ.
+    const Box box = aabb.bounding_box();
+    const double size = box.extent().norm(), widening = 1e-6 * (size + box.max.cwiseAbs().maxCoeff()) + 1e-40;
+    const double sliver = 8 * (size + widening) * (size + widening) * widening;
+    EXPECT_LE(obb.volume(), aabb.volume() * (1 + 1e-5) + sliver) << set.label;
+  }
+  // Points filling a rotated box: PCA finds the box, so the OBB is close to its true volume.
+  std::mt19937_64 rng(47);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  for (int k = 0; k < 5; ++k) {
+    const Mat3 r = random_rotation(rng);
+    const Vec3 half(2, 0.5, 0.1), center = gaussian_vec(rng);
+    std::vector<Vec3> points;
+    for (int i = 0; i < 2000; ++i)
+      points.push_back(center + r * half.cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng))));
+    for (int c = 0; c < 8; ++c)  // the corners, so the true box is the tightest
+      points.push_back(center + r * half.cwiseProduct(Vec3(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1)));
+    const double true_volume = 8 * half.prod();
+    const Obb obb = Obb::fit(points);
+    // PCA of a sampled box is off by the sampling noise of the covariance: a few percent.
+    EXPECT_LT(obb.volume(), 1.15 * true_volume) << "pose " << k;
+    EXPECT_LT(obb.volume(), Aabb::fit(points).volume()) << "pose " << k;
+    EXPECT_GE(obb.volume(), true_volume * (1 - 1e-9));
+  }
+}
+
+TEST(SphereFit, WithinAFewPercentOfTheMinimalSphereForASymmetricCloud) {
+  std::mt19937_64 rng(53);
+  std::vector<Vec3> shell;
+  for (int i = 0; i < 3000; ++i) shell.push_back(Vec3(1, 2, 3) + 2 * gaussian_vec(rng).normalized());
+  const Sphere s = Sphere::fit(shell);
+  EXPECT_LT(s.radius, 2 * 1.05);
+  EXPECT_GE(s.radius, 2 * (1 - 1e-9));
+  // A far outlier: the sphere stays near the one on the diameter (here also the minimal one).
+  std::vector<Vec3> points = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(10, 10, 10)};
+  EXPECT_LE(Sphere::fit(points).radius, (Vec3(10, 10, 10).norm() / 2) * 1.01);
+}
+
+}  // namespace
+}  // namespace bvhlab::volume_tests
