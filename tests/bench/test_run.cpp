@@ -1,0 +1,372 @@
+// The scene runner: only what a scene names is built; the cache is used, and a damaged entry is rebuilt,
+// never trusted; the CSV keeps its schema; the report is written.
+#include "bench/core/tree_cache.hpp"
+#include "bench/report.hpp"
+#include "bench/run.hpp"
+#include "scene_fixtures.hpp"
+#include "support/generated_meshes.hpp"
+#include "volumes/aabb.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+
+namespace bvhlab {
+namespace {
+
+using testing::TempDir;
+
+class RunTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // Two interlocking-size tori: at the protocol's distances some poses collide and some do not.
+    testing::write_obj(testing::make_torus(0.7, 0.25, 24, 12), dir / "torus.obj");
+    options.cache_dir = dir / "cache";
+    options.log = [this](const std::string& m) { messages.push_back(m); };
+    options.threads = 2;
+    options.warmup_queries = 1;
+  }
+
+  Scene scene(const std::string& hierarchies, const std::string& strategies, const std::string& extra = "",
+              int steps = 24) {
+    const std::string text = R"({"name": "t", "objects": [{"mesh": "torus.obj"}], "hierarchies": )" +
+                             hierarchies + R"(, "strategies": )" + strategies +
+                             R"(, "workload": {"distances": [0.8, 1.2, 1.6], "steps": )" +
+                             std::to_string(steps) + R"(}, "report": {"cgal_sample": 8})" +
+                             (extra.empty() ? "" : ", " + extra) + "}";
+    return parse_scene(text, dir.path(), "t.json");
+  }
+  Scene adb_scene() {
+    return scene(R"([{"bv": "aabb"}])",
+                 R"([{"type": "exact"}, {"type": "adb", "p_min": [0.5, 0.9]},
+                     {"type": "time_critical", "p_min": 0.9, "budgets": [{"bv_tests": 8}]}])",
+                 R"("annotation": {"type": "adb", "grid": 2, "tau": 0.5})");
+  }
+
+  std::vector<std::filesystem::path> cache_files(const std::string& sub, const std::string& extension) const {
+    std::vector<std::filesystem::path> out;
+    if (!std::filesystem::exists(dir / "cache" / sub)) return out;
+    for (const auto& e : std::filesystem::directory_iterator(dir / "cache" / sub)) {
+      const std::string name = e.path().filename().string();
+      if (name.size() >= extension.size() &&
+          name.compare(name.size() - extension.size(), extension.size(), extension) == 0)
+        out.push_back(e.path());
+    }
+    return out;
+  }
+
+  TempDir dir;
+  RunOptions options;
+  std::vector<std::string> messages;
+};
+
+// The answers of a run, for comparing two runs: time columns differ run to run, answers must not.
+std::vector<std::tuple<std::string, std::string, double, double, double, double>> answers(
+    const RunOutput& run) {
+  std::vector<std::tuple<std::string, std::string, double, double, double, double>> out;
+  for (const auto& r : run.rows)
+    out.emplace_back(r.hierarchy, r.strategy, r.p_min, r.distance, r.fp_rate,
+                     r.fn_rate + r.truth_colliding_rate);
+  return out;
+}
+
+TEST_F(RunTest, ExactAabbSceneNeverAnnotatesNorBuildsFcl) {
+  const RunOutput run = run_scene(scene(R"([{"bv": "aabb"}])", R"([{"type": "exact"}])"), options);
+  EXPECT_EQ(run.stats.trees_built, 1u);  // A and B are copies of one object: one tree
+  EXPECT_EQ(run.stats.trees_annotated, 0u);
+  EXPECT_EQ(run.stats.annotation_clip_calls, 0u);
+  EXPECT_EQ(run.stats.fcl_models_built, 0u);
+  ASSERT_EQ(run.models.size(), 1u);
+  EXPECT_EQ(run.models[0].annotation, "none");
+  for (const auto& r : run.rows) EXPECT_EQ(r.annotation, "none");
+  // The exact strategy agrees with the ground truth, which agrees with CGAL.
+  EXPECT_EQ(run.stats.cgal_checked, 8u);
+  EXPECT_EQ(run.stats.cgal_mismatches, 0u);
+  for (const auto& r : run.rows) {
+    EXPECT_EQ(r.fp_rate, 0.0);
+    EXPECT_EQ(r.fn_rate, 0.0);
+  }
+}
+
+TEST_F(RunTest, AnnotationRunsOnlyWhereAStrategyNeedsIt) {
+  const RunOutput run =
+      run_scene(scene(R"([{"bv": "aabb"}, {"bv": "dop24"}])",
+                      R"([{"type": "exact"}, {"type": "adb", "p_min": [0.9], "hierarchies": ["aabb"]}])",
+                      R"("annotation": {"type": "adb", "grid": 2, "tau": 0.5})"),
+                options);
+  EXPECT_EQ(run.stats.trees_annotated, 1u);  // aabb only; the dop24 tree runs exact and stays bare
+  EXPECT_GT(run.stats.annotation_clip_calls, 0u);
+  EXPECT_EQ(run.stats.trees_built, 2u);
+  for (const auto& m : run.models) {
+    if (m.hierarchy == "dop24") EXPECT_EQ(m.annotation, "none");
+  }
+  EXPECT_EQ(run.stats.fcl_models_built, 0u);
+}
+
+#ifdef BVHLAB_HAVE_FCL
+TEST_F(RunTest, FclModelsAreBuiltOnlyWhenAsked) {
+  const RunOutput run = run_scene(scene(R"([{"bv": "fcl_obbrss"}])", R"([{"type": "exact"}])"), options);
+  EXPECT_EQ(run.stats.fcl_models_built, 1u);
+  EXPECT_EQ(run.stats.trees_annotated, 0u);
+  // The truth still comes from bvhlab's exact traversal (an AABB tree), and FCL agrees with it.
+  for (const auto& r : run.rows) {
+    EXPECT_EQ(r.fp_rate, 0.0) << r.distance;
+    EXPECT_EQ(r.fn_rate, 0.0) << r.distance;
+  }
+}
+#endif
+
+TEST_F(RunTest, SecondRunComesFromTheCache) {
+  const RunOutput first = run_scene(adb_scene(), options);
+  EXPECT_EQ(first.stats.trees_annotated, 1u);
+  EXPECT_EQ(first.stats.truth_computed, 1u);
+  EXPECT_GT(first.stats.tree_cache_stored, 0u);
+  EXPECT_FALSE(cache_files("trees", ".tree").empty());
+  EXPECT_EQ(cache_files("truth", ".truth").size(), 1u);
+
+  const RunOutput second = run_scene(adb_scene(), options);
+  EXPECT_EQ(second.stats.trees_built, 0u);
+  EXPECT_EQ(second.stats.trees_annotated, 0u);
+  EXPECT_EQ(second.stats.tree_cache_hits, 1u);  // the annotated tree; its bare parent is not even looked at
+  EXPECT_EQ(second.stats.tree_cache_rejected, 0u);
+  EXPECT_EQ(second.stats.truth_computed, 0u);
+  EXPECT_EQ(second.stats.truth_cache_hits, 1u);
+  EXPECT_EQ(answers(first), answers(second));
+  ASSERT_FALSE(second.models.empty());
+  EXPECT_TRUE(second.models.back().from_cache);
+  EXPECT_GT(second.models.back().annotate_seconds, 0.0);  // the cost measured when it was made
+}
+
+TEST_F(RunTest, CorruptOrStaleCacheEntriesAreRebuiltNotTrusted) {
+  const RunOutput first = run_scene(adb_scene(), options);
+
+  // Flip one byte in the middle of every cached tree: checksum mismatch.
+  for (const auto& file : cache_files("trees", ".tree")) {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    const auto size = std::filesystem::file_size(file);
+    f.seekg(static_cast<std::streamoff>(size / 2));
+    char c = 0;
+    f.read(&c, 1);
+    f.seekp(static_cast<std::streamoff>(size / 2));
+    c = static_cast<char>(c ^ 0x5a);
+    f.write(&c, 1);
+  }
+  // Truncate the ground truth.
+  for (const auto& file : cache_files("truth", ".truth")) std::filesystem::resize_file(file, 20);
+
+  messages.clear();
+  const RunOutput second = run_scene(adb_scene(), options);
+  EXPECT_GE(second.stats.tree_cache_rejected, 1u);
+  EXPECT_EQ(second.stats.trees_annotated, 1u);
+  EXPECT_EQ(second.stats.truth_cache_rejected, 1u);
+  EXPECT_EQ(second.stats.truth_computed, 1u);
+  EXPECT_EQ(answers(first), answers(second));
+  EXPECT_TRUE(std::any_of(messages.begin(), messages.end(),
+                          [](const std::string& m) { return m.find("rejected") != std::string::npos; }));
+
+  // The rebuilt entries were written back: a third run hits again.
+  const RunOutput third = run_scene(adb_scene(), options);
+  EXPECT_EQ(third.stats.tree_cache_rejected, 0u);
+  EXPECT_EQ(third.stats.trees_annotated, 0u);
+  EXPECT_EQ(third.stats.truth_cache_hits, 1u);
+
+  // A meta file naming another key (a stale entry) is rejected too.
+  for (const auto& file : cache_files("trees", ".meta.json")) {
+    auto meta = nlohmann::json::parse(testing::read_text(file));
+    meta["key"] = meta["key"].get<std::string>() + "|something else";
+    testing::write_text(file, meta.dump());
+  }
+  const RunOutput fourth = run_scene(adb_scene(), options);
+  EXPECT_GE(fourth.stats.tree_cache_rejected, 1u);
+  EXPECT_EQ(fourth.stats.trees_annotated, 1u);
+  EXPECT_EQ(answers(first), answers(fourth));
+}
+
+TEST_F(RunTest, AnEntryWithAValidChecksumButWrongGeometryIsRejected) {
+  // A tree whose payload is intact but whose leaf volumes do not contain the mesh: only the structural check
+  // against the mesh can catch it (e.g. an entry made for another mesh under a colliding key).
+  const Mesh mesh = testing::make_torus(0.7, 0.25, 24, 12);
+  const Bvh<Aabb> good = Bvh<Aabb>::build(mesh);
+  std::vector<Aabb> shrunk = good.volumes();
+  for (auto& v : shrunk) v = Aabb::fit(std::vector<Vec3>{Vec3::Zero()});
+  const Tree<Aabb, NoDensity> bad{Bvh<Aabb>::from_parts(good.nodes(), shrunk, good.triangle_ids()), {}};
+  TreeCache cache(dir / "cache", [this](const std::string& m) { messages.push_back(m); });
+  cache.store("key", bad, {});
+  EXPECT_FALSE((cache.load<Aabb, NoDensity>("key", mesh).has_value()));
+  EXPECT_EQ(cache.counts().rejected, 1u);
+  // The same entry with the right volumes loads, with its polygons re-attached.
+  cache.store("key", Tree<Aabb, NoDensity>{good, {}}, {});
+  const auto loaded = cache.load<Aabb, NoDensity>("key", mesh);
+  ASSERT_TRUE(loaded.has_value());
+  EXPECT_TRUE(loaded->bvh.has_polygons());
+  EXPECT_EQ(loaded->bvh.triangles().size(), mesh.triangle_count());
+  // A tree for a mesh with other triangle counts is refused.
+  const Mesh other = testing::make_torus(0.7, 0.25, 20, 12);
+  EXPECT_FALSE((cache.load<Aabb, NoDensity>("key", other).has_value()));
+}
+
+TEST_F(RunTest, CsvSchemaAndRates) {
+  const Scene s = adb_scene();
+  const RunOutput run = run_scene(s, options);
+  write_results_csv(run, dir / "out" / "results.csv");
+  write_calibration_csv(run, dir / "out" / "calibration.csv");
+  write_results_json(run, dir / "out" / "results.json");
+
+  const auto csv = testing::read_csv(dir / "out" / "results.csv");
+  ASSERT_FALSE(csv.empty());
+  // The schema is a contract with plot_report.py and with users' scripts: spelled out here, not copied.
+  const std::vector<std::string> header{"mesh",
+                                        "hierarchy",
+                                        "bv",
+                                        "annotation",
+                                        "strategy",
+                                        "p_min",
+                                        "budget",
+                                        "distance",
+                                        "queries",
+                                        "truth_colliding_rate",
+                                        "answer_colliding_rate",
+                                        "mean_time_us",
+                                        "max_time_us",
+                                        "fp_rate",
+                                        "fn_rate",
+                                        "inexact_rate",
+                                        "budget_exhausted_rate",
+                                        "bv_tests_per_query",
+                                        "triangle_tests_per_query",
+                                        "nodes_visited_per_query",
+                                        "model_bytes",
+                                        "bytes_per_triangle",
+                                        "machine",
+                                        "compiler",
+                                        "build_type",
+                                        "git_commit"};
+  EXPECT_EQ(csv[0], header);
+  // 1 pair x 1 hierarchy x (exact + 2 p_min + 1 budget) x 3 distances.
+  ASSERT_EQ(csv.size(), 1u + 4 * 3);
+  auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  std::map<std::string, int> per_strategy;
+  for (std::size_t i = 1; i < csv.size(); ++i) {
+    const auto& row = csv[i];
+    ASSERT_EQ(row.size(), header.size()) << "row " << i;
+    EXPECT_EQ(row[column("mesh")], "torus");
+    EXPECT_EQ(row[column("queries")], "24");
+    for (const char* rate : {"fp_rate", "fn_rate", "truth_colliding_rate", "answer_colliding_rate",
+                             "inexact_rate", "budget_exhausted_rate"}) {
+      const double v = std::stod(row[column(rate)]);
+      EXPECT_GE(v, 0.0) << rate;
+      EXPECT_LE(v, 1.0) << rate;
+    }
+    EXPECT_GT(std::stod(row[column("mean_time_us")]), 0.0);
+    EXPECT_GE(std::stod(row[column("max_time_us")]), std::stod(row[column("mean_time_us")]));
+    const std::string strategy = row[column("strategy")];
+    ++per_strategy[strategy];
+    if (strategy == "exact") {
+      EXPECT_EQ(row[column("p_min")], "");
+      EXPECT_EQ(std::stod(row[column("fp_rate")]), 0.0);
+      EXPECT_EQ(std::stod(row[column("fn_rate")]), 0.0);
+    } else {
+      EXPECT_NE(row[column("p_min")], "");
+    }
+    if (strategy == "time_critical") {
+      EXPECT_EQ(row[column("budget")], "bv_tests=8");
+      EXPECT_LE(std::stod(row[column("bv_tests_per_query")]), 8.0);
+    }
+    EXPECT_EQ(row[column("build_type")], run.environment.build_type);
+    EXPECT_FALSE(row[column("git_commit")].empty());
+  }
+  EXPECT_EQ(per_strategy["exact"], 3);
+  EXPECT_EQ(per_strategy["adb"], 6);
+  EXPECT_EQ(per_strategy["time_critical"], 3);
+  // The protocol's colliding fraction falls with distance for two tori.
+  EXPECT_GE(run.truth.front().colliding, run.truth.back().colliding);
+
+  // Calibration: 10 bins per ADB-type series, all answers accounted for.
+  const auto cal = testing::read_csv(dir / "out" / "calibration.csv");
+  ASSERT_EQ(cal.size(), 1u + 3 * 10);
+  std::map<std::string, long> answers_per_series;
+  for (std::size_t i = 1; i < cal.size(); ++i)
+    answers_per_series[cal[i][2] + cal[i][3] + cal[i][4]] += std::stol(cal[i][7]);
+  for (const auto& [series, n] : answers_per_series) EXPECT_EQ(n, 3 * 24) << series;
+
+  const auto json = nlohmann::json::parse(testing::read_text(dir / "out" / "results.json"));
+  EXPECT_EQ(json["rows"].size(), 12u);
+  EXPECT_EQ(json["stats"]["trees_annotated"], 1);
+  EXPECT_EQ(json["environment"]["build_type"], run.environment.build_type);
+}
+
+TEST_F(RunTest, PoseFileWorkloadAndPairsOfDifferentObjects) {
+  testing::write_obj(testing::make_random_soup(200, 0.1, 5), dir / "soup.obj");
+  testing::write_text(dir / "poses.json", R"({"poses": [
+      {"translation": [0, 0, 0], "group": 0}, {"translation": [0.3, 0, 0], "group": 0},
+      {"translation": [5, 0, 0], "group": 5}]})");
+  const Scene s = parse_scene(R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "soup.obj", "scale": 0.5}],
+      "pairs": [["torus", "soup"]], "hierarchies": [{"bv": "aabb"}], "strategies": [{"type": "exact"}],
+      "workload": {"type": "poses", "file": "poses.json"}, "report": {"cgal_sample": 3}})",
+                              dir.path(), "p.json");
+  const RunOutput run = run_scene(s, options);
+  ASSERT_EQ(run.rows.size(), 2u);
+  EXPECT_EQ(run.rows[0].mesh, "torus|soup");
+  EXPECT_EQ(run.rows[0].queries, 2u);
+  EXPECT_EQ(run.rows[1].truth_colliding_rate, 0.0);  // 5 apart: nothing touches
+  EXPECT_EQ(run.stats.trees_built, 2u);
+  EXPECT_EQ(run.stats.cgal_mismatches, 0u);
+}
+
+TEST_F(RunTest, MissingOptionalObjectIsSkippedWithAMessage) {
+  const Scene s =
+      parse_scene(R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "absent.stl", "optional": true}],
+      "hierarchies": [{"bv": "aabb"}], "strategies": [{"type": "exact"}],
+      "workload": {"distances": [1.0], "steps": 4}})",
+                  dir.path(), "o.json");
+  const RunOutput run = run_scene(s, options);
+  EXPECT_EQ(run.rows.size(), 1u);
+  ASSERT_EQ(run.stats.skipped.size(), 1u);
+  EXPECT_NE(run.stats.skipped[0].find("absent.stl"), std::string::npos);
+}
+
+TEST_F(RunTest, ReportReadmeStatesTheOperatingPoint) {
+  const Scene s =
+      scene(R"([{"bv": "aabb"}, {"bv": "dop24"}])",
+            R"([{"type": "exact"}, {"type": "adb", "p_min": [0.5, 0.9], "hierarchies": ["aabb"]}])",
+            R"("annotation": {"type": "adb", "grid": 2, "tau": 0.5})");
+  const RunOutput run = run_scene(s, options);
+  const auto points = operating_points(run);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_EQ(points[0].adb.hierarchy, "aabb");
+  EXPECT_DOUBLE_EQ(points[0].adb.p_min, 0.9);
+  EXPECT_EQ(points[0].baseline.hierarchy, "dop24");
+  EXPECT_NEAR(points[0].speedup, points[0].baseline.mean_time_us / points[0].adb.mean_time_us, 1e-12);
+  // Summaries weight distances by queries; only 1.2 and 1.6 lie in the default range [1.2, 2].
+  EXPECT_EQ(points[0].adb.queries, 2u * 24);
+
+  ReportOptions no_figures;
+  no_figures.figures = false;
+  const ReportFiles files = write_report(run, dir / "report", no_figures);
+  const std::string readme = testing::read_text(files.readme);
+  EXPECT_NE(readme.find("## Result at the operating point"), std::string::npos);
+  EXPECT_NE(readme.find("ADB on `aabb` with p_min = 0.9"), std::string::npos) << readme;
+  EXPECT_NE(readme.find("exact `dop24`"), std::string::npos);
+  for (const auto& f : report_figures()) EXPECT_NE(readme.find(f.file), std::string::npos) << f.file;
+  EXPECT_TRUE(std::filesystem::is_regular_file(files.results_csv));
+  EXPECT_TRUE(std::filesystem::is_regular_file(files.results_json));
+}
+
+TEST_F(RunTest, PlotScriptDrawsAllFiveFigures) {
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0 &&
+      std::system("python3 -c 'import matplotlib' >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "no Python with matplotlib";
+  const RunOutput run = run_scene(adb_scene(), options);
+  const ReportFiles files = write_report(run, dir / "report");
+  EXPECT_EQ(files.plot_error, "");
+  ASSERT_EQ(files.figures.size(), 5u);
+  for (const auto& f : files.figures) EXPECT_GT(std::filesystem::file_size(f), 10'000u) << f;
+}
+
+}  // namespace
+}  // namespace bvhlab

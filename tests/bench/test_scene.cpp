@@ -1,0 +1,247 @@
+// Scene files: a full scene parses into what it says; every bad field is refused with its JSON path.
+#include "bench/core/scene.hpp"
+#include "scene_fixtures.hpp"
+#include "support/generated_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+namespace bvhlab {
+namespace {
+
+using testing::TempDir;
+
+class SceneTest : public ::testing::Test {
+ protected:
+  void SetUp() override { testing::write_obj(testing::make_torus(0.7, 0.25, 12, 8), dir / "torus.obj"); }
+
+  Scene parse(const std::string& text) { return parse_scene(text, dir.path(), "test.json"); }
+
+  /// Parses `text`, expects a SceneError, and returns its message.
+  std::string error_of(const std::string& text) {
+    try {
+      parse(text);
+    } catch (const SceneError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no SceneError for: " << text;
+    return {};
+  }
+
+  TempDir dir;
+};
+
+// A minimal valid scene with one replaceable part, so each error case changes exactly one field.
+std::string scene_with(
+    const std::string& objects = R"([{"mesh": "torus.obj"}])",
+    const std::string& hierarchies = R"([{"bv": "aabb"}, {"bv": "dop24"}])",
+    const std::string& strategies = R"([{"type": "exact"}, {"type": "adb", "p_min": [0.5, 0.9]}])",
+    const std::string& extra = R"("annotation": {"type": "adb", "grid": 2, "tau": 0.5})") {
+  return R"({"objects": )" + objects + R"(, "hierarchies": )" + hierarchies + R"(, "strategies": )" +
+         strategies + (extra.empty() ? "" : ", " + extra) + "}";
+}
+
+TEST_F(SceneTest, ParsesWhatTheFileSays) {
+  const Scene scene = parse(R"({
+    "name": "t",
+    "objects": [{"mesh": "torus.obj", "name": "ring", "scale": 0.5,
+                 "placement": {"translation": [1, 2, 3], "axis_angle_deg": [0, 0, 1, 90]}},
+                {"mesh": "torus.obj", "name": "other", "normalize": false}],
+    "pairs": [["ring", "other"]],
+    "hierarchies": [{"bv": "aabb", "split": "median", "max_leaf_triangles": 4}, {"bv": "dop24", "name": "dop"}],
+    "annotation": {"type": "adb", "grid": 3, "tau": 0.25},
+    "strategies": [{"type": "exact"}, {"type": "guided_exact", "hierarchies": ["aabb"]},
+                   {"type": "adb", "p_min": [0.5, 0.8, 0.95], "hierarchies": ["aabb"]},
+                   {"type": "time_critical", "p_min": 0.7, "budgets": [{"bv_tests": 10}, {"deadline_us": 5.5}],
+                    "hierarchies": ["aabb"]}],
+    "workload": {"type": "protocol", "distances": [0.5, 1.5], "steps": 7},
+    "report": {"quality_distances": [1.0, 1.5], "cgal_sample": 3, "operating_point": {"p_min": 0.8},
+               "baseline": {"hierarchy": "dop", "strategy": "exact"}}})");
+  EXPECT_EQ(scene.name, "t");
+  ASSERT_EQ(scene.objects.size(), 2u);
+  EXPECT_EQ(scene.objects[0].name, "ring");
+  EXPECT_DOUBLE_EQ(scene.objects[0].scale, 0.5);
+  EXPECT_TRUE(scene.objects[0].placement.translation.isApprox(Vec3(1, 2, 3)));
+  EXPECT_TRUE(scene.objects[0].placement.apply(Vec3(1, 0, 0)).isApprox(Vec3(1, 3, 3), 1e-12));
+  EXPECT_FALSE(scene.objects[1].normalize);
+  EXPECT_EQ(scene.objects[0].path, std::filesystem::absolute(dir / "torus.obj").lexically_normal());
+  ASSERT_EQ(scene.pairs.size(), 1u);
+  EXPECT_EQ(scene.pairs[0].label(), "ring|other");
+  ASSERT_EQ(scene.hierarchies.size(), 2u);
+  EXPECT_EQ(scene.hierarchies[0].build.split, SplitMethod::Median);
+  EXPECT_EQ(scene.hierarchies[0].build.max_leaf_triangles, 4u);
+  EXPECT_EQ(scene.hierarchies[1].name, "dop");
+  EXPECT_TRUE(scene.annotation.adb);
+  EXPECT_EQ(scene.annotation.grid, 3);
+  EXPECT_DOUBLE_EQ(scene.annotation.tau, 0.25);
+  // Only the hierarchy an annotated strategy runs on is annotated.
+  EXPECT_TRUE(scene.needs_annotation(scene.hierarchies[0]));
+  EXPECT_FALSE(scene.needs_annotation(scene.hierarchies[1]));
+  ASSERT_EQ(scene.strategies.size(), 4u);
+  EXPECT_EQ(expand(scene.strategies[2]).size(), 3u);
+  const auto budgets = expand(scene.strategies[3]);
+  ASSERT_EQ(budgets.size(), 2u);
+  EXPECT_EQ(budgets[0].budget.max_bv_tests, 10u);
+  EXPECT_DOUBLE_EQ(budgets[1].budget.deadline_us, 5.5);
+  EXPECT_DOUBLE_EQ(budgets[1].p_min, 0.7);
+  EXPECT_EQ(budgets[0].budget_label(), "bv_tests=10");
+  ASSERT_EQ(scene.workload.groups.size(), 2u);
+  EXPECT_DOUBLE_EQ(scene.workload.groups[1].distance, 1.5);
+  EXPECT_EQ(scene.workload.groups[1].poses.size(), 7u);
+  EXPECT_EQ(scene.report.cgal_sample, 3);
+  EXPECT_EQ(scene.report.operating_hierarchy, "aabb");
+  EXPECT_DOUBLE_EQ(scene.report.operating_p_min, 0.8);
+  EXPECT_EQ(scene.report.baseline_hierarchy, "dop");
+}
+
+TEST_F(SceneTest, DefaultsFollowTheProtocol) {
+  const Scene scene = parse(scene_with());
+  ASSERT_EQ(scene.pairs.size(), 1u);
+  EXPECT_EQ(scene.pairs[0].a, "torus");
+  EXPECT_EQ(scene.pairs[0].b, "torus");
+  EXPECT_EQ(scene.workload.steps, 5000);
+  EXPECT_EQ(scene.workload.groups.size(), 9u);
+  EXPECT_EQ(scene.report.baseline_hierarchy, "dop24");  // the paper's baseline when present
+  EXPECT_DOUBLE_EQ(scene.report.operating_p_min, 0.9);  // the largest p_min <= 0.9
+  EXPECT_TRUE(scene.needs_annotation(scene.hierarchies[1]));
+}
+
+TEST_F(SceneTest, ExactOnlySceneNeedsNoAnnotation) {
+  const Scene scene =
+      parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])", ""));
+  EXPECT_FALSE(scene.annotation.adb);
+  EXPECT_FALSE(scene.needs_annotation(scene.hierarchies[0]));
+}
+
+struct BadField {
+  std::string scene;
+  std::string expected;  // a substring of the error: the JSON path and what was expected
+};
+
+TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
+  const std::vector<BadField> cases = {
+      {"{", "test.json: not valid JSON"},
+      {"[1]", "test.json: /: expected an object"},
+      {R"({"hierarchies": [{"bv": "aabb"}], "strategies": [{"type": "exact"}]})", "/objects: missing"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}, {"bv": "abb"}])"),
+       "/hierarchies/1/bv: expected one of aabb, "},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb", "spilt": "sah"}])"),
+       "/hierarchies/0/spilt: unknown field; expected one of bv, name, split"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb", "split": "fast"}])"),
+       "/hierarchies/0/split: expected one of sah, median; got \"fast\""},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}, {"bv": "aabb"}])"),
+       "/hierarchies/1/bv: duplicate hierarchy name \"aabb\""},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb", "max_leaf_triangles": 0}])"),
+       "/hierarchies/0/max_leaf_triangles: expected an integer in [1, 255]; got 0"},
+      {scene_with(R"([{"mesh": "nope.obj"}])"), "/objects/0/mesh: mesh \"nope.obj\" not found"},
+      {scene_with(R"([{"mesh": "torus.obj", "scale": -2}])"), "/objects/0/scale: expected a number in [0, "},
+      {scene_with(R"([{"mesh": "torus.obj", "placement": {"rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 2]]}}])"),
+       "/objects/0/placement/rotation: not a rotation"},
+      {scene_with(R"([{"mesh": "torus.obj", "placement": {"translation": [1, 2]}}])"),
+       "/objects/0/placement/translation: expected an array of 3 numbers"},
+      {scene_with(R"([{"mesh": "torus.obj"}, {"mesh": "torus.obj"}])"),
+       "/objects/1/mesh: duplicate object name"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("pairs": [["torus", "ring"]])"),
+       "/pairs/0/1: no object named \"ring\""},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                  R"([{"type": "adb", "p_min": [0.5, 1.5]}])"),
+       "/strategies/0/p_min/1: expected a number in [0, 1]; got 1.5"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "adb", "p_min": 0.9}])",
+                  ""),
+       "/strategies/0/type: \"adb\" needs the ADB annotation"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "fastest"}])"),
+       "/strategies/0/type: expected one of exact, guided_exact, adb, time_critical"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                  R"([{"type": "time_critical", "budgets": [{}]}])"),
+       "/strategies/0/budgets/0: expected \"bv_tests\" and/or \"deadline_us\""},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                  R"([{"type": "exact", "hierarchies": ["dop24"]}])", ""),
+       "/strategies/0/hierarchies/0: expected one of aabb; got \"dop24\""},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])"),
+       "/annotation: an ADB annotation is set but no strategy uses it"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "adb", "p_min": 0.9}])",
+                  R"("annotation": {"type": "adb", "grid": 7})"),
+       "/annotation/grid: expected an integer in [2, 4]; got 7"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("workload": {"type": "protocol", "steps": 0})"),
+       "/workload/steps: expected an integer in [1, 10000000]; got 0"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("workload": {"distances": [1, "far"]})"),
+       "/workload/distances/1: expected a number; got \"far\""},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("workload": {"type": "poses", "file": "missing.json"})"),
+       "/workload/file: "},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "adb", "p_min": 0.9}])",
+                  R"("annotation": {"type": "adb"}, "report": {"operating_point": {"p_min": 0.5}})"),
+       "/report/operating_point/p_min: no \"adb\" strategy runs this p_min"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("report": {"quality_distances": [2, 1]})"),
+       "/report/quality_distances: expected [min, max] with min <= max"},
+  };
+  for (const auto& c : cases) {
+    const std::string message = error_of(c.scene);
+    EXPECT_NE(message.find(c.expected), std::string::npos)
+        << "scene: " << c.scene << "\nerror: " << message << "\nexpected to contain: " << c.expected;
+  }
+}
+
+TEST_F(SceneTest, PoseFileErrorsNameTheFileAndThePath) {
+  testing::write_text(dir / "poses.json",
+                      R"({"poses": [{"translation": [1, 0, 0]}, {"translation": [1, 0]}]})");
+  const std::string message =
+      error_of(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                          R"("workload": {"type": "poses", "file": "poses.json"})"));
+  EXPECT_NE(message.find("/workload/file: "), std::string::npos) << message;
+  EXPECT_NE(message.find("poses.json: /poses/1/translation: expected an array of 3 numbers"),
+            std::string::npos)
+      << message;
+}
+
+TEST_F(SceneTest, PoseFileGroupsByDistance) {
+  testing::write_text(dir / "poses.json", R"({"poses": [
+      {"translation": [1, 0, 0], "group": 1.0},
+      {"translation": [0, 2, 0]},
+      {"translation": [1, 0, 0.1], "axis_angle_deg": [0, 1, 0, 45], "group": 1.0},
+      {"translation": [0, 0, 0], "rotation": [[0, -1, 0], [1, 0, 0], [0, 0, 1]], "group": 0.5}]})");
+  const Scene scene =
+      parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                       R"("workload": {"type": "poses", "file": "poses.json"})"));
+  const auto& groups = scene.workload.groups;
+  ASSERT_EQ(groups.size(), 3u);
+  EXPECT_DOUBLE_EQ(groups[0].distance, 0.5);
+  EXPECT_DOUBLE_EQ(groups[1].distance, 1.0);
+  EXPECT_EQ(groups[1].poses.size(), 2u);
+  EXPECT_DOUBLE_EQ(groups[2].distance, 2.0);  // no group: the translation's length
+  EXPECT_TRUE(
+      groups[0].poses[0].rotation.isApprox(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix()));
+  EXPECT_NE(scene.workload.identity.find("poses:"), std::string::npos);
+}
+
+TEST_F(SceneTest, OptionalPartsAreSkippedWithANote) {
+  const Scene scene =
+      parse(scene_with(R"([{"mesh": "torus.obj"}, {"mesh": "absent.stl", "optional": true}])",
+                       R"([{"bv": "aabb"}, {"bv": "not_a_volume", "optional": true}])",
+                       R"([{"type": "exact"}, {"type": "exact", "hierarchies": ["not_a_volume"]}])", ""));
+  ASSERT_EQ(scene.objects.size(), 2u);
+  EXPECT_TRUE(scene.objects[1].path.empty());
+  ASSERT_EQ(scene.hierarchies.size(), 1u);
+  EXPECT_EQ(scene.strategies.size(), 1u);
+  ASSERT_EQ(scene.notes.size(), 2u);
+  EXPECT_NE(scene.notes[0].find("not_a_volume"), std::string::npos);
+}
+
+TEST_F(SceneTest, ShippedScenesParse) {
+  const char* source = std::getenv("BVHLAB_SOURCE_DIR");
+  ASSERT_NE(source, nullptr) << "run through ctest, which sets BVHLAB_SOURCE_DIR";
+  int parsed = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::filesystem::path(source) / "bench" / "scenes")) {
+    if (entry.path().extension() != ".json" || entry.path().filename() == "example_poses.json") continue;
+    EXPECT_NO_THROW(load_scene(entry.path())) << entry.path();
+    ++parsed;
+  }
+  EXPECT_GE(parsed, 4);
+}
+
+}  // namespace
+}  // namespace bvhlab
