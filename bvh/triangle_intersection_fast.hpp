@@ -23,53 +23,58 @@ enum class FilteredVerdict : signed char { disjoint, intersecting, undecided };
 namespace tri_detail {
 
 // orient(a, b, c, d) := det[b - a, c - a, d - a] = n . w with n = (b - a) x (c - a), w = d - a.
+// Evaluated as written below; the bound is Shewchuk-style (relative to the permanent), derived here for
+// exactly this evaluation order. eps = 2^-53, round to nearest.
 //
-// Error bound (eps = 2^-53, round to nearest; the three differences are rounded as well):
-// every one of the 6 monomials u_i v_j w_k of the determinant passes through at most 8 roundings
-// (3 differences, the inner product, the 2x2 subtraction, the outer product, two additions), so
-// |det_computed - det| <= ((1 + eps)^8 - 1) * P with P = sum of |monomials| of the exact differences.
-// The permanent is computed from the rounded differences with at most 5 monotone roundings of
-// non-negative values, and |exact difference| <= |rounded| / (1 - eps), so P <= perm / (1 - eps)^8.
-// Two more roundings evaluate the bound itself. Hence kRelativeBound = 8 eps (1 + 16 eps) >=
-// ((1 + eps)^8 - 1) / (1 - eps)^10, exactly representable (2^-50 + 2^-99).
+// Rounding: each of the 6 monomials u_i v_j w_k of det passes through at most 8 roundings (the three
+// differences are rounded too, then the inner product, the 2x2 subtraction, the outer product, two
+// additions), so |det_computed - det| <= ((1 + eps)^8 - 1) P, P = sum of |monomials| of the exact
+// differences. |exact difference| <= |rounded| / (1 - eps) and the permanent below takes at most 6 monotone
+// roundings of non-negative values, so P <= perm / (1 - eps)^9; two more round the bound itself. Hence
+// kRelativeBound = 8 eps (1 + 16 eps) >= ((1 + eps)^8 - 1) / (1 - eps)^11, exactly 2^-50 + 2^-99.
 //
-// Underflow breaks the relative model: a subnormal product carries an absolute error <= 2^-1075, and the
-// six inner ones are then multiplied by |w_i|. Sums and differences with subnormal results are exact.
-// Their total is <= 2^-1074 (|w_x| + |w_y| + |w_z| + 1.5)(1 + 10 eps); kAbsoluteUnit (|w|_1 + 2) covers
-// it with a factor ~4 to spare, including the rounding of the bound's own evaluation.
+// Underflow (the relative model fails for subnormal results): a subnormal product has an absolute error
+// <= 2^-1075; additions with subnormal results are exact. The six inner products' errors are scaled by |w_i|,
+// the three outer ones are not: total <= 2^-1074 (|w|_1 (1 + 5 eps) + 1.5 (1 + 2 eps)). kUnderflowGuard is
+// added to each inner magnitude sum and contributes kRelativeBound * 2^-600 |w_i| per axis, far above
+// 2^-1074 |w_i| (where |w_i| 2^-600 itself underflows, that axis needs less than 2^-1490); kUnderflowFloor
+// adds kRelativeBound * 2^-1018 = 2^-1068 for the constant part and for rounding the bound itself.
+// Both constants are normal numbers on purpose: subnormal operands or results cost ~100 cycles on x86, and
+// 2^-600 keeps |w_i| abs_i normal even for axis-aligned triangles (where an inner sum is exactly zero).
+// The price: triangles smaller than ~1e-95 (so n is below ~2^-650) are always left to CGAL.
 //
-// Overflow and NaN need no test: every intermediate of perm dominates the matching one of det in
-// magnitude, so any overflow makes perm (and the bound) inf or NaN, and the comparisons below are false
-// for inf/NaN bounds: the sign is then "unproven". (This relies on IEEE semantics: do not build with
-// -ffast-math / -ffinite-math-only. FMA contraction is harmless: it only removes roundings.)
+// Overflow and NaN need no test: every intermediate of perm dominates the matching one of det in magnitude,
+// so any overflow or NaN makes perm, hence the bound, inf or NaN, and then both comparisons are false: the
+// sign is "unproven". (This needs IEEE semantics: no -ffast-math / -ffinite-math-only. FMA contraction is
+// harmless: it only removes roundings.)
 inline constexpr double kRelativeBound = 0x1p-50 + 0x1p-99;
-inline constexpr double kAbsoluteUnit = 0x1p-1072;
+inline constexpr double kUnderflowGuard = 0x1p-600;
+inline constexpr double kUnderflowFloor = 0x1p-1018;
 
 // The oriented plane through a, b, c with the magnitudes needed for the error bound.
 struct FilteredPlane {
-  const Vec3* origin;
+  double ox, oy, oz;           // a
   double nx, ny, nz;           // rounded (b - a) x (c - a)
-  double abs_x, abs_y, abs_z;  // |u_y v_z| + |u_z v_y| etc., the permanent's inner sums
+  double abs_x, abs_y, abs_z;  // |u_y v_z| + |u_z v_y| + kUnderflowGuard etc.
 
-  FilteredPlane(const Vec3& a, const Vec3& b, const Vec3& c) : origin(&a) {
-    const double ux = b.x() - a.x(), uy = b.y() - a.y(), uz = b.z() - a.z();
-    const double vx = c.x() - a.x(), vy = c.y() - a.y(), vz = c.z() - a.z();
+  FilteredPlane(const Vec3& a, const Vec3& b, const Vec3& c) : ox(a.x()), oy(a.y()), oz(a.z()) {
+    const double ux = b.x() - ox, uy = b.y() - oy, uz = b.z() - oz;
+    const double vx = c.x() - ox, vy = c.y() - oy, vz = c.z() - oz;
     const double yz = uy * vz, zy = uz * vy, zx = uz * vx, xz = ux * vz, xy = ux * vy, yx = uy * vx;
     nx = yz - zy;
     ny = zx - xz;
     nz = xy - yx;
-    abs_x = std::fabs(yz) + std::fabs(zy);
-    abs_y = std::fabs(zx) + std::fabs(xz);
-    abs_z = std::fabs(xy) + std::fabs(yx);
+    abs_x = (std::fabs(yz) + std::fabs(zy)) + kUnderflowGuard;
+    abs_y = (std::fabs(zx) + std::fabs(xz)) + kUnderflowGuard;
+    abs_z = (std::fabs(xy) + std::fabs(yx)) + kUnderflowGuard;
   }
 
   // +1 / -1 when sign(orient(a, b, c, d)) is proven, 0 when it is not (zero, near zero, NaN, overflow).
   [[nodiscard]] int certified_side(const Vec3& d) const {
-    const double wx = d.x() - origin->x(), wy = d.y() - origin->y(), wz = d.z() - origin->z();
+    const double wx = d.x() - ox, wy = d.y() - oy, wz = d.z() - oz;
     const double det = wx * nx + wy * ny + wz * nz;
-    const double awx = std::fabs(wx), awy = std::fabs(wy), awz = std::fabs(wz);
-    const double permanent = awx * abs_x + awy * abs_y + awz * abs_z;
-    const double bound = kRelativeBound * permanent + (awx + awy + awz + 2.0) * kAbsoluteUnit;
+    const double permanent = std::fabs(wx) * abs_x + std::fabs(wy) * abs_y + std::fabs(wz) * abs_z;
+    const double bound = kRelativeBound * (permanent + kUnderflowFloor);
     return static_cast<int>(det > bound) - static_cast<int>(det < -bound);
   }
 };

@@ -384,6 +384,20 @@ Pair near_degenerate(Rng& rng) {
   return {permuted(p, rng), base.q, std::nullopt};
 }
 
+// Triangles in axis planes (CAD-like): exact zeros inside the normal and many exact contacts.
+TrianglePoints axis_aligned_triangle(Rng& rng) {
+  const int axis = int(integer(rng, 0, 2));
+  const double level = double(integer(rng, 0, 8)) / 2;
+  TrianglePoints t;
+  do {
+    for (Vec3& v : t) {
+      v = uniform(rng, 0, 1) < 0.5 ? integer_point(rng, 0, 4) : uniform_point(rng, 0, 4);
+      v[axis] = level;
+    }
+  } while ((t[1] - t[0]).cross(t[2] - t[0]).isZero(0.0));
+  return t;
+}
+
 Generator rescaled(double scale, Vec3 offset) {
   return [scale, offset](Rng& rng) {
     const Pair base = general_pair(rng);
@@ -453,6 +467,12 @@ TEST(TriangleFamilies, DegenerateAgainstTriangle) {
 TEST(TriangleFamilies, DegenerateAgainstDegenerate) {
   check_family("degenerate_vs_degenerate", 14, 60'000, [](Rng& rng) {
     return Pair{degenerate_triangle(rng, 2), degenerate_triangle(rng, 2), std::nullopt};
+  });
+}
+
+TEST(TriangleFamilies, AxisAligned) {
+  check_family("axis_aligned", 20, 60'000, [](Rng& rng) {
+    return Pair{axis_aligned_triangle(rng), axis_aligned_triangle(rng), std::nullopt};
   });
 }
 
