@@ -25,6 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 DISTANCE_LABEL = "distance d of B's centre (model units; each model scaled to [-1, 1]³)"
 TIME_LABEL = "mean time per query (µs)"
+MIN_BIN_ANSWERS = 5  # calibration bins with fewer answers say nothing
 
 
 def read_csv(path):
@@ -148,9 +149,18 @@ def figure_errors_vs_distance(rows, args, out):
     cmap = plt.get_cmap("viridis")
     for col, mesh in enumerate(meshes):
         series_list = list(grouped([r for r in inexact if r["mesh"] == mesh]).values())
-        for i, series in enumerate(series_list):
+        adb_count = sum(1 for s in series_list if s[0]["strategy"] == "adb")
+        other_count = len(series_list) - adb_count
+        adb_index = other_index = 0
+        for series in series_list:
             first = series[0]
-            colour = cmap(i / max(1, len(series_list) - 1) * 0.9)
+            # ADB over p_min in viridis, time-critical budgets in warm colours: two families, told apart at a glance.
+            if first["strategy"] == "adb":
+                colour = cmap(adb_index / max(1, adb_count - 1) * 0.85)
+                adb_index += 1
+            else:
+                colour = plt.get_cmap("autumn")(other_index / max(1, other_count) * 0.7)
+                other_index += 1
             marker = "^" if first["strategy"] == "adb" else "D"
             label = f"{first['hierarchy']}: {series_label(first)}"
             d = [num(r["distance"]) for r in series]
@@ -217,7 +227,7 @@ def figure_calibration(calibration, args, out):
         ax.plot([0, 1], [0, 1], "--", color="grey", label="perfect calibration")
         series = grouped([c for c in calibration if c["mesh"] == mesh and c["strategy"] == "adb"])
         for i, (key, bins) in enumerate(series.items()):
-            used = [b for b in bins if int(b["count"]) > 0]
+            used = [b for b in bins if int(b["count"]) >= MIN_BIN_ANSWERS]
             if not used:
                 continue
             colour = cmap(i / max(1, len(series) - 1) * 0.9)
@@ -225,7 +235,7 @@ def figure_calibration(calibration, args, out):
             ys = [num(b["collision_frequency"]) for b in used]
             sizes = [12 + 60 * math.sqrt(int(b["count"]) / max(int(c["count"]) for c in used)) for b in used]
             first = bins[0]
-            ax.plot(xs, ys, "-", color=colour, alpha=0.6)
+            ax.plot(xs, ys, "-", color=colour, alpha=0.5, linewidth=1)
             ax.scatter(xs, ys, s=sizes, color=colour, label=f"{first['hierarchy']}: p_min={float(first['p_min']):g}")
         ax.set_xlim(-0.02, 1.02)
         ax.set_ylim(-0.02, 1.02)
@@ -237,7 +247,8 @@ def figure_calibration(calibration, args, out):
         if not calibration:
             ax.text(0.5, 0.5, "no ADB answers", ha="center", transform=ax.transAxes)
     legend_below(fig, axes)
-    fig.suptitle("marker area grows with the number of answers in the bin", fontsize=9, color="grey")
+    fig.suptitle(f"marker area grows with the number of answers in the bin; bins with fewer than {MIN_BIN_ANSWERS} "
+                 "answers are left out", fontsize=9, color="grey")
     fig.savefig(out, dpi=110, bbox_inches="tight")
     plt.close(fig)
 

@@ -239,7 +239,9 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
        << " | " << micros(s.max_time_us) << " | " << percent(s.fp_rate) << " | " << percent(s.fn_rate)
        << " | " << count(s.bv_tests_per_query) << " | " << count(s.triangle_tests_per_query) << " | "
        << fmt("%.1f", s.bytes_per_triangle) << " |\n";
-  md << "\n";
+  md << "\nMaximum times include the odd preemption by the operating system (milliseconds on a shared "
+        "machine); "
+        "the mean is the robust figure. FCL exposes no work counters (n/a).\n\n";
 
   // Per-distance tables.
   std::vector<double> distances;

@@ -918,8 +918,9 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
           stats.queries += records.size();
           stats.query_seconds += sum_us * 1e-6;
           output.rows.push_back(row);
-          progress.advance(records.size(), label + " d=" + g17(group.distance).substr(0, 6) + " " + h.name +
-                                               " " + variant.label());
+          char distance[16];
+          std::snprintf(distance, sizeof distance, "%g", group.distance);
+          progress.advance(records.size(), label + " d=" + distance + " " + h.name + " " + variant.label());
         }
       }
     }
