@@ -3,7 +3,11 @@
 #pragma once
 
 #include "volumes/aabb.hpp"
+#include "volumes/dop24.hpp"
+#include "volumes/kdop.hpp"
+#include "volumes/obb.hpp"
 #include "volumes/restricted_box.hpp"
+#include "volumes/sphere.hpp"
 
 #include <optional>
 #include <stdexcept>
@@ -16,7 +20,8 @@ namespace bvhlab {
 template <class... Ts>
 struct TypeList {};
 
-using RegisteredVolumes = TypeList<Aabb, RestrictedBox>;
+using RegisteredVolumes =
+    TypeList<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop24, Dop<26>, Obb, Sphere, RestrictedBox>;
 
 /// Calls f(std::type_identity<BV>{}) for the BV whose name() is `name`; throws naming the choices.
 template <class F, class... BVs>
