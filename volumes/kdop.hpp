@@ -135,109 +135,114 @@ struct Tables {
 
 /// Lebesgue measure of {x : n_m . x <= d_m for all m}, where planes a and a + Axes (a < 3) are the
 /// bounding box's. Clips the box by the other planes one at a time (each face polygon clipped, the cut
-/// closed by a new face), then sums d_m * area(face m) / 3 (divergence theorem). About k^2 small steps:
-/// Bvh computes it for every node at build time.
+/// closed by a new face), then sums d_m * area(face m) / 3 (divergence theorem). Bvh computes it for every
+/// node at build time, so it works in fixed per-thread buffers: no allocation.
 template <std::size_t Axes>
 double clipped_box_volume(const std::array<Vec3, 2 * Axes>& normals,
                           const std::array<double, 2 * Axes>& world_offsets, const Box& world_box) {
+  constexpr std::size_t kPlanes = 2 * Axes;
+  // A face is a convex polygon; each clip adds at most one vertex to it, so it never has more than
+  // 4 + kPlanes vertices, and there are at most kPlanes faces.
+  constexpr std::size_t kMaxPoints = kPlanes * (kPlanes + 4);
   struct Face {
     std::size_t plane, begin, count;
   };
+  struct Scratch {
+    std::array<Vec3, kMaxPoints> points[2], cap;
+    std::array<double, kMaxPoints> distance;
+    std::array<std::pair<double, std::size_t>, kMaxPoints> order;
+    std::array<Face, kPlanes> faces[2];
+  };
+  thread_local Scratch scratch;
+  Scratch& s = scratch;
+
   // Work about the box's centre: sum d_m * area_m cancels badly for a small polytope far from the origin.
   const Vec3 center = world_box.center();
-  const Box box{world_box.min - center, world_box.max - center};
-  std::array<double, 2 * Axes> offsets;
-  for (std::size_t m = 0; m < 2 * Axes; ++m) offsets[m] = world_offsets[m] - normals[m].dot(center);
+  const Vec3 lo = world_box.min - center, hi = world_box.max - center;
+  std::array<double, kPlanes> offsets;
+  for (std::size_t m = 0; m < kPlanes; ++m) offsets[m] = world_offsets[m] - normals[m].dot(center);
   const double tol = 1e-12 * (world_box.extent().maxCoeff() + world_box.min.cwiseAbs().maxCoeff() +
                               world_box.max.cwiseAbs().maxCoeff());
-  // Scratch reused across calls (Bvh calls this once per node).
-  thread_local std::vector<Vec3> points, next_points, cap;
-  thread_local std::vector<Face> faces, next_faces;
-  thread_local std::vector<std::pair<double, std::size_t>> order;
-  thread_local std::vector<double> distances;
-  points.clear();
-  faces.clear();
+
+  int current = 0;
+  std::size_t point_count = 0, face_count = 0;
   // The box: for each axis a and side, the face's four corners in cyclic order.
   for (std::size_t a = 0; a < 3; ++a)
     for (int side = 0; side < 2; ++side) {
       const std::size_t b = (a + 1) % 3, c = (a + 2) % 3;
-      const double fixed = side == 0 ? box.max[a] : box.min[a];
-      const double uv[4][2] = {{box.min[b], box.min[c]},
-                               {box.max[b], box.min[c]},
-                               {box.max[b], box.max[c]},
-                               {box.min[b], box.max[c]}};
-      faces.push_back({side == 0 ? a : a + Axes, points.size(), 4});
+      const double uv[4][2] = {{lo[b], lo[c]}, {hi[b], lo[c]}, {hi[b], hi[c]}, {lo[b], hi[c]}};
+      s.faces[0][face_count++] = {side == 0 ? a : a + Axes, point_count, 4};
       for (const auto& corner : uv) {
-        Vec3 x;
-        x[a] = fixed;
+        Vec3& x = s.points[0][point_count++];
+        x[a] = side == 0 ? hi[a] : lo[a];
         x[b] = corner[0];
         x[c] = corner[1];
-        points.push_back(x);
       }
     }
-  for (std::size_t m = 3; m < 2 * Axes; ++m) {
+  for (std::size_t m = 3; m < kPlanes; ++m) {
     if (m >= Axes && m < Axes + 3) continue;  // the box's own planes
     const Vec3& n = normals[m];
-    const double d = offsets[m];
-    distances.resize(points.size());
+    const double offset = offsets[m];
+    const Vec3* points = s.points[current].data();
     double farthest = -std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      distances[k] = n.dot(points[k]) - d;
-      farthest = std::max(farthest, distances[k]);
+    for (std::size_t k = 0; k < point_count; ++k) {
+      s.distance[k] = n.dot(points[k]) - offset;
+      farthest = std::max(farthest, s.distance[k]);
     }
     if (farthest <= tol) continue;  // the plane does not cut
-    next_points.clear();
-    next_faces.clear();
-    cap.clear();
-    for (const Face& f : faces) {
-      const std::size_t begin = next_points.size();
-      for (std::size_t k = 0; k < f.count; ++k) {
-        const std::size_t i = f.begin + k, j = f.begin + (k + 1 == f.count ? 0 : k + 1);
-        const double dp = distances[i], dq = distances[j];
+    Vec3* next = s.points[1 - current].data();
+    Face* next_faces = s.faces[1 - current].data();
+    std::size_t next_count = 0, next_face_count = 0, cap_count = 0;
+    for (std::size_t f = 0; f < face_count; ++f) {
+      const Face& face = s.faces[current][f];
+      const std::size_t begin = next_count;
+      for (std::size_t k = 0; k < face.count; ++k) {
+        const std::size_t i = face.begin + k, j = face.begin + (k + 1 == face.count ? 0 : k + 1);
+        const double dp = s.distance[i], dq = s.distance[j];
         if (dp <= tol) {
-          next_points.push_back(points[i]);
-          if (dp >= -tol) cap.push_back(points[i]);
+          next[next_count++] = points[i];
+          if (dp >= -tol) s.cap[cap_count++] = points[i];
         }
         if ((dp < -tol && dq > tol) || (dp > tol && dq < -tol)) {
           const Vec3 x = points[i] + (points[j] - points[i]) * (dp / (dp - dq));
-          next_points.push_back(x);
-          cap.push_back(x);
+          next[next_count++] = x;
+          s.cap[cap_count++] = x;
         }
       }
-      if (next_points.size() - begin >= 3)
-        next_faces.push_back({f.plane, begin, next_points.size() - begin});
+      if (next_count - begin >= 3)
+        next_faces[next_face_count++] = {face.plane, begin, next_count - begin};
       else
-        next_points.resize(begin);
+        next_count = begin;
     }
-    if (cap.size() >= 3) {
+    if (cap_count >= 3 && next_count + cap_count <= kMaxPoints && next_face_count < kPlanes) {
       // The cut face: its points are on a convex polygon; order them by (pseudo-)angle about their mean.
       const Vec3 e1 = n.unitOrthogonal(), e2 = n.cross(e1);
       Vec3 mean = Vec3::Zero();
-      for (const Vec3& x : cap) mean += x;
-      mean /= double(cap.size());
-      order.clear();
-      for (std::size_t k = 0; k < cap.size(); ++k) {
-        const double u = e1.dot(cap[k] - mean), v = e2.dot(cap[k] - mean);
+      for (std::size_t k = 0; k < cap_count; ++k) mean += s.cap[k];
+      mean /= double(cap_count);
+      for (std::size_t k = 0; k < cap_count; ++k) {
+        const double u = e1.dot(s.cap[k] - mean), v = e2.dot(s.cap[k] - mean);
         // Monotone in the angle, without atan2: position on the unit diamond's perimeter, in [0, 4).
         const double r = std::abs(u) + std::abs(v);
         const double p = r > 0 ? v / r : 0;
-        order.push_back({u >= 0 ? (v >= 0 ? p : 4 + p) : 2 - p, k});
+        s.order[k] = {u >= 0 ? (v >= 0 ? p : 4 + p) : 2 - p, k};
       }
-      std::sort(order.begin(), order.end());
-      next_faces.push_back({m, next_points.size(), cap.size()});
-      for (const auto& [key, k] : order) next_points.push_back(cap[k]);
+      std::sort(s.order.begin(), s.order.begin() + cap_count);
+      next_faces[next_face_count++] = {m, next_count, cap_count};
+      for (std::size_t k = 0; k < cap_count; ++k) next[next_count++] = s.cap[s.order[k].second];
     }
-    std::swap(points, next_points);
-    std::swap(faces, next_faces);
-    if (faces.empty()) return 0;
+    current = 1 - current;
+    point_count = next_count;
+    face_count = next_face_count;
+    if (face_count == 0) return 0;
   }
   double volume = 0;
-  for (const Face& f : faces) {
+  for (std::size_t f = 0; f < face_count; ++f) {
+    const Face& face = s.faces[current][f];
+    const Vec3* p = s.points[current].data() + face.begin;
     Vec3 twice_area = Vec3::Zero();
-    const Vec3& origin = points[f.begin];
-    for (std::size_t k = 1; k + 1 < f.count; ++k)
-      twice_area += (points[f.begin + k] - origin).cross(points[f.begin + k + 1] - origin);
-    volume += offsets[f.plane] * std::abs(normals[f.plane].dot(twice_area)) / 6;
+    for (std::size_t k = 1; k + 1 < face.count; ++k) twice_area += (p[k] - p[0]).cross(p[k + 1] - p[0]);
+    volume += offsets[face.plane] * std::abs(normals[face.plane].dot(twice_area)) / 6;
   }
   return volume;
 }
