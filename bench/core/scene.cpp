@@ -1,5 +1,6 @@
 #include "bench/core/scene.hpp"
 
+#include "adb/annotate.hpp"
 #include "adb/lb_table.hpp"
 #include "bench/core/content_hash.hpp"
 #include "bench/core/mesh_catalog.hpp"
@@ -229,6 +230,16 @@ bool fcl_available() {
 }
 
 }  // namespace
+
+bool volume_supports_annotation(std::string_view bv) {
+  bool supported = false;
+  with_volume(bv, [&]<class BV>(std::type_identity<BV>) {
+    supported = requires(Bvh<BV> bvh, const AnnotateOptions& options) {
+      annotate<2>(std::move(bvh), options);
+    };
+  });
+  return supported;
+}
 
 std::vector<std::string> hierarchy_bv_names() {
   std::vector<std::string> names = volume_names();
@@ -490,6 +501,12 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
           "\"" + type +
           "\" needs the ADB annotation; add \"annotation\": {\"type\": \"adb\", \"grid\": 2, "
           "\"tau\": 0.5}");
+    if (spec.needs_annotation())
+      for (const auto& h : scene.hierarchies)
+        if (scene.applies(spec, h) && !volume_supports_annotation(h.bv))
+          s.fail("\"" + type + "\" needs ADB-annotated trees, and the annotation does not support \"" + h.bv +
+                 "\" (hierarchy \"" + h.name +
+                 "\"); list the hierarchies it should run on in \"hierarchies\"");
     const bool applies_somewhere =
         std::any_of(scene.hierarchies.begin(), scene.hierarchies.end(),
                     [&](const HierarchySpec& h) { return scene.applies(spec, h); });

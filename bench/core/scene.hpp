@@ -150,6 +150,10 @@ struct Scene {
 /// Names a scene may use for "bv": the registered volumes, then fcl_obb and fcl_obbrss.
 std::vector<std::string> hierarchy_bv_names();
 
+/// Whether the ADB annotation (adb/annotate.hpp) accepts trees of this registered BV; throws for unknown
+/// names.
+bool volume_supports_annotation(std::string_view bv);
+
 /// Parses and checks a scene. Relative paths resolve against `base_dir`. Throws SceneError.
 Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_dir,
                   std::string_view source_name = "<scene>");

@@ -1,4 +1,5 @@
 // Scene files: a full scene parses into what it says; every bad field is refused with its JSON path.
+#include "bench/core/registry.hpp"
 #include "bench/core/scene.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
@@ -182,6 +183,20 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
     const std::string message = error_of(c.scene);
     EXPECT_NE(message.find(c.expected), std::string::npos)
         << "scene: " << c.scene << "\nerror: " << message << "\nexpected to contain: " << c.expected;
+  }
+}
+
+TEST_F(SceneTest, AdbOnAVolumeTheAnnotationLacksIsRefusedAtParseTime) {
+  ASSERT_TRUE(volume_supports_annotation("aabb"));
+  for (const std::string& bv : volume_names()) {
+    const std::string text = scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": ")" + bv + R"("}])",
+                                        R"([{"type": "adb", "p_min": 0.9}])");
+    if (volume_supports_annotation(bv)) {
+      EXPECT_NO_THROW(parse(text)) << bv;
+    } else {
+      EXPECT_NE(error_of(text).find("/strategies/0: \"adb\" needs ADB-annotated trees"), std::string::npos)
+          << bv;
+    }
   }
 }
 
