@@ -88,14 +88,34 @@ def aggregate(rows, lo, hi):
     }
 
 
-def subplots(n, width=6.0, height=4.2, rows=1):
-    fig, axes = plt.subplots(rows, n, figsize=(width * n, height * rows), squeeze=False, constrained_layout=True)
-    return fig, axes
+def subplots(n, width=6.0, height=4.2, rows_per_mesh=1):
+    """A grid with at most two meshes side by side; returns the figure and, per mesh, its column of axes."""
+    columns = min(2, max(1, n))
+    mesh_rows = math.ceil(max(1, n) / columns)
+    fig, grid = plt.subplots(mesh_rows * rows_per_mesh, columns, figsize=(width * columns, height * mesh_rows * rows_per_mesh),
+                             squeeze=False, constrained_layout=True)
+    per_mesh = []
+    for i in range(max(1, n)):
+        r, c = divmod(i, columns)
+        per_mesh.append([grid[r * rows_per_mesh + k][c] for k in range(rows_per_mesh)])
+    for i in range(max(1, n), mesh_rows * columns):  # an odd number of meshes leaves one slot empty
+        r, c = divmod(i, columns)
+        for k in range(rows_per_mesh):
+            grid[r * rows_per_mesh + k][c].set_visible(False)
+    return fig, per_mesh, grid
+
+
+def floor_at_zero(ax):
+    """Rates cannot be negative: start the axis just below 0, in proportion to its range."""
+    top = ax.get_ylim()[1]
+    ax.set_ylim(bottom=-0.03 * max(top, 1e-9), top=top)
 
 
 def legend_below(fig, axes):
     handles, labels = [], []
     for ax in axes.flat:
+        if not ax.get_visible():
+            continue
         for h, l in zip(*ax.get_legend_handles_labels()):
             if l not in labels:
                 handles.append(h)
@@ -123,8 +143,8 @@ def is_operating(row, args):
 def figure_time_vs_distance(rows, args, out):
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
-    fig, axes = subplots(len(meshes))
-    for ax, mesh in zip(axes[0], meshes):
+    fig, per_mesh, axes = subplots(len(meshes))
+    for (ax,), mesh in zip(per_mesh, meshes):
         for key, series in grouped([r for r in rows if r["mesh"] == mesh]).items():
             first = series[0]
             if first["strategy"] not in ("exact", "guided_exact") and not is_operating(first, args):
@@ -145,9 +165,9 @@ def figure_time_vs_distance(rows, args, out):
 def figure_errors_vs_distance(rows, args, out):
     meshes = meshes_of(rows)
     inexact = [r for r in rows if r["strategy"] in ("adb", "time_critical")]
-    fig, axes = subplots(len(meshes), rows=2, height=3.6)
+    fig, per_mesh, axes = subplots(len(meshes), rows_per_mesh=2, height=3.6)
     cmap = plt.get_cmap("viridis")
-    for col, mesh in enumerate(meshes):
+    for (fp_ax, fn_ax), mesh in zip(per_mesh, meshes):
         series_list = list(grouped([r for r in inexact if r["mesh"] == mesh]).values())
         adb_count = sum(1 for s in series_list if s[0]["strategy"] == "adb")
         other_count = len(series_list) - adb_count
@@ -164,18 +184,17 @@ def figure_errors_vs_distance(rows, args, out):
             marker = "^" if first["strategy"] == "adb" else "D"
             label = f"{first['hierarchy']}: {series_label(first)}"
             d = [num(r["distance"]) for r in series]
-            axes[0][col].plot(d, [100 * num(r["fp_rate"]) for r in series], marker=marker, color=colour, label=label)
-            axes[1][col].plot(d, [100 * num(r["fn_rate"]) for r in series], marker=marker, color=colour, label=label)
-        axes[0][col].set_title(f"{mesh}: false positives")
-        axes[1][col].set_title(f"{mesh}: false negatives")
-        for row in (0, 1):
-            ax = axes[row][col]
+            fp_ax.plot(d, [100 * num(r["fp_rate"]) for r in series], marker=marker, color=colour, label=label)
+            fn_ax.plot(d, [100 * num(r["fn_rate"]) for r in series], marker=marker, color=colour, label=label)
+        fp_ax.set_title(f"{mesh}: false positives")
+        fn_ax.set_title(f"{mesh}: false negatives")
+        for ax, kind in ((fp_ax, "false-positive"), (fn_ax, "false-negative")):
             ax.set_xlabel(DISTANCE_LABEL, fontsize=9)
-            ax.set_ylabel(("false-positive" if row == 0 else "false-negative") + " rate (% of queries)")
-            ax.set_ylim(bottom=-1)
+            ax.set_ylabel(kind + " rate (% of queries)")
+            floor_at_zero(ax)
             ax.grid(True, alpha=0.3)
         if not series_list:
-            axes[0][col].text(0.5, 0.5, "no inexact strategy", ha="center", transform=axes[0][col].transAxes)
+            fp_ax.text(0.5, 0.5, "no inexact strategy", ha="center", transform=fp_ax.transAxes)
     legend_below(fig, axes)
     fig.savefig(out, dpi=110, bbox_inches="tight")
     plt.close(fig)
@@ -184,8 +203,8 @@ def figure_errors_vs_distance(rows, args, out):
 def figure_error_vs_time(rows, args, out):
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
-    fig, axes = subplots(len(meshes))
-    for ax, mesh in zip(axes[0], meshes):
+    fig, per_mesh, axes = subplots(len(meshes))
+    for (ax,), mesh in zip(per_mesh, meshes):
         groups = grouped([r for r in rows if r["mesh"] == mesh])
         curves = {}
         for key, series in groups.items():
@@ -212,7 +231,7 @@ def figure_error_vs_time(rows, args, out):
                      if args.quality_min > -1e299 else f"{mesh}: error vs time, all distances")
         ax.set_xlabel(TIME_LABEL + ", log scale")
         ax.set_ylabel("wrong answers (FP + FN, % of queries)")
-        ax.set_ylim(bottom=-1)
+        floor_at_zero(ax)
         ax.grid(True, which="both", alpha=0.3)
     legend_below(fig, axes)
     fig.savefig(out, dpi=110, bbox_inches="tight")
@@ -221,9 +240,9 @@ def figure_error_vs_time(rows, args, out):
 
 def figure_calibration(calibration, args, out):
     meshes = meshes_of(calibration) or ["(no ADB strategy)"]
-    fig, axes = subplots(len(meshes), width=5.2, height=4.6)
+    fig, per_mesh, axes = subplots(len(meshes), width=5.2, height=4.6)
     cmap = plt.get_cmap("viridis")
-    for ax, mesh in zip(axes[0], meshes):
+    for (ax,), mesh in zip(per_mesh, meshes):
         ax.plot([0, 1], [0, 1], "--", color="grey", label="perfect calibration")
         series = grouped([c for c in calibration if c["mesh"] == mesh and c["strategy"] == "adb"])
         for i, (key, bins) in enumerate(series.items()):
@@ -256,8 +275,8 @@ def figure_calibration(calibration, args, out):
 def figure_time_vs_size(rows, args, out):
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
-    fig, axes = subplots(len(meshes))
-    for ax, mesh in zip(axes[0], meshes):
+    fig, per_mesh, axes = subplots(len(meshes))
+    for (ax,), mesh in zip(per_mesh, meshes):
         for key, series in grouped([r for r in rows if r["mesh"] == mesh]).items():
             first = series[0]
             if first["strategy"] not in ("exact", "guided_exact") and not is_operating(first, args):
