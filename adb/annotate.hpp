@@ -1,0 +1,113 @@
+// ADB density annotation (ADB-METHOD.md section 1): for every node V, the number pc(V) of "possible
+// collision cells" among the g x g x g cells laid on V's bounding box.
+//
+// Definitions (the open points of the method, decided here)
+// - Grid: V's bounding box (BV::bounding_box(), so a non-box BV uses its bounding box), cut into g cells per
+//   axis. Cell boundaries are the doubles lo + (hi - lo) * i / g (clamped to hi; the last one is hi itself).
+// - Cells are CLOSED boxes. A polygon lying exactly in a face shared by two cells counts in full for both,
+//   one along an edge shared by four cells counts for all four: both neighbours' closures contain it, and an
+//   object touching it from either side collides with it, so counting it twice errs on the safe side
+//   (more possible collision cells, a higher estimate, fewer false negatives). Consequence: the cell areas of
+//   a triangle add up to its area unless the triangle lies in a cell plane. A node box that is flat in one
+//   axis has g identical layers, and a polygon in that plane counts in every layer (pc / g^3 is then the
+//   fraction of the flat box's cells that are full, as for a solid box).
+// - Threshold: a cell is a possible collision cell when the area A of V's triangles inside it satisfies
+//   A > 0 and A >= tau * F, where F = (ab + bc + ca) / 3 is the mean face area of a cell with sides
+//   a, b, c = extent / g (F = c^2 for cubic cells, matching the LB table's "fraction of c^2").
+// - Default tau = 0.5 (kDefaultAdbTau), one of the LB table's rows {0.25, 0.5, 0.75, 1}. Reason: for
+//   isotropic random planes hitting a cubic cell, the section area has mean 2/3 c^2 and a plane crosses
+//   1.5 A / c^2 cells on average (Crofton). Monte Carlo (2e5 planes) gives the fraction of crossed cells
+//   whose section reaches tau c^2 as 0.75 / 0.62 / 0.49 / 0.36 for tau = 0.25 / 0.5 / 0.75 / 1, i.e. a flat
+//   surface of area A gets 1.12 / 0.92 / 0.74 / 0.54 times A / c^2 possible collision cells. tau = 0.5 is
+//   the table value closest to "one possible collision cell per c^2 of surface" (the balls-into-bins
+//   model's reading of pc) while still ignoring cells a surface only nicks at a corner.
+//
+// Exactness ("exact where it matters": only the thresholded decision is stored)
+// - A triangle whose bounding box lies inside one closed cell contributes its whole area (no clipping).
+// - Otherwise it is clipped with CGAL::intersection(Triangle_3, Iso_cuboid_3) in the Epeck kernel: the
+// clipped
+//   polygon is exact (lazy), and its area is taken as the certified interval of the lazy approximation.
+// - Per cell the intervals are summed with a rigorous rounding bound and compared with a certified interval
+//   of tau * F. Only when the two intervals overlap (a tie or a near-tie, e.g. axis-aligned CAD faces) is the
+//   cell decided exactly: polygon areas as exact rationals squared (Simple_cartesian<Gmpq>), and
+//   sum sqrt(q_i) >= T decided with GMP/MPFR (an exact rational sum when every q_i is a perfect square;
+//   otherwise the sum is irrational, so it differs from the rational T and interval refinement ends).
+// - Degenerate (exactly collinear) triangles have area 0 and are skipped. A cell with area 0 never counts.
+#pragma once
+
+#include "adb/tree.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+namespace bvhlab {
+
+inline constexpr double kDefaultAdbTau = 0.5;
+
+struct AnnotateOptions {
+  double tau = kDefaultAdbTau;  ///< threshold as a fraction of the cell's mean face area; finite, > 0
+  unsigned threads = 0;         ///< 0: hardware concurrency
+  /// Called now and then with (triangle-node pairs processed, total pairs), from worker threads but never
+  /// concurrently, and once at the end with (total, total).
+  std::function<void(std::size_t, std::size_t)> progress;
+};
+
+/// What one annotation run did: the caller's evidence that annotation ran, and how it spent its time.
+struct AnnotateStats {
+  double seconds = 0;
+  unsigned threads = 0;
+  std::size_t nodes = 0;
+  std::size_t triangle_node_pairs = 0;  ///< sum over nodes of the node's triangle count
+  std::size_t fast_path_triangles = 0;  ///< pairs whose triangle lies inside one cell: no clipping
+  std::size_t clipped_triangles = 0;    ///< pairs that needed clipping
+  std::size_t clip_calls = 0;     ///< CGAL intersections (one per open candidate cell of a clipped pair)
+  std::size_t skipped_clips = 0;  ///< candidate cells already decided by area bounds: not clipped
+  std::size_t degenerate_triangles = 0;  ///< pairs skipped because the triangle has zero area
+  std::size_t exact_cells = 0;           ///< cells whose decision needed exact arithmetic (ties, near-ties)
+};
+
+struct CellCounts {
+  std::vector<std::uint8_t> counts;  ///< pc per node
+  AnnotateStats stats;
+};
+
+/// The annotation without templates: node i has box node_boxes[i] and the triangles
+/// triangles[node_ranges[i].first .. node_ranges[i].second) (tree order, bvh/topology.hpp
+/// node_triangle_ranges). grid in [1, 6] (g^3 must fit a byte).
+/// Throws std::invalid_argument for a bad grid or tau, mismatched sizes, a range outside `triangles`, or a
+/// node box that is empty or not finite while holding triangles.
+CellCounts annotate_counts(std::span<const Box> node_boxes,
+                           std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
+                           std::span<const TrianglePoints> triangles, int grid,
+                           const AnnotateOptions& options);
+
+/// Area of the part of `triangle` inside the closed box `cell` (CGAL clipping, Epeck), to double precision.
+/// 0 for degenerate triangles, boxes that miss the triangle, and empty boxes.
+double triangle_area_in_box(const TrianglePoints& triangle, const Box& cell);
+
+/// Annotates a built tree (which must still hold its polygons): pc(V) for every node, on V's bounding box.
+/// `stats`, when given, receives what the run did.
+template <int G, BoundingVolume BV>
+Tree<BV, AdbDensity<G>> annotate(Bvh<BV> bvh, const AnnotateOptions& options = {},
+                                 AnnotateStats* stats = nullptr) {
+  if (!bvh.has_polygons())
+    throw std::invalid_argument(
+        "annotate: the tree holds no polygons (a tree loaded without them cannot be annotated)");
+  std::vector<Box> boxes;
+  boxes.reserve(bvh.volumes().size());
+  for (const BV& volume : bvh.volumes()) boxes.push_back(volume.bounding_box());
+  const auto ranges = node_triangle_ranges(bvh.nodes());
+  CellCounts result = annotate_counts(boxes, ranges, bvh.triangles(), G, options);
+  if (stats) *stats = result.stats;
+  Tree<BV, AdbDensity<G>> tree{std::move(bvh), {}};
+  tree.density.possible_collision_cells = std::move(result.counts);
+  tree.density.tau = options.tau;
+  return tree;
+}
+
+}  // namespace bvhlab
