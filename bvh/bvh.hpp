@@ -76,7 +76,8 @@ class Bvh {
     }
     return boxes;
   }
-  /// Measure of node i's volume, cached: traversals descend into the larger of two nodes.
+  /// Volume of node i's bounding box, cached: traversals descend into the larger of two nodes. The box, not
+  /// the BV's own volume(), because a DOP's exact volume costs a polytope clipping per node.
   [[nodiscard]] float size(std::uint32_t i) const { return sizes_[i]; }
   /// Triangle vertices in tree order; empty for a tree loaded without polygons.
   [[nodiscard]] const std::vector<TrianglePoints>& triangles() const { return triangles_; }
@@ -168,10 +169,12 @@ class Bvh {
     sizes_.resize(volumes_.size());
     if constexpr (hierarchical) {
       if (!nodes_.empty() && volumes_.size() == nodes_.size())
-        for_each_decoded(
-            [&](std::uint32_t i, const Fitted& v) { sizes_[i] = static_cast<float>(v.volume()); });
+        for_each_decoded([&](std::uint32_t i, const Fitted& v) {
+          sizes_[i] = static_cast<float>(v.bounding_box().volume());
+        });
     } else {
-      for (std::size_t i = 0; i < volumes_.size(); ++i) sizes_[i] = static_cast<float>(volumes_[i].volume());
+      for (std::size_t i = 0; i < volumes_.size(); ++i)
+        sizes_[i] = static_cast<float>(volumes_[i].bounding_box().volume());
     }
   }
 

@@ -26,7 +26,10 @@ struct Aabb {
   }
   static Aabb fit(std::span<const Vec3> points) {
     Box box;
-    for (const auto& p : points) box.extend(p);
+    for (const auto& p : points) {
+      if (!p.allFinite()) throw std::invalid_argument("aabb::fit: a point has a NaN or infinite coordinate");
+      box.extend(p);
+    }
     return from_box(box);
   }
   static Aabb merge(const Aabb& a, const Aabb& b) {
@@ -46,8 +49,8 @@ struct Aabb {
     const Vec3 gap = (b_center - a_center).cwiseAbs() - a_half - b_half;
     // Slack for the rounding of these few operations, relative to the magnitudes involved.
     const Scalar slack = Scalar(16) * std::numeric_limits<Scalar>::epsilon() *
-                         (b_center.cwiseAbs().maxCoeff() + a_center.cwiseAbs().maxCoeff() + a_half.maxCoeff() +
-                          b_half.maxCoeff());
+                         (b_center.cwiseAbs().maxCoeff() + a_center.cwiseAbs().maxCoeff() +
+                          a_half.maxCoeff() + b_half.maxCoeff());
     return gap.maxCoeff() <= slack;
   }
 
