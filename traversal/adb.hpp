@@ -57,6 +57,12 @@ struct AdbOptions {
   /// independent) and answers "collision" once that exceeds p_min. When not set: the paper's literal
   /// rule, which drops each such pair. (A running product: no transcendental math.)
   bool combine_leaf_evidence = true;
+  /// A pair whose estimate exceeds p_min decides "collision" only if its children confirm it: their
+  /// combined estimate 1 - prod(1 - p_child) must exceed p_min too; otherwise the descent goes on. Coarse
+  /// pairs of dense nodes (every cell full) otherwise decide on the first test whenever their boxes overlap
+  /// widely. Costs at most four BV tests per decision. Leaf pairs have no children and decide directly.
+  /// When not set: the paper's literal rule.
+  bool confirm_with_children = false;
 
   /// Throws std::invalid_argument for nonsense values (NaN, outside [0, 1], negative deadline).
   void validate() const {
@@ -149,6 +155,7 @@ struct QueuedPair {
   std::uint32_t a, b;
   [[no_unique_address]] Working wa;
   [[no_unique_address]] Working wb;
+  bool candidate = false;  ///< its estimate exceeded p_min; awaiting confirmation by its children
   bool operator<(const QueuedPair& o) const { return probability < o.probability; }
 };
 
@@ -218,17 +225,21 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
   double best_dropped = 0;
   double no_contact_in_leaves = 1;  // prod(1 - p) over leaf pairs left below p_min
 
-  auto consider = [&](Pair e) -> bool {  // true: answer found
-    const double p = probability(e);
-    if (p < 0) return false;
+  auto is_leaf_pair = [&](const Pair& e) { return a.bvh.node(e.a).is_leaf() && b.bvh.node(e.b).is_leaf(); };
+  auto decide = [&](double p) {
+    result.collides = true;
+    result.exact = false;
+    result.probability = p;
+    return true;
+  };
+  // Files an evaluated pair: decide, queue (possibly as a candidate), or drop. True when decided.
+  auto admit = [&](Pair e, double p) -> bool {
+    if (p < 0) return false;  // volumes apart: provably no contact below
     if (!options.exact_leaves) {
       if (p > options.p_min) {
-        result.collides = true;
-        result.exact = false;
-        result.probability = p;
-        return true;
-      }
-      if (p <= 0) {
+        if (!options.confirm_with_children || is_leaf_pair(e)) return decide(p);
+        e.candidate = true;
+      } else if (p <= 0) {
         dropped_possible_contact = true;
         return false;
       }
@@ -257,8 +268,10 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
     return false;
   };
 
-  if (!may_test() || consider({0, 0, 0, Walker::root_a(a.bvh, context), Walker::root_b(b.bvh, context)}))
-    return finish_adb(result, queue, options, budget_hit, false, 0);
+  if (!may_test()) return finish_adb(result, queue, options, budget_hit, false, 0);
+  if (const Pair root{0, 0, 0, Walker::root_a(a.bvh, context), Walker::root_b(b.bvh, context)};
+      admit(root, probability(root)))
+    return result;
   std::uint64_t pops = 0;
   while (!queue.empty()) {
     if (budget.deadline_us > 0 && (++pops & 15) == 0 &&
@@ -287,12 +300,7 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
           no_contact_in_leaves *= 1 - top.probability;
           const double combined = 1 - no_contact_in_leaves;
           best_dropped = std::max(best_dropped, combined);
-          if (combined > options.p_min) {
-            result.collides = true;
-            result.exact = false;
-            result.probability = combined;
-            return result;
-          }
+          if (combined > options.p_min) return decide(combined), result;
         }
       }
       continue;
@@ -312,16 +320,27 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
         const std::uint32_t c = y ? nb.right() : nb.left();
         b_children[y] = {c, Walker::child_b(b.bvh, top.wb, c, context)};
       }
+    Pair children[4];
+    double estimates[4];
+    int count = 0;
+    double no_contact_in_children = 1;
     for (int x = 0; x < a_count; ++x)
       for (int y = 0; y < b_count; ++y) {
         if (!may_test()) {
           queue.push(top);  // the unexpanded pair keeps its estimate for the best-effort answer
           return finish_adb(result, queue, options, true, dropped_possible_contact, best_dropped);
         }
-        if (consider(
-                {0, a_children[x].first, b_children[y].first, a_children[x].second, b_children[y].second}))
-          return result;
+        children[count] = {0, a_children[x].first, b_children[y].first, a_children[x].second,
+                           b_children[y].second};
+        estimates[count] = probability(children[count]);
+        no_contact_in_children *= 1 - std::max(0.0, estimates[count]);
+        ++count;
       }
+    // A candidate is confirmed by its children's combined estimate, or demoted to a plain descent.
+    if (top.candidate && 1 - no_contact_in_children > options.p_min)
+      return decide(1 - no_contact_in_children), result;
+    for (int c = 0; c < count; ++c)
+      if (admit(children[c], estimates[c])) return result;
   }
   return finish_adb(result, queue, options, budget_hit, dropped_possible_contact, best_dropped);
 }

@@ -126,6 +126,21 @@ TEST(AdbTraversal, CombiningLeafEvidenceOnlyAddsCollisionsAndNeverCostsMore) {
   EXPECT_GT(changed, 0);  // the option must matter on this scene, or the test shows nothing
 }
 
+TEST(AdbTraversal, ConfirmationNeverDecidesOnASingleCoarsePair) {
+  const Scene scene;
+  AdbOptions confirm;
+  confirm.p_min = 0.0;  // every overlapping pair exceeds p_min: without confirmation the root decides
+  confirm.confirm_with_children = true;
+  const Result r = query_adb(scene.tree_a, scene.tree_a, RigidTransform::identity(), scene.model, confirm);
+  EXPECT_TRUE(r.collides);
+  EXPECT_GT(r.counters.bv_tests, 1u);  // the root's children were consulted
+  AdbOptions literal = confirm;
+  literal.confirm_with_children = false;
+  EXPECT_EQ(query_adb(scene.tree_a, scene.tree_a, RigidTransform::identity(), scene.model, literal)
+                .counters.bv_tests,
+            1u);
+}
+
 TEST(AdbTraversal, DisjointIsAnExactNo) {
   const Scene scene;
   const Result r =
