@@ -43,6 +43,7 @@ struct RunStats {
   double truth_seconds = 0;
   double query_seconds = 0;  ///< sum of the timed queries only
   double wall_seconds = 0;
+  double clock_overhead_us = 0;      ///< cost of an empty timed region, subtracted from every query time
   std::vector<std::string> skipped;  ///< objects or pairs left out, with the reason
 };
 
