@@ -90,17 +90,16 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
 /// 0 for degenerate triangles, boxes that miss the triangle, and empty boxes.
 double triangle_area_in_box(const TrianglePoints& triangle, const Box& cell);
 
-/// Annotates a built tree (which must still hold its polygons): pc(V) for every node, on V's bounding box.
-/// `stats`, when given, receives what the run did.
-template <int G, BoundingVolume BV>
+/// Annotates a built tree (which must still hold its polygons): pc(V) for every node, on V's bounding box
+/// (decoded top-down for volumes stored relative to their parent). `stats`, when given, receives what the
+/// run did.
+template <int G, TreeVolume BV>
 Tree<BV, AdbDensity<G>> annotate(Bvh<BV> bvh, const AnnotateOptions& options = {},
                                  AnnotateStats* stats = nullptr) {
   if (!bvh.has_polygons())
     throw std::invalid_argument(
         "annotate: the tree holds no polygons (a tree loaded without them cannot be annotated)");
-  std::vector<Box> boxes;
-  boxes.reserve(bvh.volumes().size());
-  for (const BV& volume : bvh.volumes()) boxes.push_back(volume.bounding_box());
+  const std::vector<Box> boxes = bvh.node_boxes();
   const auto ranges = node_triangle_ranges(bvh.nodes());
   CellCounts result = annotate_counts(boxes, ranges, bvh.triangles(), G, options);
   if (stats) *stats = result.stats;

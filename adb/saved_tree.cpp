@@ -1,0 +1,339 @@
+// Saved-tree format: encoding, validating decoder, atomic file writes. See adb/saved_tree.hpp.
+#include "adb/saved_tree.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+namespace bvhlab::saved_tree_detail {
+namespace {
+
+static_assert(sizeof(TreeNode) == 8 && std::is_trivially_copyable_v<TreeNode>);
+
+constexpr std::array<char, 8> kMagic = {'B', 'V', 'H', 'L', 'T', 'R', 'E', 'E'};
+constexpr std::uint32_t kByteOrderMark = 0x01020304;
+constexpr std::uint32_t kFlagTriangleIds = 1;
+constexpr std::size_t kNameField = 32;
+constexpr std::size_t kChecksumOffset = 120;
+
+// Header field offsets.
+constexpr std::size_t kVersionAt = 8, kByteOrderAt = 12, kHeaderSizeAt = 16, kFlagsAt = 20, kNameAt = 24,
+                      kVolumeSizeAt = 56, kRootSizeAt = 60, kGridAt = 64, kReserved0At = 68, kTauAt = 72,
+                      kNodesAt = 80, kTrianglesAt = 88, kPayloadAt = 96, kReserved1At = 104;
+
+[[noreturn]] void fail(std::string_view source, const std::string& problem) {
+  throw SavedTreeError("saved tree '" + std::string(source) + "': " + problem);
+}
+
+void put_le(std::byte* at, std::uint64_t value, int bytes) {
+  for (int i = 0; i < bytes; ++i) at[i] = static_cast<std::byte>((value >> (8 * i)) & 0xff);
+}
+std::uint64_t get_le(const std::byte* at, int bytes) {
+  std::uint64_t value = 0;
+  for (int i = 0; i < bytes; ++i) value |= std::uint64_t(std::to_integer<std::uint8_t>(at[i])) << (8 * i);
+  return value;
+}
+
+std::uint64_t checksum_of(std::span<const std::byte> file) {
+  const std::uint64_t head = fnv1a64(file.first(kChecksumOffset));
+  return fnv1a64(file.subspan(kSavedTreeHeaderSize), head);
+}
+
+/// a * b + c, or false on overflow.
+bool mul_add(std::uint64_t a, std::uint64_t b, std::uint64_t c, std::uint64_t& out) {
+  if (b != 0 && a > (std::numeric_limits<std::uint64_t>::max() - c) / b) return false;
+  out = a * b + c;
+  return true;
+}
+
+/// Structure checks shared by writer and reader; `problem` receives the first defect.
+bool valid_topology(std::span<const TreeNode> nodes, std::uint64_t triangle_count, std::string& problem) {
+  const std::size_t n = nodes.size();
+  if (n == 0) {
+    problem = "the tree has no nodes";
+    return false;
+  }
+  std::vector<std::uint8_t> parents(n, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const TreeNode& node = nodes[k];
+    if (node.is_leaf()) {
+      if (node.first > triangle_count || node.count > triangle_count - node.first) {
+        problem = "leaf " + std::to_string(k) + " covers triangles [" + std::to_string(node.first) + ", " +
+                  std::to_string(std::uint64_t{node.first} + node.count) + ") beyond the " +
+                  std::to_string(triangle_count) + " triangles";
+        return false;
+      }
+      continue;
+    }
+    if (node.first <= k || std::uint64_t{node.first} + 1 >= n) {
+      problem = "node " + std::to_string(k) + " has children " + std::to_string(node.first) + " and " +
+                std::to_string(std::uint64_t{node.first} + 1) +
+                (node.first <= k ? ", not stored after it (out of order)"
+                                 : ", out of range of the " + std::to_string(n) + " nodes");
+      return false;
+    }
+    for (const std::uint32_t child : {node.left(), node.right()})
+      if (++parents[child] > 1) {
+        problem = "node " + std::to_string(child) + " has more than one parent";
+        return false;
+      }
+  }
+  for (std::size_t k = 1; k < n; ++k)
+    if (parents[k] == 0) {
+      problem = "node " + std::to_string(k) + " is not reachable from the root";
+      return false;
+    }
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+  try {
+    ranges = node_triangle_ranges(nodes);
+  } catch (const std::exception& e) {
+    problem = e.what();
+    return false;
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    if (!nodes[k].is_leaf() && ranges[nodes[k].left()].second != ranges[nodes[k].right()].first) {
+      problem = "the children of node " + std::to_string(k) + " do not cover adjacent triangle ranges";
+      return false;
+    }
+  if (ranges[0].first != 0 || ranges[0].second != triangle_count) {
+    problem = "the leaves cover triangles [" + std::to_string(ranges[0].first) + ", " +
+              std::to_string(ranges[0].second) + "), not all " + std::to_string(triangle_count);
+    return false;
+  }
+  return true;
+}
+
+bool is_permutation_of_range(std::span<const std::uint32_t> ids) {
+  std::vector<bool> seen(ids.size(), false);
+  for (const std::uint32_t id : ids) {
+    if (id >= ids.size() || seen[id]) return false;
+    seen[id] = true;
+  }
+  return true;
+}
+
+std::string grid_name(std::uint64_t grid) {
+  return grid == 0 ? std::string("no density") : "an ADB grid of " + std::to_string(grid) + " cells per axis";
+}
+
+}  // namespace
+
+std::uint64_t fnv1a64(std::span<const std::byte> bytes, std::uint64_t hash) {
+  for (const std::byte b : bytes) {
+    hash ^= std::to_integer<std::uint8_t>(b);
+    hash *= 0x100000001b3ull;
+  }
+  return hash;
+}
+
+std::vector<std::byte> encode(const View& view, std::string_view source) {
+  const Layout& layout = view.layout;
+  const std::size_t n = view.nodes.size();
+  if (layout.bv_name.empty() || layout.bv_name.size() >= kNameField)
+    fail(source, "BV name '" + std::string(layout.bv_name) + "' must have 1 to 31 characters");
+  if (n >= std::numeric_limits<std::uint32_t>::max() ||
+      view.triangle_count >= std::numeric_limits<std::uint32_t>::max())
+    fail(source, "too many nodes or triangles for 32-bit indices");
+  if (view.volumes.size() != n * layout.volume_size) fail(source, "volume bytes do not match the node count");
+  if (view.root_volume.size() != layout.root_volume_size) fail(source, "root volume size mismatch");
+  std::string problem;
+  if (!valid_topology(view.nodes, view.triangle_count, problem)) fail(source, "cannot save: " + problem);
+  if (!view.triangle_ids.empty() && view.triangle_ids.size() != view.triangle_count)
+    fail(source, "cannot save: " + std::to_string(view.triangle_ids.size()) + " triangle ids for " +
+                     std::to_string(view.triangle_count) + " triangles");
+  if (layout.grid > 0) {
+    if (view.pc.size() != n)
+      fail(source, "cannot save: " + std::to_string(view.pc.size()) + " pc counts for " + std::to_string(n) +
+                       " nodes (was the tree annotated?)");
+    if (!std::isfinite(view.tau) || !(view.tau > 0)) fail(source, "cannot save: tau must be finite and > 0");
+    const std::uint64_t cells = std::uint64_t{layout.grid} * layout.grid * layout.grid;
+    if (std::any_of(view.pc.begin(), view.pc.end(), [&](std::uint8_t c) { return c > cells; }))
+      fail(source, "cannot save: a pc count exceeds the grid's " + std::to_string(cells) + " cells");
+  }
+
+  const std::size_t payload = layout.root_volume_size + n * sizeof(TreeNode) + view.volumes.size() +
+                              view.triangle_ids.size() * sizeof(std::uint32_t) + (layout.grid > 0 ? n : 0);
+  std::vector<std::byte> out(kSavedTreeHeaderSize + payload, std::byte{0});
+  std::byte* h = out.data();
+  std::memcpy(h, kMagic.data(), kMagic.size());
+  put_le(h + kVersionAt, kSavedTreeVersion, 4);
+  std::memcpy(h + kByteOrderAt, &kByteOrderMark, 4);  // native on purpose: it tells the arrays' byte order
+  put_le(h + kHeaderSizeAt, kSavedTreeHeaderSize, 4);
+  put_le(h + kFlagsAt, view.triangle_ids.empty() ? 0 : kFlagTriangleIds, 4);
+  std::memcpy(h + kNameAt, layout.bv_name.data(), layout.bv_name.size());
+  put_le(h + kVolumeSizeAt, layout.volume_size, 4);
+  put_le(h + kRootSizeAt, layout.root_volume_size, 4);
+  put_le(h + kGridAt, layout.grid, 4);
+  put_le(h + kTauAt, std::bit_cast<std::uint64_t>(layout.grid > 0 ? view.tau : 0.0), 8);
+  put_le(h + kNodesAt, n, 8);
+  put_le(h + kTrianglesAt, view.triangle_count, 8);
+  put_le(h + kPayloadAt, payload, 8);
+
+  std::byte* at = out.data() + kSavedTreeHeaderSize;
+  auto append = [&](std::span<const std::byte> bytes) {
+    if (!bytes.empty()) std::memcpy(at, bytes.data(), bytes.size());
+    at += bytes.size();
+  };
+  append(view.root_volume);
+  append(std::as_bytes(view.nodes));
+  append(view.volumes);
+  append(std::as_bytes(view.triangle_ids));
+  if (layout.grid > 0) append(std::as_bytes(view.pc));
+  put_le(h + kChecksumOffset, checksum_of(out), 8);
+  return out;
+}
+
+Parts decode(std::span<const std::byte> buffer, const Layout& expected, std::string_view source) {
+  if (buffer.size() < kSavedTreeHeaderSize)
+    fail(source, "truncated: " + std::to_string(buffer.size()) + " bytes, shorter than the " +
+                     std::to_string(kSavedTreeHeaderSize) + "-byte header");
+  const std::byte* h = buffer.data();
+  if (std::memcmp(h, kMagic.data(), kMagic.size()) != 0)
+    fail(source, "not a bvhlab saved tree (bad magic bytes)");
+  const std::uint64_t version = get_le(h + kVersionAt, 4);
+  if (version != kSavedTreeVersion)
+    fail(source, "format version " + std::to_string(version) + ", this build reads version " +
+                     std::to_string(kSavedTreeVersion));
+  std::uint32_t byte_order = 0;
+  std::memcpy(&byte_order, h + kByteOrderAt, 4);
+  if (byte_order != kByteOrderMark) fail(source, "written on a machine of another byte order (or corrupted)");
+  if (get_le(h + kHeaderSizeAt, 4) != kSavedTreeHeaderSize)
+    fail(source, "corrupted header (bad header size)");
+  const std::uint64_t flags = get_le(h + kFlagsAt, 4);
+  if ((flags & ~std::uint64_t{kFlagTriangleIds}) != 0) fail(source, "unknown flags " + std::to_string(flags));
+  if (get_le(h + kReserved0At, 4) != 0 || get_le(h + kReserved1At, 8) != 0 ||
+      get_le(h + kReserved1At + 8, 8) != 0)
+    fail(source, "corrupted header (reserved bytes are not zero)");
+
+  const char* name_field = reinterpret_cast<const char*>(h + kNameAt);
+  const std::size_t name_length = std::find(name_field, name_field + kNameField, '\0') - name_field;
+  if (name_length == 0 || name_length == kNameField) fail(source, "corrupted header (bad BV name field)");
+  const std::string_view name(name_field, name_length);
+  if (name != expected.bv_name)
+    fail(source,
+         "holds '" + std::string(name) + "' volumes, expected '" + std::string(expected.bv_name) + "'");
+  const std::uint64_t volume_size = get_le(h + kVolumeSizeAt, 4), root_size = get_le(h + kRootSizeAt, 4);
+  if (volume_size != expected.volume_size || root_size != expected.root_volume_size)
+    fail(source, "'" + std::string(name) + "' volumes of " + std::to_string(volume_size) + " bytes (root " +
+                     std::to_string(root_size) + "), this build's are " +
+                     std::to_string(expected.volume_size) + " (root " +
+                     std::to_string(expected.root_volume_size) + ")");
+  const std::uint64_t grid = get_le(h + kGridAt, 4);
+  if (grid != expected.grid)
+    fail(source, "holds a tree with " + grid_name(grid) + ", expected " + grid_name(expected.grid));
+  const double tau = std::bit_cast<double>(get_le(h + kTauAt, 8));
+  if (grid > 0 ? !(std::isfinite(tau) && tau > 0) : tau != 0.0)
+    fail(source, "corrupted header (tau " + std::to_string(tau) + ")");
+
+  // Sizes, against the buffer's real length, before any allocation.
+  const std::uint64_t n = get_le(h + kNodesAt, 8), triangles = get_le(h + kTrianglesAt, 8);
+  const std::uint64_t payload = get_le(h + kPayloadAt, 8);
+  const bool has_ids = (flags & kFlagTriangleIds) != 0;
+  const std::uint64_t per_node = sizeof(TreeNode) + volume_size + (grid > 0 ? 1 : 0);
+  std::uint64_t expected_payload = 0;
+  if (n == 0 || n >= std::numeric_limits<std::uint32_t>::max() ||
+      triangles >= std::numeric_limits<std::uint32_t>::max() ||
+      !mul_add(n, per_node, root_size, expected_payload) ||
+      !mul_add(has_ids ? triangles : 0, sizeof(std::uint32_t), expected_payload, expected_payload))
+    fail(source, "corrupted header (absurd counts: " + std::to_string(n) + " nodes, " +
+                     std::to_string(triangles) + " triangles)");
+  if (payload != expected_payload)
+    fail(source, "corrupted header (payload size " + std::to_string(payload) + " does not match " +
+                     std::to_string(n) + " nodes and " + std::to_string(triangles) + " triangles)");
+  const std::uint64_t available = buffer.size() - kSavedTreeHeaderSize;
+  if (available < payload)
+    fail(source, "truncated: the payload has " + std::to_string(available) + " of " +
+                     std::to_string(payload) + " bytes");
+  if (available > payload)
+    fail(source, std::to_string(available - payload) + " trailing bytes after the payload");
+  if (get_le(h + kChecksumOffset, 8) != checksum_of(buffer))
+    fail(source, "checksum mismatch: the file is corrupted");
+
+  Parts parts;
+  parts.tau = grid > 0 ? tau : 0.0;
+  parts.triangle_count = triangles;
+  const std::byte* at = buffer.data() + kSavedTreeHeaderSize;
+  parts.root_volume = {at, static_cast<std::size_t>(root_size)};
+  at += root_size;
+  parts.nodes.resize(n);
+  std::memcpy(parts.nodes.data(), at, n * sizeof(TreeNode));
+  at += n * sizeof(TreeNode);
+  parts.volumes = {at, static_cast<std::size_t>(n * volume_size)};
+  at += n * volume_size;
+  if (has_ids) {
+    parts.triangle_ids.resize(triangles);
+    std::memcpy(parts.triangle_ids.data(), at, triangles * sizeof(std::uint32_t));
+    at += triangles * sizeof(std::uint32_t);
+  }
+  if (grid > 0)
+    parts.pc.assign(reinterpret_cast<const std::uint8_t*>(at), reinterpret_cast<const std::uint8_t*>(at) + n);
+
+  std::string problem;
+  if (!valid_topology(parts.nodes, triangles, problem)) fail(source, "bad topology: " + problem);
+  if (has_ids && !is_permutation_of_range(parts.triangle_ids))
+    fail(source, "the triangle ids are not a permutation of 0.." + std::to_string(triangles - 1));
+  const std::uint64_t cells = grid * grid * grid;
+  for (std::size_t k = 0; k < parts.pc.size(); ++k)
+    if (parts.pc[k] > cells)
+      fail(source, "node " + std::to_string(k) + " has pc " + std::to_string(parts.pc[k]) +
+                       ", more than the grid's " + std::to_string(cells) + " cells");
+  return parts;
+}
+
+std::vector<std::byte> read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path.string(), "cannot open for reading");
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) fail(path.string(), "cannot read its size: " + ec.message());
+  std::vector<std::byte> bytes(size);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size)) ||
+      in.gcount() != static_cast<std::streamsize>(size))
+    fail(path.string(), "read error");
+  return bytes;
+}
+
+void write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes) {
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::string temp_name = path.filename().string();
+  temp_name.insert(temp_name.begin(), '.');  // hidden, beside the target: the rename stays on one filesystem
+  temp_name += ".tmp-XXXXXX";
+  std::string temp = (dir / temp_name).string();
+  const int fd = ::mkstemp(temp.data());
+  if (fd < 0)
+    fail(path.string(), "cannot create a temporary file in " + dir.string() + ": " + std::strerror(errno));
+  auto abandon = [&](const std::string& problem) {
+    ::close(fd);
+    ::unlink(temp.c_str());
+    fail(path.string(), problem);
+  };
+  ::fchmod(fd, 0644);
+  std::size_t written = 0;
+  while (written < bytes.size()) {
+    const ::ssize_t r = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) abandon(std::string("write failed: ") + std::strerror(errno));
+    written += static_cast<std::size_t>(r);
+  }
+  if (::fsync(fd) != 0) abandon(std::string("fsync failed: ") + std::strerror(errno));
+  if (::close(fd) != 0) {
+    ::unlink(temp.c_str());
+    fail(path.string(), std::string("close failed: ") + std::strerror(errno));
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp, path, ec);
+  if (ec) {
+    ::unlink(temp.c_str());
+    fail(path.string(), "cannot move the written file into place: " + ec.message());
+  }
+}
+
+}  // namespace bvhlab::saved_tree_detail
