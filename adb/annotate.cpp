@@ -389,7 +389,8 @@ Bounds certified(const CellSum& s) {
 }
 
 struct ThreadStats {
-  std::size_t fast = 0, clipped = 0, clip_calls = 0, skipped_clips = 0, degenerate = 0, exact_cells = 0;
+  std::size_t fast = 0, clipped = 0, clip_calls = 0, skipped_clips = 0, derived_areas = 0, degenerate = 0,
+              exact_cells = 0;
 };
 
 struct Worker {
@@ -527,30 +528,64 @@ std::uint8_t count_node(const Job& job, std::uint32_t node, Worker& worker) {
     if (cell.known.terms + cell.pending_count > 0) cell.decide(threshold);
   }
 
+  // The candidate cells of a clipped triangle partition it (they overlap in cell planes only, which a
+  // triangle spanning a positive extent across them meets in segments), unless an axis has two containing
+  // cells (the triangle lies in their shared plane). So when every candidate is still open, the last one's
+  // area is the triangle's minus the others': one clip fewer per triangle.
+  std::vector<std::array<int, 3>> candidates;
   for (const std::uint32_t t : pending) {
     const TriangleInfo& info = job.infos[t];
     const Placement p = place(grid, info);
+    candidates.clear();
+    bool all_open = true;
     for_each_candidate_cell(p, [&](const std::array<int, 3>& c) {
-      CellState& cell = cells[index(c)];
-      if (cell.decision != CellState::Decision::Open) {
-        ++stats.skipped_clips;
-        return;
-      }
-      ClipBox clip;
-      if (make_clip_box(grid, info, p, c, clip)) {
-        ++stats.clip_calls;
-        const Bounds area = clipped_area_bounds(job.triangles[t], clip);
-        if (area.hi > 0) {
-          cell.known.lo += area.lo;
-          cell.known.hi += area.hi;
-          ++cell.known.terms;
-        }
+      candidates.push_back(c);
+      all_open = all_open && cells[index(c)].decision == CellState::Decision::Open;
+    });
+    bool partition = all_open && candidates.size() >= 2;
+    for (int a = 0; a < 3; ++a)
+      partition = partition && (!p.contained[a] || p.candidate[a].first == p.candidate[a].last);
+    std::array<ClipBox, kMaxGrid * kMaxGrid * kMaxGrid> boxes;
+    std::array<bool, kMaxGrid * kMaxGrid * kMaxGrid> has_area{};
+    std::size_t derived = candidates.size();  // the candidate whose area is derived, if any
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      has_area[k] = make_clip_box(grid, info, p, candidates[k], boxes[k]);
+      if (partition && has_area[k]) derived = k;
+    }
+    Interval rest(info.area.lo, info.area.hi);
+    auto add = [&](CellState& cell, const Bounds& area) {
+      if (area.hi > 0) {
+        cell.known.lo += area.lo;
+        cell.known.hi += area.hi;
+        ++cell.known.terms;
       }
       cell.pending -= info.area.hi;
       --cell.pending_count;
       ++cell.pending_ops;
       cell.decide(threshold);
-    });
+    };
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      CellState& cell = cells[index(candidates[k])];
+      if (cell.decision != CellState::Decision::Open) {
+        ++stats.skipped_clips;
+        continue;
+      }
+      if (k == derived) continue;
+      Bounds area;
+      if (has_area[k]) {
+        ++stats.clip_calls;
+        area = clipped_area_bounds(job.triangles[t], boxes[k]);
+        if (derived < candidates.size()) {
+          CGAL::Protect_FPU_rounding<true> guard;
+          rest -= Interval(area.lo, area.hi);
+        }
+      }
+      add(cell, area);
+    }
+    if (derived < candidates.size()) {
+      ++stats.derived_areas;
+      add(cells[index(candidates[derived])], to_bounds(rest));
+    }
   }
 
   int count = 0;
@@ -696,6 +731,7 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
     s.clipped_triangles += t.clipped;
     s.clip_calls += t.clip_calls;
     s.skipped_clips += t.skipped_clips;
+    s.derived_areas += t.derived_areas;
     s.degenerate_triangles += t.degenerate;
     s.exact_cells += t.exact_cells;
   }

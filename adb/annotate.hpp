@@ -67,6 +67,7 @@ struct AnnotateStats {
   std::size_t clipped_triangles = 0;    ///< pairs that needed clipping
   std::size_t clip_calls = 0;     ///< CGAL intersections (one per open candidate cell of a clipped pair)
   std::size_t skipped_clips = 0;  ///< candidate cells already decided by area bounds: not clipped
+  std::size_t derived_areas = 0;  ///< candidate cells whose area was the triangle's minus the others'
   std::size_t degenerate_triangles = 0;  ///< pairs skipped because the triangle has zero area
   std::size_t exact_cells = 0;           ///< cells whose decision needed exact arithmetic (ties, near-ties)
 };
