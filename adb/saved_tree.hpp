@@ -28,7 +28,8 @@
 // corrupt count cannot cause a giant allocation), then the checksum, then the structure: children stored
 // after their parent and in range, every node but the root the child of exactly one parent, leaf ranges
 // tiling [0, T), triangle ids a permutation, pc <= g^3. The stored volumes themselves are opaque bytes:
-// only the checksum vouches for them.
+// the checksum vouches for them, and a volume model with a `bool valid() const` member is asked to check
+// each one (a restricted box's axis, for one, indexes an array when decoded).
 //
 // Triangle ids are stored by default: they map tree order to the mesh's triangles, which is what re-attaching
 // polygons needs (the tree cache, an exact fallback). An ADB-only query needs none of them, so
@@ -171,6 +172,21 @@ Tree<BV, Density> load_tree_from_buffer(std::span<const std::byte> buffer,
     std::memcpy(&root, parts.root_volume.data(), sizeof(Root));
   else
     root = volumes.front();
+  // Volume bytes are opaque to the format; a model that can check its own invariants (say, an axis index
+  // that decoding uses to index an array) gets the chance to refuse a crafted file here.
+  if constexpr (requires(const BV& v) {
+                  { v.valid() } -> std::convertible_to<bool>;
+                }) {
+    for (std::size_t i = 0; i < volumes.size(); ++i)
+      if (!volumes[i].valid())
+        throw SavedTreeError("saved tree '" + std::string(source) + "': node " + std::to_string(i) +
+                             " has an invalid volume");
+  }
+  if constexpr (HierarchicalVolume<BV> && requires(const Root& v) {
+                  { v.valid() } -> std::convertible_to<bool>;
+                }) {
+    if (!root.valid()) throw SavedTreeError("saved tree '" + std::string(source) + "': invalid root volume");
+  }
   Tree<BV, Density> tree{Bvh<BV>::from_parts(std::move(parts.nodes), std::move(volumes),
                                              std::move(parts.triangle_ids), {}, root),
                          {}};

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <unistd.h>
+#include <cstddef>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -273,6 +274,36 @@ TEST(SavedTree, RejectsBadStructureEvenWithAValidChecksum) {
   std::memcpy(bad.data() + ids_at, bad.data() + ids_at + 4, 4);
   reseal(bad);
   expect_rejected([&] { load_adb(bad); }, "permutation");
+}
+
+// A volume model that can check its own bytes: the reader must ask it.
+struct CheckedBox {
+  Aabb box;
+  std::uint32_t tag = 1;
+  using PairContext = Aabb::PairContext;
+  static constexpr std::string_view name() { return "checked_box"; }
+  static CheckedBox fit(std::span<const Vec3> points) { return {Aabb::fit(points), 1}; }
+  static CheckedBox merge(const CheckedBox& a, const CheckedBox& b) { return {Aabb::merge(a.box, b.box), 1}; }
+  static PairContext make_context(const RigidTransform& pose) { return Aabb::make_context(pose); }
+  static bool overlap(const CheckedBox& a, const CheckedBox& b, const PairContext& c) {
+    return Aabb::overlap(a.box, b.box, c);
+  }
+  [[nodiscard]] Scalar volume() const { return box.volume(); }
+  [[nodiscard]] Box bounding_box() const { return box.bounding_box(); }
+  [[nodiscard]] bool contains(const Vec3& p) const { return box.contains(p); }
+  [[nodiscard]] bool valid() const { return tag == 1; }
+};
+static_assert(BoundingVolume<CheckedBox>);
+
+TEST(SavedTree, AVolumeModelCanRefuseItsOwnBytes) {
+  const Tree<CheckedBox> tree{Bvh<CheckedBox>::build(testing::make_torus(1.0, 0.3, 8, 4)), {}};
+  Bytes bytes = save_tree_to_buffer(tree);
+  EXPECT_NO_THROW(load_tree_from_buffer<CheckedBox>(bytes));
+  const std::size_t third_tag = nodes_offset() + tree.bvh.nodes().size() * sizeof(TreeNode) +
+                                3 * sizeof(CheckedBox) + offsetof(CheckedBox, tag);
+  put_u32(bytes, third_tag, 7);
+  reseal(bytes);
+  expect_rejected([&] { load_tree_from_buffer<CheckedBox>(bytes); }, "node 3 has an invalid volume");
 }
 
 TEST(SavedTree, RandomGarbageNeverCrashes) {
