@@ -24,6 +24,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <iostream>
@@ -680,8 +681,87 @@ BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hie
       bytes = save_tree_to_buffer(*store.plain<BV>(data, hierarchy, &outcome.model));
     }
   });
-  tree_cache_detail::write_file_bytes(output, bytes);
+  saved_tree_detail::write_file_atomically(output, bytes);
   outcome.file_bytes = std::filesystem::file_size(output);
+  return outcome;
+}
+
+bool is_saved_tree(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  char magic[8] = {};
+  return in.read(magic, 8) && std::string_view(magic, 8) == "BVHLTREE";
+}
+
+SavedTreeInfo peek_saved_tree(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  unsigned char header[kSavedTreeHeaderSize];
+  if (!in || !in.read(reinterpret_cast<char*>(header), sizeof header) ||
+      std::memcmp(header, "BVHLTREE", 8) != 0)
+    throw std::runtime_error(file.string() + ": not a saved bvhlab tree");
+  auto u64 = [&](std::size_t at) {
+    std::uint64_t v = 0;
+    for (int i = 7; i >= 0; --i) v = (v << 8) | header[at + static_cast<std::size_t>(i)];
+    return v;
+  };
+  auto u32 = [&](std::size_t at) { return static_cast<std::uint32_t>(u64(at) & 0xffffffffu); };
+  if (u32(8) != kSavedTreeVersion)
+    throw std::runtime_error(file.string() + ": saved-tree format version " + std::to_string(u32(8)) +
+                             ", this build reads " + std::to_string(kSavedTreeVersion));
+  SavedTreeInfo info;
+  info.bv.assign(reinterpret_cast<const char*>(header + 24),
+                 strnlen(reinterpret_cast<const char*>(header + 24), 32));
+  info.grid = static_cast<int>(u32(64));
+  const std::uint64_t tau_bits = u64(72);
+  std::memcpy(&info.tau, &tau_bits, sizeof info.tau);
+  info.nodes = u64(80);
+  info.triangles = u64(88);
+  return info;
+}
+
+QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
+                                const StrategyVariant& strategy, const RigidTransform& pose) {
+  if (strategy.kind == StrategyKind::Exact || strategy.kind == StrategyKind::GuidedExact)
+    throw std::invalid_argument(
+        "saved trees carry no polygons, so they answer adb and time_critical queries only; "
+        "give the meshes for " +
+        std::string(to_string(strategy.kind)));
+  const SavedTreeInfo ia = peek_saved_tree(a), ib = peek_saved_tree(b);
+  if (ia.grid == 0 || ib.grid == 0)
+    throw std::invalid_argument((ia.grid == 0 ? a : b).string() +
+                                ": the tree has no ADB annotation (build it with --adb)");
+  if (ia.bv != ib.bv || ia.grid != ib.grid || ia.tau != ib.tau)
+    throw std::invalid_argument("the two trees differ in BV, grid or tau (" + ia.bv +
+                                " g=" + std::to_string(ia.grid) + " vs " + ib.bv +
+                                " g=" + std::to_string(ib.grid) + ")");
+  QueryOutcome outcome;
+  with_volume(ia.bv, [&]<class BV>(std::type_identity<BV>) {
+    with_grid(ia.grid, [&]<int G>(std::integral_constant<int, G>) {
+      const auto tree_a = load_tree<BV, AdbDensity<G>>(a);
+      const auto tree_b = a == b ? tree_a : load_tree<BV, AdbDensity<G>>(b);
+      const AdbModel model(G, ia.tau);
+      AdbOptions options;
+      options.p_min = strategy.p_min >= 0 ? strategy.p_min : 1.0;
+      options.budget = strategy.budget;
+      options.best_effort_threshold = strategy.best_effort_threshold;
+      options.validate();
+      const auto start = Clock::now();
+      outcome.result = query_adb(tree_a, tree_b, pose, model, options);
+      outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+      for (auto [info, tree, file] :
+           {std::tuple{&outcome.model_a, &tree_a, &a}, std::tuple{&outcome.model_b, &tree_b, &b}}) {
+        const BvhStats st = tree->bvh.stats();
+        info->object = file->filename().string();
+        info->hierarchy = info->bv = ia.bv;
+        info->annotation = "adb g=" + std::to_string(G) + " tau=" + g17(ia.tau);
+        info->triangles = st.triangles;
+        info->nodes = st.nodes;
+        info->depth = st.depth;
+        info->model_bytes = double(st.nodes * st.bytes_per_node + st.nodes);
+        info->bytes_per_triangle = st.triangles ? info->model_bytes / double(st.triangles) : 0;
+        info->from_cache = true;
+      }
+    });
+  });
   return outcome;
 }
 

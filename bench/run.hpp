@@ -132,6 +132,24 @@ struct QueryOutcome {
 QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRequest& request,
                        const RigidTransform& pose, const RunOptions& options);
 
+/// What a saved-tree file's header says about its tree.
+struct SavedTreeInfo {
+  std::string bv;
+  int grid = 0;  ///< 0: no annotation
+  double tau = 0;
+  std::uint64_t nodes = 0, triangles = 0;
+};
+/// Reads the header of a saved tree (adb/saved_tree.hpp, format version 1). Throws std::runtime_error naming
+/// the file for anything that is not one.
+SavedTreeInfo peek_saved_tree(const std::filesystem::path& file);
+/// Whether `file` starts like a saved tree (so the CLI can take trees and meshes alike).
+bool is_saved_tree(const std::filesystem::path& file);
+
+/// One ADB or time-critical query between two saved, annotated trees (no polygons needed). Both must have the
+/// same BV, grid and tau. Throws std::invalid_argument for exact strategies (saved trees carry no polygons).
+QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
+                                const StrategyVariant& strategy, const RigidTransform& pose);
+
 /// Builds (and, if asked, annotates) one object's tree and saves it, without polygons, in the saved-tree
 /// format.
 struct BuildOutcome {

@@ -169,6 +169,7 @@ int main(int argc, char** argv) {
       "  bvhlab info jeep1.ms3d\n"
       "  bvhlab build teapot.obj --bv aabb --adb --grid 2 --tau 0.5 -o teapot.tree\n"
       "  bvhlab query jeep1.ms3d jeep1.ms3d --protocol 1.4,100,5000 --strategy adb --p-min 0.9\n"
+      "  bvhlab query teapot.tree teapot.tree --pose 1.2,0,0,0,0,1,45 --strategy adb\n"
       "  bvhlab run bench/scenes/smoke.json -o results/smoke\n"
       "  bvhlab report bench/scenes/demo.json -o report/demo\n"
       "  bvhlab demo --build-dir build/release\n"
@@ -179,7 +180,7 @@ int main(int argc, char** argv) {
   std::string info_mesh;
   bool info_json = false;
   auto* info = app.add_subcommand("info", "Triangles, degenerate triangles, bounds and checksum of a mesh");
-  info->add_option("MESH", info_mesh, "Mesh file or catalog name")->required();
+  info->add_option("MESH", info_mesh, "Mesh file or catalog name (or a saved tree: its header)")->required();
   info->add_flag("--json", info_json, "Print JSON");
   info->footer("Example: bvhlab info meshes/pinion.off");
 
@@ -221,8 +222,8 @@ int main(int argc, char** argv) {
   std::uint64_t query_bv_tests = 0;
   bool query_all = false, query_json = false, query_raw = false, query_no_cache = false;
   auto* query = app.add_subcommand("query", "One query between two meshes; prints the full result");
-  query->add_option("A", query_a, "Mesh A (stays at the origin)")->required();
-  query->add_option("B", query_b, "Mesh B (moved by the pose)")->required();
+  query->add_option("A", query_a, "Mesh A (stays at the origin), or a saved annotated tree")->required();
+  query->add_option("B", query_b, "Mesh B (moved by the pose), or a saved annotated tree")->required();
   auto* pose_option =
       query->add_option("--pose", query_pose, "B's pose: TX,TY,TZ or TX,TY,TZ,AX,AY,AZ,DEGREES");
   query->add_option("--protocol", query_protocol, "B's pose from the protocol: DISTANCE,STEP,STEPS")
@@ -298,6 +299,16 @@ int main(int argc, char** argv) {
 
   try {
     if (*info) {
+      if (fs::is_regular_file(info_mesh) && is_saved_tree(info_mesh)) {
+        const SavedTreeInfo t = peek_saved_tree(info_mesh);
+        std::printf("%s (saved tree)\n  bv              %s\n  nodes           %ju\n  triangles       %ju\n",
+                    info_mesh.c_str(), t.bv.c_str(), std::uintmax_t(t.nodes), std::uintmax_t(t.triangles));
+        if (t.grid)
+          std::printf("  annotation      adb g=%d tau=%g\n", t.grid, t.tau);
+        else
+          std::printf("  annotation      none\n");
+        return 0;
+      }
       const fs::path path = resolve_mesh_argument(info_mesh);
       const LoadedMesh loaded = load_mesh(path);
       const LoadReport& r = loaded.report;
@@ -349,9 +360,10 @@ int main(int argc, char** argv) {
     if (*query) {
       if (query_pose.empty() && query_protocol.empty())
         throw CLI::ValidationError("query", "give B's pose with --pose or --protocol");
-      const SceneObject a = object_for(query_a, !query_raw);
-      const SceneObject b_separate = object_for(query_b, !query_raw);
-      const bool same = a.path == b_separate.path;
+      const bool tree_a = fs::is_regular_file(query_a) && is_saved_tree(query_a);
+      const bool tree_b = fs::is_regular_file(query_b) && is_saved_tree(query_b);
+      if (tree_a != tree_b)
+        throw CLI::ValidationError("query", "give two meshes or two saved trees, not one of each");
       QueryRequest request;
       request.hierarchy.bv = request.hierarchy.name = query_bv;
       request.strategy.kind = strategy_from(query_strategy);
@@ -365,8 +377,22 @@ int main(int argc, char** argv) {
         throw CLI::ValidationError("--strategy time_critical", "needs --bv-tests and/or --deadline-us");
       request.all_contacts = query_all;
       const RigidTransform pose = parse_pose(query_pose, query_protocol);
-      RunOptions options = run_options(query_cache, query_no_cache, true);
-      const QueryOutcome outcome = run_query(a, same ? a : b_separate, request, pose, options);
+      QueryOutcome outcome;
+      std::string name_a, name_b;
+      if (tree_a) {  // saved trees: ADB without polygons; BV, grid and tau come from the files
+        outcome = run_query_on_trees(query_a, query_b, request.strategy, pose);
+        name_a = query_a;
+        name_b = query_b;
+        query_bv = outcome.model_a.bv;
+      } else {
+        const SceneObject a = object_for(query_a, !query_raw);
+        const SceneObject b_separate = object_for(query_b, !query_raw);
+        const bool same = a.path == b_separate.path;
+        const RunOptions options = run_options(query_cache, query_no_cache, true);
+        outcome = run_query(a, same ? a : b_separate, request, pose, options);
+        name_a = a.name;
+        name_b = b_separate.name;
+      }
       const Result& r = outcome.result;
       if (query_json) {
         nlohmann::json j = {{"collides", r.collides},
@@ -385,8 +411,8 @@ int main(int argc, char** argv) {
         }
         std::cout << j.dump(2) << '\n';
       } else {
-        std::printf("%s vs %s, %s on %s\n", a.name.c_str(), b_separate.name.c_str(),
-                    request.strategy.label().c_str(), query_bv.c_str());
+        std::printf("%s vs %s, %s on %s\n", name_a.c_str(), name_b.c_str(), request.strategy.label().c_str(),
+                    query_bv.c_str());
         std::printf("  collides          %s\n  probability       %g\n  exact             %s\n",
                     r.collides ? "yes" : "no", r.probability, r.exact ? "yes" : "no");
         if (r.budget_exhausted) std::printf("  budget            exhausted (best-effort answer)\n");

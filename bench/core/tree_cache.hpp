@@ -9,11 +9,8 @@
 // Anything else is a stale or corrupt entry: it is reported, rebuilt by the caller and overwritten.
 #pragma once
 
-#include "adb/tree.hpp"
-#if __has_include("adb/saved_tree.hpp")
 #include "adb/saved_tree.hpp"
-#define BVHLAB_TREE_CACHE_SAVED_TREE 1
-#endif
+#include "adb/tree.hpp"
 #include "bench/core/content_hash.hpp"
 #include "bvh/mesh.hpp"
 
@@ -32,66 +29,6 @@ namespace bvhlab {
 struct CachedTreeTimes {
   double build_seconds = 0, annotate_seconds = 0;
 };
-
-#ifndef BVHLAB_TREE_CACHE_SAVED_TREE
-// TEMPORARY stand-in until adb/saved_tree.hpp lands: raw arrays, no versioning beyond a magic word.
-template <class BV, DensityPolicy D>
-std::vector<std::byte> save_tree_to_buffer(const Tree<BV, D>& tree) {
-  std::vector<std::byte> out;
-  auto put = [&](const void* p, std::size_t n) {
-    const auto* b = static_cast<const std::byte*>(p);
-    out.insert(out.end(), b, b + n);
-  };
-  auto put_vec = [&](const auto& v) {
-    const std::uint64_t n = v.size();
-    put(&n, 8);
-    put(v.data(), n * sizeof(v[0]));
-  };
-  put("TMPTREE1", 8);
-  put_vec(tree.bvh.nodes());
-  put_vec(tree.bvh.volumes());
-  put_vec(tree.bvh.triangle_ids());
-  if constexpr (D::annotated) {
-    put_vec(tree.density.possible_collision_cells);
-    put(&tree.density.tau, 8);
-  }
-  return out;
-}
-template <class BV, DensityPolicy D>
-Tree<BV, D> load_tree_from_buffer(std::span<const std::byte> in) {
-  std::size_t at = 0;
-  auto get = [&](void* p, std::size_t n) {
-    if (in.size() - at < n) throw std::runtime_error("truncated tree");
-    std::memcpy(p, in.data() + at, n);
-    at += n;
-  };
-  auto get_vec = [&](auto& v) {
-    std::uint64_t n = 0;
-    get(&n, 8);
-    if (n > in.size()) throw std::runtime_error("bad length");
-    v.resize(n);
-    get(v.data(), n * sizeof(v[0]));
-  };
-  char magic[8];
-  get(magic, 8);
-  if (std::memcmp(magic, "TMPTREE1", 8) != 0) throw std::runtime_error("bad magic");
-  std::vector<TreeNode> nodes;
-  std::vector<BV> volumes;
-  std::vector<std::uint32_t> ids;
-  get_vec(nodes);
-  get_vec(volumes);
-  get_vec(ids);
-  if (nodes.empty() || volumes.size() != nodes.size()) throw std::runtime_error("bad node count");
-  (void)node_triangle_ranges(nodes);  // throws on children out of order, before anything walks the tree
-  Tree<BV, D> tree{Bvh<BV>::from_parts(std::move(nodes), std::move(volumes), std::move(ids)), {}};
-  if constexpr (D::annotated) {
-    get_vec(tree.density.possible_collision_cells);
-    get(&tree.density.tau, 8);
-  }
-  if (at != in.size()) throw std::runtime_error("trailing bytes");
-  return tree;
-}
-#endif
 
 namespace tree_cache_detail {
 

@@ -1,5 +1,6 @@
 // The scene runner: only what a scene names is built; the cache is used, and a damaged entry is rebuilt,
 // never trusted; the CSV keeps its schema; the report is written.
+#include "bench/core/protocol.hpp"
 #include "bench/core/tree_cache.hpp"
 #include "bench/report.hpp"
 #include "bench/run.hpp"
@@ -355,6 +356,44 @@ TEST_F(RunTest, ReportReadmeStatesTheOperatingPoint) {
   for (const auto& f : report_figures()) EXPECT_NE(readme.find(f.file), std::string::npos) << f.file;
   EXPECT_TRUE(std::filesystem::is_regular_file(files.results_csv));
   EXPECT_TRUE(std::filesystem::is_regular_file(files.results_json));
+}
+
+TEST_F(RunTest, SavedTreesAnswerLikeTheMeshesTheyWereBuiltFrom) {
+  SceneObject torus;
+  torus.mesh = "torus.obj";
+  torus.name = "torus";
+  torus.path = dir / "torus.obj";
+  HierarchySpec aabb;
+  aabb.bv = aabb.name = "aabb";
+  const AnnotationSpec annotation{true, 2, 0.5};
+  const BuildOutcome built = build_tree_file(torus, aabb, annotation, dir / "torus.tree", 2);
+  EXPECT_EQ(built.file_bytes, std::filesystem::file_size(dir / "torus.tree"));
+  EXPECT_GT(built.model.annotate_seconds, 0.0);
+  const SavedTreeInfo info = peek_saved_tree(dir / "torus.tree");
+  EXPECT_EQ(info.bv, "aabb");
+  EXPECT_EQ(info.grid, 2);
+  EXPECT_EQ(info.tau, 0.5);
+  EXPECT_EQ(info.triangles, built.model.triangles);
+  EXPECT_FALSE(is_saved_tree(dir / "torus.obj"));
+
+  QueryRequest request;
+  request.hierarchy = aabb;
+  request.annotation = annotation;
+  request.strategy.kind = StrategyKind::Adb;
+  request.strategy.p_min = 0.9;
+  options.cache_dir.clear();
+  for (int step = 0; step < 40; step += 7) {
+    const RigidTransform pose = protocol_pose(1.3, step, 40);
+    const QueryOutcome from_trees =
+        run_query_on_trees(dir / "torus.tree", dir / "torus.tree", request.strategy, pose);
+    const QueryOutcome from_meshes = run_query(torus, torus, request, pose, options);
+    EXPECT_EQ(from_trees.result.collides, from_meshes.result.collides) << step;
+    EXPECT_EQ(from_trees.result.probability, from_meshes.result.probability) << step;
+    EXPECT_EQ(from_trees.result.counters.bv_tests, from_meshes.result.counters.bv_tests) << step;
+  }
+  StrategyVariant exact;
+  EXPECT_THROW(run_query_on_trees(dir / "torus.tree", dir / "torus.tree", exact, {}), std::invalid_argument);
+  EXPECT_THROW(peek_saved_tree(dir / "torus.obj"), std::runtime_error);
 }
 
 TEST_F(RunTest, PlotScriptDrawsAllFiveFigures) {
