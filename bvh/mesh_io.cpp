@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -293,7 +294,9 @@ LoadedMesh merge_scene(const aiScene& scene, const std::string& source, std::str
   return merger.finish(std::move(name));
 }
 
-constexpr unsigned kPostProcess = aiProcess_Triangulate;
+// Validation first: Debian's assimp keeps its ai_asserts, and TriangulateProcess aborts the whole process on
+// a face without indices (any truncated OFF file; found by tests/fuzz); validation refuses such a scene.
+constexpr unsigned kPostProcess = aiProcess_ValidateDataStructure | aiProcess_Triangulate;
 
 template <class ReadFn>
 LoadedMesh import_with(const std::string& source, std::string name, ReadFn read) {
@@ -309,11 +312,19 @@ LoadedMesh import_with(const std::string& source, std::string name, ReadFn read)
   }
 
   std::vector<std::string> log;
-  for (auto& m : capture.messages) log.push_back(strip_log_prefix(std::move(m)));
+  for (auto& m : capture.messages) {
+    std::string message = strip_log_prefix(std::move(m));
+    // The merger keeps only vertices that triangles use, so this validation remark is no news to the caller.
+    if (message.find("There are unreferenced vertices") == std::string::npos)
+      log.push_back(std::move(message));
+  }
   if (scene == nullptr) {
     const std::string error = importer.GetErrorString();
     if (error.find("No suitable reader") != std::string::npos)
       throw MeshError(source + ": unknown or unsupported file format (assimp: " + error + ")");
+    if (error.find("Validation failed") != std::string::npos &&
+        error.find("out of range") != std::string::npos)
+      throw MeshError(source + ": index out of range (assimp: " + error + ")");
     throw MeshError(source + ": assimp could not read it: " + (error.empty() ? "unknown error" : error));
   }
   for (const auto& m : log)
@@ -329,6 +340,25 @@ LoadedMesh import_with(const std::string& source, std::string name, ReadFn read)
   return loaded;
 }
 
+// assimp 5.2's PLY reader never returns when the header ends without an `end_header` line (any truncated
+// header; found by tests/fuzz), so such input is refused before assimp sees it. `next_line` yields the
+// input's lines until it returns false.
+template <class NextLine>
+bool ply_header_unterminated(std::string_view start, NextLine next_line) {
+  auto lower = [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); };
+  if (start.size() < 3 || lower(start[0]) != 'p' || lower(start[1]) != 'l' || lower(start[2]) != 'y')
+    return false;
+  std::string line;
+  while (next_line(line)) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line.compare(first, 10, "end_header") != 0) continue;
+    if (first + 10 == line.size() || std::isspace(static_cast<unsigned char>(line[first + 10]))) return false;
+  }
+  return true;
+}
+
+constexpr const char* kUnterminatedPly = ": PLY header has no end_header line (truncated file?)";
+
 }  // namespace
 
 LoadedMesh load_mesh(const std::filesystem::path& path) {
@@ -341,6 +371,17 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
     throw MeshError(source + ": cannot be opened for reading");
   const auto size = std::filesystem::file_size(path, ec);
   if (!ec && size == 0) throw MeshError(source + ": file is empty");
+  {
+    std::ifstream in(path, std::ios::binary);
+    char magic[3] = {};
+    in.read(magic, 3);
+    const std::string_view start(magic, static_cast<std::size_t>(in.gcount()));
+    in.clear();
+    in.seekg(0);
+    if (ply_header_unterminated(start,
+                                [&](std::string& line) { return static_cast<bool>(std::getline(in, line)); }))
+      throw MeshError(source + kUnterminatedPly);
+  }
   return import_with(source, path.stem().string(),
                      [&](Assimp::Importer& importer) { return importer.ReadFile(source, kPostProcess); });
 }
@@ -349,6 +390,16 @@ LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_
                                  std::string_view name) {
   const std::string source(name);
   if (buffer.empty()) throw MeshError(source + ": buffer is empty");
+  const std::string_view text(reinterpret_cast<const char*>(buffer.data()), buffer.size());
+  std::size_t position = 0;
+  if (ply_header_unterminated(text, [&](std::string& line) {
+        if (position >= text.size()) return false;
+        const std::size_t end = std::min(text.find('\n', position), text.size());
+        line.assign(text.substr(position, end - position));
+        position = end + 1;
+        return true;
+      }))
+    throw MeshError(source + kUnterminatedPly);
   std::string hint(format_hint);
   if (!hint.empty() && hint.front() == '.') hint.erase(0, 1);
   return import_with(source, std::filesystem::path(source).stem().string(), [&](Assimp::Importer& importer) {

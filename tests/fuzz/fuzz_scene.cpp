@@ -1,0 +1,96 @@
+// libFuzzer target: the scene-file parser and the pose-file reader (bench/core/scene.hpp). Input: JSON text,
+// parsed once as a scene and once, written to a temporary file, as a pose file.
+//
+// A SceneError naming the source is the expected way to refuse. Anything else -- another exception, a crash,
+// a sanitizer report, or an accepted scene that breaks the parser's promises (every transform rigid and
+// finite, every name resolvable) -- is a finding.
+#include "bench/core/scene.hpp"
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include <unistd.h>
+
+namespace {
+
+[[noreturn]] void broken_promise(const std::string& what) {
+  std::fprintf(stderr, "fuzz_scene: accepted scene breaks a promise: %s\n", what.c_str());
+  std::abort();
+}
+
+void check_rigid(const bvhlab::RigidTransform& t, const char* where) {
+  using namespace bvhlab;
+  if (!t.rotation.allFinite() || !t.translation.allFinite())
+    broken_promise(std::string(where) + ": non-finite");
+  const double orthogonality = (t.rotation.transpose() * t.rotation - Mat3::Identity()).cwiseAbs().maxCoeff();
+  if (orthogonality > 1e-6 || t.rotation.determinant() < 0)
+    broken_promise(std::string(where) +
+                   ": not a rotation (max |R^T R - I| = " + std::to_string(orthogonality) + ")");
+}
+
+void check_scene(const bvhlab::Scene& scene) {
+  using namespace bvhlab;
+  if (scene.objects.empty() || scene.hierarchies.empty()) broken_promise("empty objects or hierarchies");
+  for (const auto& o : scene.objects) {
+    check_rigid(o.placement, "placement");
+    if (!(o.scale > 0) || !std::isfinite(o.scale)) broken_promise("scale");
+  }
+  for (const auto& p : scene.pairs)
+    if (!scene.object(p.a) || !scene.object(p.b)) broken_promise("pair names an unknown object");
+  for (const auto& s : scene.strategies) {
+    for (double p : s.p_min)
+      if (!(p >= 0 && p <= 1)) broken_promise("p_min outside [0, 1]");
+    for (const auto& name : s.hierarchies)
+      if (!scene.hierarchy(name)) broken_promise("strategy names an unknown hierarchy");
+    for (const auto& v : expand(s)) (void)v.label();
+  }
+  for (const auto& g : scene.workload.groups)
+    for (const auto& pose : g.poses) check_rigid(pose, "pose");
+}
+
+// Relative paths resolve here: an empty directory, so only catalog names (meshes/) resolve.
+const std::filesystem::path& base_dir() {
+  static const std::filesystem::path dir = [] {
+    auto d = std::filesystem::temp_directory_path() / "bvhlab-fuzz-scene-base";
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+void expect_named_refusal(const bvhlab::SceneError& e, std::string_view source) {
+  if (std::string_view(e.what()).rfind(source, 0) != 0) {
+    std::fprintf(stderr, "fuzz_scene: refusal does not start with the source %s: %s\n",
+                 std::string(source).c_str(), e.what());
+    std::abort();
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  try {
+    check_scene(bvhlab::parse_scene(text, base_dir(), "fuzz.json"));
+  } catch (const bvhlab::SceneError& e) {
+    expect_named_refusal(e, "fuzz.json");
+  }
+
+  static const std::filesystem::path pose_file = base_dir() / ("poses-" + std::to_string(getpid()) + ".json");
+  {
+    std::ofstream out(pose_file, std::ios::binary | std::ios::trunc);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  }
+  try {
+    for (const auto& group : bvhlab::load_pose_file(pose_file))
+      for (const auto& pose : group.poses) check_rigid(pose, "pose file");
+  } catch (const bvhlab::SceneError& e) {
+    expect_named_refusal(e, pose_file.string());
+  }
+  return 0;
+}

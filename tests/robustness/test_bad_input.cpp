@@ -1,0 +1,315 @@
+// Bad input: every refusal is an exception whose message names the input and the problem; nothing crashes;
+// a failed `build` leaves no file behind. The fuzz corpora double as fixtures here, so every reproducer a
+// fuzzer ever found is also a plain unit test in the normal and the ASan build.
+#include "bench/core/scene.hpp"
+#include "bench/run.hpp"
+#include "bvh/mesh_io.hpp"
+#include "support/meshes.hpp"
+#include "traversal/exact.hpp"
+#include "volumes/aabb.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+
+namespace bvhlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path source_dir() {
+  const char* dir = std::getenv("BVHLAB_SOURCE_DIR");
+  if (dir == nullptr) throw std::runtime_error("BVHLAB_SOURCE_DIR is not set (run through ctest)");
+  return dir;
+}
+
+std::vector<std::uint8_t> read_bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The fuzz target's input format: one selector byte (the format hint), then the file.
+constexpr const char* kFormats[] = {"obj", "ply", "stl", "off", "ms3d", "gltf", "glb", ""};
+struct MeshSeed {
+  std::string name, format;
+  std::vector<std::uint8_t> bytes;
+};
+std::vector<MeshSeed> mesh_seeds() {
+  std::vector<MeshSeed> out;
+  for (const auto& entry : fs::directory_iterator(source_dir() / "tests/fuzz/corpus/fuzz_mesh_load")) {
+    auto bytes = read_bytes(entry.path());
+    if (bytes.empty()) continue;
+    const std::string format = kFormats[bytes[0] % std::size(kFormats)];
+    bytes.erase(bytes.begin());
+    out.push_back({entry.path().filename().string(), format, std::move(bytes)});
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+  return out;
+}
+
+// Loads, and on success checks what every loaded mesh promises; on refusal checks the message names `name`.
+// Returns whether it loaded.
+bool load_or_refuse(std::span<const std::uint8_t> bytes, const std::string& format, const std::string& name) {
+  try {
+    const LoadedMesh loaded = load_mesh_from_memory(std::as_bytes(bytes), format, name);
+    EXPECT_FALSE(loaded.mesh.triangles.empty()) << name;
+    for (const auto& t : loaded.mesh.triangles)
+      for (auto i : t) EXPECT_LT(i, loaded.mesh.vertices.size()) << name;
+    for (const auto& v : loaded.mesh.vertices) EXPECT_TRUE(v.allFinite()) << name;
+    return true;
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    return false;
+  }
+}
+
+TEST(BadMeshInput, EverySeedLoadsAndEveryReproducerIsRefused) {
+  const auto seeds = mesh_seeds();
+  ASSERT_GE(seeds.size(), 10u);
+  for (const auto& seed : seeds) {
+    const bool reproducer = seed.name.rfind("regress_", 0) == 0;
+    EXPECT_EQ(load_or_refuse(seed.bytes, seed.format, seed.name), !reproducer) << seed.name;
+  }
+}
+
+// The first fuzz finding: an OFF file that declares more faces than it holds (any truncated OFF file) makes
+// assimp leave faces without indices, and its TriangulateProcess then hit an ai_assert that aborted the whole
+// process. The loader now validates the scene first, so this is an ordinary refusal with a message.
+TEST(BadMeshInput, TruncatedOffIsRefusedNotAborted) {
+  const std::string off = "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  try {
+    load_mesh_from_memory(std::as_bytes(std::span(off.data(), off.size())), "off", "truncated.off");
+    FAIL() << "loaded an OFF file that lacks a declared face";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated.off"), std::string::npos) << e.what();
+  }
+}
+
+// The second: assimp's PLY reader never returns on a header without an `end_header` line (any truncated
+// header). The loader refuses it before assimp sees it, from memory and from a file.
+TEST(BadMeshInput, TruncatedPlyHeaderIsRefusedNotHung) {
+  for (const std::string ply : {"ply\nformat ascii 1.0\n", "ply\nformat ascii 1.0\nelement vertex 8\nprop",
+                                "PLY\nformat binary_little_endian 1.0\nend_headerX\n"}) {
+    try {
+      load_mesh_from_memory(std::as_bytes(std::span(ply.data(), ply.size())), "ply", "cut.ply");
+      ADD_FAILURE() << "loaded " << ply;
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("cut.ply: PLY header has no end_header"), std::string::npos)
+          << e.what();
+    }
+    const fs::path file = fs::temp_directory_path() / ("bvhlab-cut-" + std::to_string(getpid()) + ".ply");
+    std::ofstream(file, std::ios::binary) << ply;
+    EXPECT_THROW(load_mesh(file), MeshError);
+    fs::remove(file);
+  }
+  // A complete header still loads, with end_header as the very last bytes or followed by CRLF.
+  for (const std::string tail : {"end_header", "end_header\r\n"}) {
+    const std::string ply = "ply\r\nformat ascii 1.0\r\nelement vertex 0\r\nproperty float x\r\n" + tail;
+    try {
+      load_mesh_from_memory(std::as_bytes(std::span(ply.data(), ply.size())), "ply", "empty.ply");
+    } catch (const MeshError& e) {
+      EXPECT_EQ(std::string(e.what()).find("end_header"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Truncations and byte flips of every seed: each loads (and then keeps the loader's promises) or is refused
+// with a message naming the input. A crash or an abort fails the whole test binary.
+TEST(BadMeshInput, MutilatedSeedsAreLoadedOrRefusedNeverCrash) {
+  std::mt19937_64 rng(6);
+  int refused = 0, loaded = 0;
+  for (const auto& seed : mesh_seeds()) {
+    const std::size_t n = seed.bytes.size();
+    for (std::size_t cut : {std::size_t{1}, n / 7, n / 3, n / 2, n - n / 5, n - 2, n - 1}) {
+      if (cut == 0 || cut >= n) continue;
+      const std::string name = seed.name + "-cut-" + std::to_string(cut);
+      (load_or_refuse(std::span(seed.bytes).first(cut), seed.format, name) ? loaded : refused)++;
+    }
+    for (int k = 0; k < 12; ++k) {
+      auto flipped = seed.bytes;
+      flipped[rng() % n] ^= static_cast<std::uint8_t>(1u << (rng() % 8));
+      const std::string name = seed.name + "-flip-" + std::to_string(k);
+      (load_or_refuse(flipped, seed.format, name) ? loaded : refused)++;
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(loaded, 0);
+}
+
+void expect_mesh_refused(const std::string& text, const std::string& format, const std::string& problem) {
+  const std::string name = "bad." + (format.empty() ? std::string("bin") : format);
+  try {
+    load_mesh_from_memory(std::as_bytes(std::span(text.data(), text.size())), format, name);
+    ADD_FAILURE() << "accepted: " << text.substr(0, 60);
+  } catch (const MeshError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(name + ": ", 0), 0u) << what;
+    EXPECT_NE(what.find(problem), std::string::npos) << "expected '" << problem << "' in: " << what;
+  }
+}
+
+TEST(BadMeshInput, RefusalsNameTheInputAndTheProblem) {
+  expect_mesh_refused("", "obj", "empty");
+  expect_mesh_refused("this is not a mesh\n", "", "");
+  expect_mesh_refused("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "NaN or infinite");
+  expect_mesh_refused("v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "NaN or infinite");
+  expect_mesh_refused("v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "NaN or infinite");  // float overflow
+  expect_mesh_refused("v 0 0 0\nv 1e16 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "coordinates too large");
+  expect_mesh_refused("v 2 2 2\nv 2 2 2\nv 2 2 2\nf 1 2 3\n", "obj", "zero size");
+  expect_mesh_refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "obj", "out of range");
+  expect_mesh_refused("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n", "off", "index out of range");
+  expect_mesh_refused("v 0 0 0\nv 1 0 0\nl 1 2\n", "obj", "no triangles");
+  expect_mesh_refused("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n", "ply", "");
+  expect_mesh_refused("solid x\nendsolid x\n", "stl", "");
+  try {
+    load_mesh(fs::temp_directory_path() / "bvhlab-no-such-mesh.obj");
+    ADD_FAILURE() << "loaded a missing file";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(load_mesh(fs::temp_directory_path()), MeshError);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Scenes and pose files
+
+void expect_scene_refused(const std::string& text, const std::string& pointer, const std::string& problem) {
+  try {
+    parse_scene(text, fs::temp_directory_path(), "bad.json");
+    ADD_FAILURE() << "accepted: " << text;
+  } catch (const SceneError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("bad.json: " + pointer, 0), 0u) << what;
+    EXPECT_NE(what.find(problem), std::string::npos) << "expected '" << problem << "' in: " << what;
+  }
+}
+
+std::string scene_with(const std::string& object_fields, const std::string& rest = "") {
+  return R"({"objects": [{"mesh": "pinion.off")" + object_fields + R"(}], "hierarchies": [{"bv": "aabb"}],)" +
+         R"( "strategies": [{"type": "exact"}])" + rest + "}";
+}
+
+TEST(BadSceneInput, RefusalsNameTheFileTheFieldAndTheProblem) {
+  ASSERT_NO_THROW(parse_scene(scene_with(""), fs::temp_directory_path(), "good.json"));
+  expect_scene_refused("{", "", "not valid JSON");
+  expect_scene_refused("[]", "/", "expected an object");
+  expect_scene_refused(scene_with(R"(, "placement": {"rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 2]]})"),
+                       "/objects/0/placement/rotation", "not orthonormal");
+  expect_scene_refused(scene_with(R"(, "placement": {"rotation": [[1, 0, 0], [0, 1, 0], [0, 0, -1]]})"),
+                       "/objects/0/placement/rotation", "reflection");
+  expect_scene_refused(scene_with(R"(, "placement": {"rotation": [[1, 0, 0], [0, 1, 0]]})"),
+                       "/objects/0/placement/rotation", "3 rows");
+  expect_scene_refused(scene_with(R"(, "placement": {"axis_angle_deg": [0, 0, 0, 90]})"),
+                       "/objects/0/placement/axis_angle_deg", "zero length");
+  expect_scene_refused(scene_with(R"(, "scale": -1)"), "/objects/0/scale", "");
+  expect_scene_refused(scene_with(R"(, "mesh": "x")"), "/objects/0/mesh", "");
+  expect_scene_refused(scene_with("", R"(, "workload": {"steps": 0})"), "/workload/steps", "integer in");
+  expect_scene_refused(scene_with("", R"(, "workload": {"type": "poses", "file": "/nonexistent/p.json"})"),
+                       "/workload/file", "cannot read");
+  expect_scene_refused(R"({"objects": [{"mesh": "pinion.off"}], "hierarchies": [{"bv": "abb"}],
+                           "strategies": [{"type": "exact"}]})",
+                       "/hierarchies/0/bv", "expected one of");
+}
+
+// DISABLED until bench/core/scene.cpp catches every nlohmann::json exception: a number beyond double's
+// range ("1e999") throws json::out_of_range (406) from the parser, which escapes as a bare exception without
+// the file's name (parse_json catches only parse_error). Reported to the lead.
+TEST(BadSceneInput, DISABLED_NumberOutOfRangeIsASceneError) {
+  expect_scene_refused(scene_with(R"(, "placement": {"translation": [1e999, 0, 0]})"), "", "");
+}
+
+// A caller's rotation that is not one must be refused, whatever way it is written. An axis whose length
+// overflows a double normalises to the zero vector, and AngleAxis then builds a matrix that is no rotation.
+// DISABLED until bench/core/scene.cpp checks the normalised axis (measured: [1e200, 1e200, 0, 90] is accepted
+// as 6e-17 * I, [1e308, 0, 0, 45] as 0.707 * I). Reported to the lead.
+TEST(BadSceneInput, DISABLED_HugeAxisAngleAxisIsRefusedOrRigid) {
+  for (const char* axis : {"[1e200, 1e200, 0, 90]", "[1e308, 0, 0, 45]", "[1e-200, 1e-200, 0, 90]"}) {
+    SCOPED_TRACE(axis);
+    try {
+      const Scene scene =
+          parse_scene(scene_with(std::string(R"(, "placement": {"axis_angle_deg": )") + axis + "}"),
+                      fs::temp_directory_path(), "axis.json");
+      const Mat3& r = scene.objects[0].placement.rotation;
+      ASSERT_TRUE(r.allFinite());
+      EXPECT_LT((r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-9) << r;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("axis_angle_deg"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// A failed build writes nothing: no tree, no temporary left behind, and an older tree stays intact.
+
+class FailedBuild : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("bvhlab-failed-build-" + std::to_string(getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  [[nodiscard]] std::vector<std::string> files() const {
+    std::vector<std::string> out;
+    for (const auto& e : fs::recursive_directory_iterator(dir_))
+      out.push_back(e.path().lexically_relative(dir_));
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  static SceneObject object(const fs::path& mesh) {
+    SceneObject o;
+    o.name = mesh.stem().string();
+    o.mesh = mesh.string();
+    o.path = mesh;
+    return o;
+  }
+  static HierarchySpec aabb() {
+    HierarchySpec h;
+    h.name = h.bv = "aabb";
+    return h;
+  }
+  fs::path dir_;
+};
+
+TEST_F(FailedBuild, CorruptMeshLeavesNoFile) {
+  const fs::path mesh = dir_ / "broken.obj";
+  std::ofstream(mesh) << "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n";
+  const fs::path output = dir_ / "out.tree";
+  EXPECT_THROW(build_tree_file(object(mesh), aabb(), {}, output, 1), MeshError);
+  EXPECT_EQ(files(), std::vector<std::string>{"broken.obj"});
+}
+
+TEST_F(FailedBuild, OlderTreeSurvivesAFailedRebuild) {
+  const fs::path good = testing::bundled_mesh("pinion.off");
+  const fs::path output = dir_ / "pinion.tree";
+  build_tree_file(object(good), aabb(), {}, output, 1);
+  const auto before = read_bytes(output);
+  ASSERT_FALSE(before.empty());
+  const fs::path broken = dir_ / "broken.obj";
+  std::ofstream(broken) << "v 0 0 0\nf 1 1 1\n";
+  EXPECT_THROW(build_tree_file(object(broken), aabb(), {}, output, 1), MeshError);
+  EXPECT_EQ(read_bytes(output), before);
+  EXPECT_EQ(files(), (std::vector<std::string>{"broken.obj", "pinion.tree"}));
+}
+
+TEST_F(FailedBuild, UnwritableDestinationLeavesNoTemporary) {
+  const fs::path good = testing::bundled_mesh("pinion.off");
+  // The destination is an existing, non-empty directory: the final rename must fail.
+  const fs::path output = dir_ / "taken.tree";
+  fs::create_directories(output / "inside");
+  EXPECT_ANY_THROW(build_tree_file(object(good), aabb(), {}, output, 1));
+  EXPECT_EQ(files(), (std::vector<std::string>{"taken.tree", "taken.tree/inside"}));
+  // The destination's parent is a regular file.
+  const fs::path blocker = dir_ / "file";
+  std::ofstream(blocker) << "x";
+  EXPECT_ANY_THROW(build_tree_file(object(good), aabb(), {}, blocker / "out.tree", 1));
+  EXPECT_EQ(files(), (std::vector<std::string>{"file", "taken.tree", "taken.tree/inside"}));
+}
+
+}  // namespace
+}  // namespace bvhlab
