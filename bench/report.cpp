@@ -336,10 +336,11 @@ std::string report_snippet(const RunOutput& run, const std::filesystem::path& re
   std::ostringstream md;
   bool fell_back = false;
   const auto [lo, hi] = quality_range(run, &fell_back);
-  md << "## Results\n\n`make demo` runs `bench/scenes/" << run.scene.file.filename().string()
-     << "` and writes a report folder (`" << report_dir.filename().string()
-     << "/README.md`, `results.csv`, five figures). On " << run.environment.machine << " ("
-     << run.environment.build_type << ", commit `" << run.environment.git_commit << "`), over "
+  md << "## Results\n\nScene `" << run.scene.file.filename().string() << "` (" << run.stats.queries
+     << " timed queries; `make demo` runs `bench/scenes/demo.json`) writes a report folder (`"
+     << report_dir.filename().string() << "/README.md`, `results.csv`, five figures). On "
+     << run.environment.machine << " (" << run.environment.build_type << ", commit `"
+     << run.environment.git_commit << "`), over "
      << (fell_back ? std::string("all distances") : "distances " + fmt("%g", lo) + "–" + fmt("%g", hi))
      << ":\n\n";
   for (const auto& p : operating_points(run))
