@@ -207,6 +207,7 @@ def figure_error_vs_time(rows, args, out):
     for (ax,), mesh in zip(per_mesh, meshes):
         groups = grouped([r for r in rows if r["mesh"] == mesh])
         curves = {}
+        budget_markers = iter(["D", "P", "X", "*", "v", "<", ">"])  # one marker per time-critical budget
         for key, series in groups.items():
             first = series[0]
             agg = aggregate(series, args.quality_min, args.quality_max)
@@ -216,6 +217,8 @@ def figure_error_vs_time(rows, args, out):
                 curves.setdefault(first["hierarchy"], []).append((float(first["p_min"]), agg))
                 continue
             colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies)
+            if first["strategy"] == "time_critical":
+                marker = next(budget_markers, "D")
             ax.plot([agg["time"]], [100 * (agg["fp"] + agg["fn"])], marker, color=colour, markersize=8,
                     linestyle="none", label=f"{first['hierarchy']}: {series_label(first)}")
         for hierarchy, points in curves.items():

@@ -44,6 +44,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using LogFn = std::function<void(const std::string&)>;
 constexpr double kNotApplicable = std::numeric_limits<double>::quiet_NaN();
+/// Poses per block of the interleaved timing loop (see run_scene).
+constexpr std::size_t kPoseBlock = 50;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -871,7 +873,7 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
   std::map<std::string, CalibrationAccumulator> calibration;
   std::map<std::string, CalibrationBin> calibration_keys;
   std::vector<std::string> calibration_order;
-  std::vector<QueryRecord> records;
+  std::vector<QueryRecord> block_records;
 
   for (const ScenePair* pair : pairs) {
     const ObjectData& a = object(pair->a);
@@ -938,15 +940,35 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
       output.truth.push_back(summary);
     }
 
-    // The timed queries: every hierarchy and strategy on the same poses, distance by distance.
+    // The timed queries: every hierarchy and strategy on the same poses, distance by distance. The poses run
+    // in blocks, each block through every series in turn, so a slow spell of a shared machine (another
+    // process, frequency changes) spreads over all series instead of landing on one; within a block the
+    // caches stay warm.
     for (std::size_t g = 0; g < scene.workload.groups.size(); ++g) {
       const PoseGroup& group = scene.workload.groups[g];
       const auto& expected = (*truth)[g];
+      std::vector<std::vector<std::vector<QueryRecord>>> series(plan.size());
+      for (std::size_t i = 0; i < plan.size(); ++i) series[i].resize(plan[i].second.size());
+      const std::span<const RigidTransform> poses(group.poses);
+      for (std::size_t begin = 0; begin < poses.size(); begin += kPoseBlock) {
+        const auto block = poses.subspan(begin, std::min(kPoseBlock, poses.size() - begin));
+        for (std::size_t i = 0; i < plan.size(); ++i)
+          for (std::size_t v = 0; v < plan[i].second.size(); ++v) {
+            prepared[i]->run(plan[i].second[v], block, options.warmup_queries, block_records);
+            series[i][v].insert(series[i][v].end(), block_records.begin(), block_records.end());
+          }
+        char distance[16];
+        std::snprintf(distance, sizeof distance, "%g", group.distance);
+        std::size_t done = 0;
+        for (const auto& [h, variants] : plan) done += variants.size() * block.size();
+        progress.advance(done, label + " d=" + distance);
+      }
       for (std::size_t i = 0; i < plan.size(); ++i) {
         const HierarchySpec& h = *plan[i].first;
         const PreparedHierarchy& hierarchy = *prepared[i];
-        for (const StrategyVariant& variant : plan[i].second) {
-          hierarchy.run(variant, group.poses, options.warmup_queries, records);
+        for (std::size_t v = 0; v < plan[i].second.size(); ++v) {
+          const StrategyVariant& variant = plan[i].second[v];
+          const std::vector<QueryRecord>& records = series[i][v];
           ResultRow row;
           row.mesh = label;
           row.hierarchy = h.name;
@@ -1013,9 +1035,6 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
           stats.queries += records.size();
           stats.query_seconds += sum_us * 1e-6;
           output.rows.push_back(row);
-          char distance[16];
-          std::snprintf(distance, sizeof distance, "%g", group.distance);
-          progress.advance(records.size(), label + " d=" + distance + " " + h.name + " " + variant.label());
         }
       }
     }

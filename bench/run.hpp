@@ -20,7 +20,7 @@ struct RunOptions {
   /// Receives messages (skipped objects, rejected cache entries, what is being built). Default: stderr.
   std::function<void(const std::string&)> log;
   unsigned threads = 0;    ///< preprocessing threads; 0: hardware concurrency
-  int warmup_queries = 3;  ///< untimed queries before each timed series (caches, branch predictors)
+  int warmup_queries = 2;  ///< untimed queries before each timed block of poses (caches, branch predictors)
 };
 
 /// Evidence of what the run did, for the "only what is needed" rule and the cache.
