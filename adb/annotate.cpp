@@ -49,9 +49,13 @@ struct TriangleInfo {
 };
 
 /// The (possibly expanded) box a triangle is clipped against.
+/// The box a triangle is clipped against: per axis the two cell planes, or `open` for a face that cannot cut
+/// the triangle (it is then placed well outside the triangle when the cuboid is built).
 struct ClipBox {
   std::array<double, 3> lo{};
   std::array<double, 3> hi{};
+  std::array<bool, 3> open_lo{};
+  std::array<bool, 3> open_hi{};
 };
 
 /// Inclusive range of cell indices along one axis; empty when first > last.
@@ -129,31 +133,77 @@ Placement place(const Grid& grid, const TriangleInfo& t) {
   return p;
 }
 
-/// The box to clip against for cell (i, j, k). A face that cannot cut the triangle is moved away from it:
-/// along an axis where the cell contains the triangle's extent (both faces), and the grid's outer faces
-/// when the triangle lies on their inner side (always, in a valid tree). The clipped polygon is the same,
-/// a zero-width slab (flat node) never reaches CGAL as a degenerate cuboid, and, above all, a vertex lying
-/// exactly on the node box (the box is fitted to the vertices, so every node has such vertices) does not
-/// make the lazy kernel's interval filter fail and recompute the whole clip in rationals.
-/// Returns false when the cell meets the triangle in zero area: a zero-width slab that does not contain the
-/// triangle's extent.
+/// The box to clip against for cell (i, j, k). A face that cannot cut the triangle is left open: both faces
+/// along an axis where the cell contains the triangle's extent, and the grid's outer faces when the triangle
+/// lies on their inner side (always, in a valid tree). The clipped polygon is the same, a zero-width slab
+/// (flat node) never reaches CGAL as a degenerate cuboid, and, above all, a vertex lying exactly on the node
+/// box (the box is fitted to the vertices, so every node has such vertices) does not make an interval
+/// decision uncertain. Returns false when the cell meets the triangle in zero area: a zero-width slab that
+/// does not contain the triangle's extent.
 bool make_clip_box(const Grid& grid, const TriangleInfo& t, const Placement& p,
                    const std::array<int, 3>& cell, ClipBox& out) {
   for (int a = 0; a < 3; ++a) {
-    const double margin = std::max({1.0, std::abs(t.min[a]), std::abs(t.max[a])});
-    const double far_below = t.min[a] - margin, far_above = t.max[a] + margin;
     const int g = grid.g;
+    out.lo[a] = grid.c[a][cell[a]];
+    out.hi[a] = grid.c[a][cell[a] + 1];
     if (p.contained[a]) {
-      out.lo[a] = far_below;
-      out.hi[a] = far_above;
+      out.open_lo[a] = out.open_hi[a] = true;
     } else {
-      const double lo = grid.c[a][cell[a]], hi = grid.c[a][cell[a] + 1];
-      if (!(lo < hi)) return false;
-      out.lo[a] = cell[a] == 0 && t.min[a] >= lo ? far_below : lo;
-      out.hi[a] = cell[a] == g - 1 && t.max[a] <= hi ? far_above : hi;
+      if (!(out.lo[a] < out.hi[a])) return false;
+      out.open_lo[a] = cell[a] == 0 && t.min[a] >= out.lo[a];
+      out.open_hi[a] = cell[a] == g - 1 && t.max[a] <= out.hi[a];
     }
   }
   return true;
+}
+
+/// a - b, and whether that double is the exact difference (TwoSum's error term is zero).
+bool exact_difference(double a, double b, double& difference) {
+  difference = a - b;
+  const double b_virtual = difference - a;
+  const double a_virtual = difference - b_virtual;
+  return (a - a_virtual) + (-b - b_virtual) == 0.0;
+}
+
+/// A clip problem in concrete coordinates.
+struct ClipProblem {
+  TrianglePoints triangle;
+  std::array<double, 3> lo{};
+  std::array<double, 3> hi{};
+};
+
+/// The clip problem translated, per axis, by the triangle's smallest coordinate whenever every subtraction
+/// involved is exact (Sterbenz: values within a factor 2 of each other), so it is the same problem with
+/// small coordinates: a leaf of the 871k dragon is 1e-4 wide at coordinates near 1, and interval arithmetic
+/// on the raw coordinates loses four more digits in every clipping step. Open faces are placed one triangle
+/// extent outside the triangle.
+ClipProblem shifted(const TrianglePoints& t, const ClipBox& box) {
+  ClipProblem out;
+  double largest_extent = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double lo = std::min({t[0][a], t[1][a], t[2][a]}), hi = std::max({t[0][a], t[1][a], t[2][a]});
+    largest_extent = std::max(largest_extent, hi - lo);
+  }
+  for (int a = 0; a < 3; ++a) {
+    const double shift = std::min({t[0][a], t[1][a], t[2][a]});
+    std::array<double, 3> v{};
+    double lo = 0, hi = 0;
+    bool exact = true;
+    for (int k = 0; k < 3; ++k) exact = exact_difference(t[k][a], shift, v[k]) && exact;
+    if (!box.open_lo[a]) exact = exact_difference(box.lo[a], shift, lo) && exact;
+    if (!box.open_hi[a]) exact = exact_difference(box.hi[a], shift, hi) && exact;
+    if (!exact) {
+      for (int k = 0; k < 3; ++k) v[k] = t[k][a];
+      lo = box.lo[a];
+      hi = box.hi[a];
+    }
+    for (int k = 0; k < 3; ++k) out.triangle[k][a] = v[k];
+    const double t_lo = std::min({v[0], v[1], v[2]}), t_hi = std::max({v[0], v[1], v[2]});
+    const double margin = std::max({largest_extent, std::abs(t_lo), std::abs(t_hi)});
+    out.lo[a] = box.open_lo[a] ? t_lo - margin : lo;
+    out.hi[a] = box.open_hi[a] ? t_hi + margin : hi;
+  }
+  return out;
 }
 
 Bounds to_bounds(const Interval& x) {
@@ -230,14 +280,15 @@ Bounds result_area_bounds(const Result& result, Approx&& approx) {
 
 /// CGAL::intersection in interval arithmetic (what Epeck does first internally, without building its lazy
 /// DAG). Empty when one of its decisions is uncertain: a vertex on or very near a clipping plane.
-std::optional<Bounds> interval_clip(const TrianglePoints& t, const ClipBox& box) {
+std::optional<Bounds> interval_clip(const ClipProblem& problem) {
   try {
     CGAL::Protect_FPU_rounding<true> guard;
     using P = IntervalPoint;
+    const TrianglePoints& t = problem.triangle;
     const IntervalKernel::Triangle_3 tri(P(t[0].x(), t[0].y(), t[0].z()), P(t[1].x(), t[1].y(), t[1].z()),
                                          P(t[2].x(), t[2].y(), t[2].z()));
-    const IntervalKernel::Iso_cuboid_3 cuboid(P(box.lo[0], box.lo[1], box.lo[2]),
-                                              P(box.hi[0], box.hi[1], box.hi[2]));
+    const IntervalKernel::Iso_cuboid_3 cuboid(P(problem.lo[0], problem.lo[1], problem.lo[2]),
+                                              P(problem.hi[0], problem.hi[1], problem.hi[2]));
     const auto result = CGAL::intersection(tri, cuboid);
     return result_area_bounds<IntervalKernel>(result, [](const P& p) { return p; });
   } catch (const CGAL::Uncertain_conversion_exception&) {
@@ -246,35 +297,43 @@ std::optional<Bounds> interval_clip(const TrianglePoints& t, const ClipBox& box)
 }
 
 /// Certified area of triangle ∩ box.
-/// Uncertain interval decisions are frequent in one structural case: a leaf's box is its triangle's bounding
+/// Interval decisions are uncertain in one frequent structural case: a leaf's box is its triangle's bounding
 /// box, so when the mesh coordinates are floats the mid-planes of two axes meet exactly on the edge that
 /// spans the box diagonally, and the clipped vertex on one plane lies exactly on the next. Recomputing such a
 /// clip in rationals (Epeck's fallback) costs about 100 times more. Instead the area is bracketed: the area
-/// inside a box is monotone under inclusion, so the clips against the box shrunk and grown by a hair
-/// (2^-26 of the cell's width or 2^-34 of its coordinates, whichever is larger: more than the
-/// intervals' own growth, so the clips are in general position again) bound it from below and above. The
-/// bracket is narrower than any realistic margin to the threshold; cells it leaves undecided go to the exact
-/// decision. Only if the bracketing clips are uncertain too does Epeck compute the exact polygon.
+/// inside a box is monotone under inclusion, so the clips against the box shrunk and grown by a hair (about
+/// 2^-26 of the cell, at least 2^-40 of its coordinates) bound it from below and above. The bracket is
+/// narrower than any realistic margin to the threshold; cells it leaves undecided go to the exact decision.
+/// Only if the bracketing clips are uncertain too does Epeck compute the exact polygon.
 Bounds clipped_area_bounds(const TrianglePoints& t, const ClipBox& box) {
-  if (const auto area = interval_clip(t, box)) return *area;
+  if (const auto area = interval_clip(shifted(t, box))) return *area;
   ClipBox inner = box, outer = box;
   bool inner_empty = false;
+  // One length for all axes, times a different factor per axis: a hair proportional to each cell's own
+  // width would move the two planes through a box-diagonal edge by the same edge parameter and rebuild the
+  // very coincidence it is meant to break.
+  double length = 0;
+  for (int a = 0; a < 3; ++a)
+    if (!box.open_lo[a] || !box.open_hi[a]) length = std::max(length, box.hi[a] - box.lo[a]);
+  constexpr double kFactor[3] = {1.0, 1.3819660112501051, 1.6180339887498949};
   for (int a = 0; a < 3; ++a) {
     const double hair =
-        std::max((box.hi[a] - box.lo[a]) * 0x1p-26, (std::abs(box.lo[a]) + std::abs(box.hi[a])) * 0x1p-34);
-    inner.lo[a] += hair;
-    inner.hi[a] -= hair;
-    outer.lo[a] -= hair;
-    outer.hi[a] += hair;
+        kFactor[a] * std::max(length * 0x1p-26, (std::abs(box.lo[a]) + std::abs(box.hi[a])) * 0x1p-40);
+    if (!box.open_lo[a]) inner.lo[a] += hair, outer.lo[a] -= hair;
+    if (!box.open_hi[a]) inner.hi[a] -= hair, outer.hi[a] += hair;
     inner_empty = inner_empty || !(inner.lo[a] < inner.hi[a]);
   }
-  const std::optional<Bounds> lower = inner_empty ? std::optional<Bounds>(Bounds{}) : interval_clip(t, inner);
-  const std::optional<Bounds> upper = interval_clip(t, outer);
+  const std::optional<Bounds> lower =
+      inner_empty ? std::optional<Bounds>(Bounds{}) : interval_clip(shifted(t, inner));
+  const std::optional<Bounds> upper = interval_clip(shifted(t, outer));
   if (lower && upper) return {lower->lo, upper->hi};
 
   using P = Epeck::Point_3;
-  const Epeck::Triangle_3 tri(point<Epeck>(t[0]), point<Epeck>(t[1]), point<Epeck>(t[2]));
-  const Epeck::Iso_cuboid_3 cuboid(P(box.lo[0], box.lo[1], box.lo[2]), P(box.hi[0], box.hi[1], box.hi[2]));
+  const ClipProblem problem = shifted(t, box);
+  const TrianglePoints& s = problem.triangle;
+  const Epeck::Triangle_3 tri(point<Epeck>(s[0]), point<Epeck>(s[1]), point<Epeck>(s[2]));
+  const Epeck::Iso_cuboid_3 cuboid(P(problem.lo[0], problem.lo[1], problem.lo[2]),
+                                   P(problem.hi[0], problem.hi[1], problem.hi[2]));
   const auto result = CGAL::intersection(tri, cuboid);
   return result_area_bounds<Epeck>(result, [](const P& p) { return CGAL::approx(p); });
 }
@@ -302,8 +361,11 @@ Rational polygon_squared_area(const Points& pts) {
 Rational clipped_squared_area_exact(const TrianglePoints& t, const ClipBox& box) {
   using K = RationalKernel;
   using P = K::Point_3;
-  const K::Triangle_3 tri(point<K>(t[0]), point<K>(t[1]), point<K>(t[2]));
-  const K::Iso_cuboid_3 cuboid(P(box.lo[0], box.lo[1], box.lo[2]), P(box.hi[0], box.hi[1], box.hi[2]));
+  const ClipProblem problem = shifted(t, box);
+  const TrianglePoints& s = problem.triangle;
+  const K::Triangle_3 tri(point<K>(s[0]), point<K>(s[1]), point<K>(s[2]));
+  const K::Iso_cuboid_3 cuboid(P(problem.lo[0], problem.lo[1], problem.lo[2]),
+                               P(problem.hi[0], problem.hi[1], problem.hi[2]));
   const auto result = CGAL::intersection(tri, cuboid);
   if (!result) return Rational(0);
   if (const auto* piece = boost::get<K::Triangle_3>(&*result))
