@@ -48,7 +48,6 @@ struct TriangleInfo {
   bool degenerate = false;
 };
 
-/// The (possibly expanded) box a triangle is clipped against.
 /// The box a triangle is clipped against: per axis the two cell planes, or `open` for a face that cannot cut
 /// the triangle (it is then placed well outside the triangle when the cuboid is built).
 struct ClipBox {
