@@ -294,9 +294,33 @@ LoadedMesh merge_scene(const aiScene& scene, const std::string& source, std::str
   return merger.finish(std::move(name));
 }
 
-// Validation first: Debian's assimp keeps its ai_asserts, and TriangulateProcess aborts the whole process on
-// a face without indices (any truncated OFF file; found by tests/fuzz); validation refuses such a scene.
-constexpr unsigned kPostProcess = aiProcess_ValidateDataStructure | aiProcess_Triangulate;
+// Debian's assimp keeps its ai_asserts, and TriangulateProcess aborts the whole process on a face without
+// indices or on a mesh that claims polygons it does not have (truncated or corrupt OFF and PLY files; found
+// by tests/fuzz). So a scene is read and validated first, then checked and its primitive types recomputed
+// from its faces (prepare_for_triangulation), and only then triangulated.
+constexpr unsigned kPostProcess = aiProcess_ValidateDataStructure;
+
+/// Empty when `scene` is safe to triangulate, else the problem.
+std::string prepare_for_triangulation(aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    aiMesh* mesh = scene.mMeshes[m];
+    if (mesh == nullptr) continue;
+    if (mesh->mNumFaces > 0 && mesh->mFaces == nullptr)
+      return describe_submesh(m, *mesh) + " has no faces array";
+    unsigned types = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices == 0 || face.mIndices == nullptr)
+        return "face " + std::to_string(f) + " of " + describe_submesh(m, *mesh) + " has no vertex indices";
+      types |= face.mNumIndices == 1   ? aiPrimitiveType_POINT
+               : face.mNumIndices == 2 ? aiPrimitiveType_LINE
+               : face.mNumIndices == 3 ? aiPrimitiveType_TRIANGLE
+                                       : aiPrimitiveType_POLYGON;
+    }
+    mesh->mPrimitiveTypes = types;
+  }
+  return {};
+}
 
 template <class ReadFn>
 LoadedMesh import_with(const std::string& source, std::string name, ReadFn read) {
@@ -304,9 +328,14 @@ LoadedMesh import_with(const std::string& source, std::string name, ReadFn read)
   LogCapture capture;
   Assimp::Importer importer;
   const aiScene* scene = nullptr;
+  std::string problem;
   try {
     ScopedCapture scoped(capture);
     scene = read(importer);
+    if (scene != nullptr) {
+      problem = prepare_for_triangulation(*const_cast<aiScene*>(scene));  // the importer's own scene
+      if (problem.empty()) scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
+    }
   } catch (const std::exception& e) {  // assimp reports through GetErrorString; this is for bad_alloc & co.
     throw MeshError(source + ": reading failed: " + e.what());
   }
@@ -327,6 +356,7 @@ LoadedMesh import_with(const std::string& source, std::string name, ReadFn read)
       throw MeshError(source + ": index out of range (assimp: " + error + ")");
     throw MeshError(source + ": assimp could not read it: " + (error.empty() ? "unknown error" : error));
   }
+  if (!problem.empty()) throw MeshError(source + ": " + problem);
   for (const auto& m : log)
     if (reports_bad_index(m)) throw MeshError(source + ": index out of range (assimp: " + m + ")");
 

@@ -6,6 +6,7 @@
 #include "bvh/bvh.hpp"
 #include "traversal/adb.hpp"
 #include "traversal/exact.hpp"
+#include "volumes/aabb.hpp"
 
 #include <gtest/gtest.h>
 

@@ -77,7 +77,8 @@ TEST(BadMeshInput, EverySeedLoadsAndEveryReproducerIsRefused) {
 
 // The first fuzz finding: an OFF file that declares more faces than it holds (any truncated OFF file) makes
 // assimp leave faces without indices, and its TriangulateProcess then hit an ai_assert that aborted the whole
-// process. The loader now validates the scene first, so this is an ordinary refusal with a message.
+// process; a PLY face line with a stray character did the same. The loader now checks the scene before
+// triangulating, so these are ordinary refusals with a message.
 TEST(BadMeshInput, TruncatedOffIsRefusedNotAborted) {
   const std::string off = "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   try {
@@ -86,6 +87,34 @@ TEST(BadMeshInput, TruncatedOffIsRefusedNotAborted) {
   } catch (const MeshError& e) {
     EXPECT_NE(std::string(e.what()).find("truncated.off"), std::string::npos) << e.what();
   }
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+      "3 0(y\nfo3 0 2 3\n";
+  try {
+    load_mesh_from_memory(std::as_bytes(std::span(ply.data(), ply.size())), "ply", "stray.ply");
+    FAIL() << "loaded a PLY file with a broken face line";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("stray.ply"), std::string::npos) << e.what();
+  }
+}
+
+// The fix reads and checks the scene before assimp triangulates it; polygons must still be triangulated by
+// assimp's ear clipping, not by a fan: this concave L-shaped hexagon starts at a vertex that does not see the
+// whole polygon, so a fan from it would leave the polygon.
+TEST(BadMeshInput, ConcavePolygonIsStillTriangulatedInsideItself) {
+  const std::string obj = "v 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\nf 1 2 3 4 5 6\n";
+  const LoadedMesh loaded =
+      load_mesh_from_memory(std::as_bytes(std::span(obj.data(), obj.size())), "obj", "l.obj");
+  ASSERT_EQ(loaded.mesh.triangle_count(), 4u);
+  double area = 0;
+  for (std::size_t i = 0; i < loaded.mesh.triangle_count(); ++i) {
+    const auto t = loaded.mesh.triangle(i);
+    area += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).norm();
+    const Vec3 c = (t[0] + t[1] + t[2]) / 3;
+    EXPECT_FALSE(c.x() > 1 && c.y() > 1) << "triangle " << i << " lies outside the L";
+  }
+  EXPECT_NEAR(area, 3.0, 1e-12);
 }
 
 // The second: assimp's PLY reader never returns on a header without an `end_header` line (any truncated
