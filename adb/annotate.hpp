@@ -22,16 +22,26 @@
 //   the table value closest to "one possible collision cell per c^2 of surface" (the balls-into-bins
 //   model's reading of pc) while still ignoring cells a surface only nicks at a corner.
 //
-// Exactness ("exact where it matters": only the thresholded decision is stored)
-// - A triangle whose bounding box lies inside one closed cell contributes its whole area (no clipping).
-// - Otherwise it is clipped with CGAL::intersection(Triangle_3, Iso_cuboid_3) in the Epeck kernel: the
-// clipped
-//   polygon is exact (lazy), and its area is taken as the certified interval of the lazy approximation.
-// - Per cell the intervals are summed with a rigorous rounding bound and compared with a certified interval
-//   of tau * F. Only when the two intervals overlap (a tie or a near-tie, e.g. axis-aligned CAD faces) is the
-//   cell decided exactly: polygon areas as exact rationals squared (Simple_cartesian<Gmpq>), and
-//   sum sqrt(q_i) >= T decided with GMP/MPFR (an exact rational sum when every q_i is a perfect square;
-//   otherwise the sum is irrational, so it differs from the rational T and interval refinement ends).
+// Exactness ("exact where it matters": only the thresholded count is stored, so every cell decision is
+// certified, and arithmetic is exact only where a decision needs it)
+// - Every area is carried as a certified interval. A triangle whose bounding box lies inside one closed cell
+//   contributes its whole area, no clipping (most triangle-node pairs: in every node above the last few
+//   levels a triangle is small against the cells).
+// - Otherwise it is clipped by CGAL::intersection(Triangle_3, Iso_cuboid_3) on an interval-arithmetic
+//   kernel (Simple_cartesian<Interval_nt>: what Epeck evaluates first, without its lazy DAG), in coordinates
+//   translated exactly to the triangle, with every face that cannot cut it moved out of the way. When an
+//   interval decision is uncertain (a vertex on a clipping plane; frequent in leaves of float meshes, where
+//   the mid-planes pass through edge midpoints), the area is bracketed by clips against the cell shrunk and
+//   grown by a hair (area is monotone under inclusion); only if that fails too does Epeck clip exactly.
+//   Measured on the 871k dragon: 18.66M clips, 971 brackets, 670 Epeck clips. Epeck for every clip measured
+//   2-3 times slower, and its rational fallbacks are some 100 times slower than an interval clip.
+// - A cell is decided as soon as its bounds allow (area certainly >= tau F, or certainly below it even if all
+//   pending triangles fell inside in full); the last open candidate cell of a triangle gets the triangle's
+//   area minus the others'. Cells whose bounds still straddle the threshold (ties, near-ties: exact ones in
+//   axis-aligned test meshes, a handful in real meshes) are decided exactly: polygon areas squared as exact
+//   rationals (Simple_cartesian<Gmpq>), and sum sqrt(q_i) >= T decided with GMP/MPFR (an exact rational sum
+//   when every q_i is a perfect square; otherwise the sum is irrational, hence differs from the rational T,
+//   and interval refinement terminates).
 // - Degenerate (exactly collinear) triangles have area 0 and are skipped. A cell with area 0 never counts.
 #pragma once
 
