@@ -40,6 +40,9 @@ struct RestrictedBox {
 
   static constexpr std::string_view name() { return "rbox"; }
 
+  /// For loaders of raw node bytes: a stored node must name an axis and a finite, ordered interval.
+  [[nodiscard]] bool valid() const { return axis < 3 && std::isfinite(lo) && std::isfinite(hi) && lo <= hi; }
+
   static RestrictedBox encode(const Aabb& parent, const Aabb& child) {
     // Keep the axis whose restriction removes the most volume, i.e. the smallest extent ratio.
     RestrictedBox best;

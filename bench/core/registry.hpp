@@ -25,7 +25,7 @@ using RegisteredVolumes =
 
 /// Calls f(std::type_identity<BV>{}) for the BV whose name() is `name`; throws naming the choices.
 template <class F, class... BVs>
-decltype(auto) with_volume_impl(std::string_view name, F&& f, TypeList<BVs...>) {
+auto with_volume_impl(std::string_view name, F&& f, TypeList<BVs...>) {
   using R = decltype(f(std::type_identity<Aabb>{}));
   if constexpr (std::is_void_v<R>) {
     bool found = false;
@@ -39,7 +39,7 @@ decltype(auto) with_volume_impl(std::string_view name, F&& f, TypeList<BVs...>) 
   }
 }
 template <class F>
-decltype(auto) with_volume(std::string_view name, F&& f) {
+auto with_volume(std::string_view name, F&& f) {
   return with_volume_impl(name, std::forward<F>(f), RegisteredVolumes{});
 }
 

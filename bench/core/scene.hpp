@@ -10,7 +10,7 @@
 //     "hierarchies": [ {"bv": "aabb", "name": "aabb", "split": "sah", "max_leaf_triangles": 1},
 //                      {"bv": "fcl_obbrss", "optional": true} ],   // optional: skipped if this build lacks
 //                      it
-//     "annotation": {"type": "adb", "grid": 2, "tau": 0.5},     // or {"type": "none"} (the default)
+//     "annotation": {"type": "adb", "grid": 2, "tau": 0.25},     // or {"type": "none"} (the default)
 //     "strategies": [ {"type": "exact"}, {"type": "guided_exact"},
 //                     {"type": "adb", "p_min": [0.5, 0.9]},
 //                     {"type": "time_critical", "p_min": 0.9, "budgets": [{"bv_tests": 200}, {"deadline_us":
@@ -28,6 +28,7 @@
 // the length of the translation) is the value the report files the pose under in its "distance" column.
 #pragma once
 
+#include "adb/annotate.hpp"
 #include "bvh/topology.hpp"
 #include "traversal/adb.hpp"
 #include "volumes/geometry.hpp"
@@ -73,8 +74,8 @@ struct HierarchySpec {
 
 struct AnnotationSpec {
   bool adb = false;
-  int grid = 2;      ///< cells per axis, 2..4
-  double tau = 0.5;  ///< area threshold, fraction of the cell face area
+  int grid = 2;                 ///< cells per axis, 2..4
+  double tau = kDefaultAdbTau;  ///< area threshold, fraction of the cell face area
 };
 
 enum class StrategyKind { Exact, GuidedExact, Adb, TimeCritical };

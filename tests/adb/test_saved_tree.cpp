@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <unistd.h>
 #include <cstddef>
 #include <cstring>
@@ -304,6 +306,20 @@ TEST(SavedTree, AVolumeModelCanRefuseItsOwnBytes) {
   put_u32(bytes, third_tag, 7);
   reseal(bytes);
   expect_rejected([&] { load_tree_from_buffer<CheckedBox>(bytes); }, "node 3 has an invalid volume");
+}
+
+TEST(SavedTree, ARestrictedBoxWithAnImpossibleAxisIsRefused) {
+  // A crafted file past the checksum: an axis >= 3 would make decode write outside the box.
+  const Tree<RestrictedBox> tree{Bvh<RestrictedBox>::build(testing::make_torus(1.0, 0.3, 8, 4)), {}};
+  Bytes bytes = save_tree_to_buffer(tree);
+  EXPECT_NO_THROW(load_tree_from_buffer<RestrictedBox>(bytes));
+  // Find node 3's stored bytes in the file rather than assuming the layout.
+  const auto* node3 = reinterpret_cast<const std::byte*>(&tree.bvh.volumes()[3]);
+  const auto at = std::search(bytes.begin(), bytes.end(), node3, node3 + sizeof(RestrictedBox));
+  ASSERT_NE(at, bytes.end());
+  put_u32(bytes, static_cast<std::size_t>(at - bytes.begin()) + offsetof(RestrictedBox, axis), 7);
+  reseal(bytes);
+  expect_rejected([&] { load_tree_from_buffer<RestrictedBox>(bytes); }, "invalid volume");
 }
 
 TEST(SavedTree, RandomGarbageNeverCrashes) {
