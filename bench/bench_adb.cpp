@@ -7,6 +7,7 @@
 //   bench_adb [--meshes=a,b] [--steps=200] [--p-min=0.5,0.7,...] [--exact=aabb,dop24] [--grid=2]
 //             [--tau=0.5] [--distances=1.2,1.4,...] [benchmark flags]
 #include "adb/annotate.hpp"
+#include "bench/core/arguments.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
@@ -67,19 +68,6 @@ void run_poses(benchmark::State& state, const Workload& w, std::size_t d, Query&
   state.counters["fp_rate"] = static_cast<double>(fp) / n;
   state.counters["fn_rate"] = static_cast<double>(fn) / n;
   state.counters["bv_tests"] = bv_tests / n;
-}
-
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-std::vector<double> split_numbers(const std::string& s) {
-  std::vector<double> out;
-  for (const auto& item : split_list(s)) out.push_back(std::stod(item));
-  return out;
 }
 
 template <int G>

@@ -5,6 +5,7 @@
 //
 // Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
 // protocol's mean time per query. Counters: BV tests and triangle tests per query, bytes per triangle.
+#include "bench/core/arguments.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
@@ -112,14 +113,6 @@ void register_fcl(const std::string& mesh_name, const std::string& bv_name,
   }
 }
 #endif
-
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 }  // namespace
 }  // namespace bvhlab
