@@ -376,3 +376,13 @@ TEST(Annotate, RejectsBadInputWithAClearMessage) {
 
 }  // namespace
 }  // namespace bvhlab
+
+// A tree without density pays nothing: the compiler checks it for every registered kind of volume.
+#include "volumes/dop24.hpp"
+#include "volumes/obb.hpp"
+#include "volumes/restricted_box.hpp"
+static_assert(std::is_empty_v<bvhlab::NoDensity::Storage>);
+static_assert(bvhlab::no_density_is_free<bvhlab::Aabb>);
+static_assert(bvhlab::no_density_is_free<bvhlab::Dop24>);
+static_assert(bvhlab::no_density_is_free<bvhlab::Obb>);
+static_assert(bvhlab::no_density_is_free<bvhlab::RestrictedBox>);
