@@ -261,6 +261,19 @@ void with_grid(int grid, F&& f) {
   }
 }
 
+// Progress of a long build or annotation as log lines, every 10%, for meshes large enough to wait on.
+std::function<void(std::size_t, std::size_t)> percent_logger(const LogFn& log, std::string what,
+                                                             std::size_t triangles) {
+  constexpr std::size_t kLargeMesh = 100'000;
+  if (triangles < kLargeMesh) return {};
+  return [log, what = std::move(what), next = std::size_t{10}](std::size_t done, std::size_t total) mutable {
+    const std::size_t percent = total ? 100 * done / total : 100;
+    if (percent < next) return;
+    log("  " + what + " " + std::to_string(percent) + "%");
+    next = percent / 10 * 10 + 10;
+  };
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Trees: from the run's memory, else the disk cache, else built (and then cached).
 
@@ -289,6 +302,7 @@ class TreeStore {
            std::to_string(object.mesh.triangle_count()) + " triangles)");
       BuildOptions options = h.build;
       options.threads = threads_;
+      options.progress = percent_logger(log_, "building: triangles placed", object.mesh.triangle_count());
       tree.emplace(Tree<BV, NoDensity>{Bvh<BV>::build(object.mesh, options), {}});
       ++stats_.trees_built;
       times.build_seconds = tree->bvh.stats().build_seconds;
@@ -324,6 +338,8 @@ class TreeStore {
       AnnotateOptions options;
       options.tau = tau;
       options.threads = threads_;
+      options.progress =
+          percent_logger(log_, "annotating: triangle-node pairs", object.mesh.triangle_count());
       AnnotateStats annotate_stats;
       if constexpr (requires { annotate<G>(std::move(bvh), options, &annotate_stats); })
         tree.emplace(annotate<G>(std::move(bvh), options, &annotate_stats));
@@ -665,13 +681,12 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
 
 BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hierarchy,
                              const AnnotationSpec& annotation, const std::filesystem::path& output,
-                             unsigned threads) {
+                             unsigned threads, std::function<void(const std::string&)> log) {
   if (hierarchy.is_fcl()) throw std::invalid_argument("FCL models cannot be saved as bvhlab trees");
   BuildOutcome outcome;
   RunStats stats;
-  TreeStore store(
-      {}, stats, [](const std::string&) {},
-      threads ? threads : std::max(1u, std::thread::hardware_concurrency()));
+  TreeStore store({}, stats, std::move(log),
+                  threads ? threads : std::max(1u, std::thread::hardware_concurrency()));
   const ObjectData data = load_object(object);
   std::vector<std::byte> bytes;
   with_volume(hierarchy.bv, [&]<class BV>(std::type_identity<BV>) {

@@ -156,9 +156,10 @@ struct BuildOutcome {
   ModelInfo model;
   std::uintmax_t file_bytes = 0;
 };
-BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hierarchy,
-                             const AnnotationSpec& annotation, const std::filesystem::path& output,
-                             unsigned threads = 0);
+BuildOutcome build_tree_file(
+    const SceneObject& object, const HierarchySpec& hierarchy, const AnnotationSpec& annotation,
+    const std::filesystem::path& output, unsigned threads = 0,
+    std::function<void(const std::string&)> log = [](const std::string&) {});
 
 /// The CSV header of results.csv, in order. The schema test holds the writer to it.
 const std::vector<std::string>& results_csv_columns();

@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
   app.footer(
       "Examples:\n"
       "  bvhlab info jeep1.ms3d\n"
-      "  bvhlab build teapot.obj --bv aabb --adb --grid 2 --tau 0.5 -o teapot.tree\n"
+      "  bvhlab build teapot.obj --bv aabb --adb --grid 2 --tau 0.25 -o teapot.tree\n"
       "  bvhlab query jeep1.ms3d jeep1.ms3d --protocol 1.4,100,5000 --strategy adb --p-min 0.9\n"
       "  bvhlab query teapot.tree teapot.tree --pose 1.2,0,0,0,0,1,45 --strategy adb\n"
       "  bvhlab run bench/scenes/smoke.json -o results/smoke\n"
@@ -189,7 +189,7 @@ int main(int argc, char** argv) {
   unsigned build_leaf = 1, build_threads = 0;
   bool build_adb = false, build_raw = false;
   int build_grid = 2;
-  double build_tau = 0.5;
+  double build_tau = kDefaultAdbTau;
   auto* build =
       app.add_subcommand("build", "Build (and optionally ADB-annotate) a tree and save it without polygons");
   build->add_option("MESH", build_mesh, "Mesh file or catalog name")->required();
@@ -217,7 +217,7 @@ int main(int argc, char** argv) {
   // query
   std::string query_a, query_b, query_pose, query_protocol, query_bv = "aabb", query_strategy = "exact",
                                                             query_cache;
-  double query_p_min = 0.9, query_tau = 0.5, query_deadline = 0, query_threshold = 0.5;
+  double query_p_min = 0.9, query_tau = kDefaultAdbTau, query_deadline = 0, query_threshold = 0.5;
   int query_grid = 2;
   std::uint64_t query_bv_tests = 0;
   bool query_all = false, query_json = false, query_raw = false, query_no_cache = false;
@@ -351,7 +351,9 @@ int main(int argc, char** argv) {
       h.build.split = split_method_from_string(build_split);
       h.build.max_leaf_triangles = build_leaf;
       AnnotationSpec annotation{build_adb, build_grid, build_tau};
-      const BuildOutcome outcome = build_tree_file(object, h, annotation, build_out, build_threads);
+      const BuildOutcome outcome =
+          build_tree_file(object, h, annotation, build_out, build_threads,
+                          [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); });
       std::printf("%s -> %s (%ju bytes)\n", object.path.c_str(), build_out.c_str(), outcome.file_bytes);
       print_model(outcome.model);
       return 0;
