@@ -1,0 +1,160 @@
+// libFuzzer target: the saved-tree reader (adb/saved_tree.hpp).
+//
+// Input: one selector byte, then the file. The selector's low 3 bits pick the (volume, annotation) the reader
+// expects; bit 3 set keeps the file's checksum as it is, clear recomputes it first, so that mutations reach
+// the structure checks behind the checksum instead of dying at it.
+//
+// A SavedTreeError naming the source is the expected way to refuse. Anything else -- another exception, a
+// crash, a sanitizer report -- is a finding, and so is an accepted tree that does not save back to the same
+// bytes, or whose ADB query misbehaves (a probability outside [0, 1], a budget overrun).
+//
+// Seeds: run with BVHLAB_FUZZ_WRITE_SEEDS=<dir> to write one saved tree per layout there (and exit).
+#include "adb/saved_tree.hpp"
+#include "traversal/adb.hpp"
+#include "volumes/aabb.hpp"
+#include "volumes/dop24.hpp"
+#include "volumes/obb.hpp"
+#include "volumes/restricted_box.hpp"
+#include "volumes/sphere.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <vector>
+
+namespace {
+
+using namespace bvhlab;
+
+constexpr std::size_t kChecksumOffset = 120;
+
+[[noreturn]] void finding(const std::string& what) {
+  std::fprintf(stderr, "fuzz_saved_tree: %s\n", what.c_str());
+  std::abort();
+}
+
+template <int G>
+const AdbModel& model() {
+  static const AdbModel m(G, 0.5);
+  return m;
+}
+
+template <class BV, class Density>
+void load_and_check(std::span<const std::byte> file) {
+  Tree<BV, Density> tree;
+  try {
+    tree = load_tree_from_buffer<BV, Density>(file, "fuzz.tree");
+  } catch (const SavedTreeError& e) {
+    if (std::string_view(e.what()).find("fuzz.tree") == std::string_view::npos)
+      finding(std::string("refusal does not name the source: ") + e.what());
+    return;
+  }
+  // Accepted: the tree must save back to exactly the bytes it came from (the format has no slack).
+  const std::vector<std::byte> again =
+      save_tree_to_buffer(tree, {.triangle_ids = !tree.bvh.triangle_ids().empty()}, "fuzz.tree");
+  if (again.size() != file.size() || !std::equal(again.begin(), again.end(), file.begin()))
+    finding("an accepted tree does not save back to the same bytes");
+  if constexpr (Density::annotated) {
+    // And it must survive a query against itself: ADB needs no polygons.
+    AdbOptions options;
+    options.p_min = 0.99;
+    options.budget.max_bv_tests = 4096;
+    RigidTransform pose;
+    pose.rotation = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    const Result r = query_adb(tree, tree, pose, model<Density::grid>(), options);
+    if (!(r.probability >= 0 && r.probability <= 1)) finding("ADB probability outside [0, 1]");
+    if (r.counters.bv_tests > options.budget.max_bv_tests) finding("ADB exceeded its BV-test budget");
+  }
+}
+
+using Loader = void (*)(std::span<const std::byte>);
+constexpr Loader kLayouts[8] = {
+    load_and_check<Aabb, NoDensity>,          load_and_check<Aabb, AdbDensity<2>>,
+    load_and_check<RestrictedBox, NoDensity>, load_and_check<RestrictedBox, AdbDensity<2>>,
+    load_and_check<Obb, AdbDensity<3>>,       load_and_check<Dop24, NoDensity>,
+    load_and_check<Sphere, AdbDensity<2>>,    load_and_check<Dop24, AdbDensity<4>>,
+};
+
+// --- seeds -------------------------------------------------------------------------------------------------
+
+Mesh seed_mesh() {  // a small torus: enough nodes for every check to matter, few bytes
+  Mesh m;
+  const int nu = 6, nv = 4;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const double u = 2 * std::numbers::pi * i / nu, v = 2 * std::numbers::pi * j / nv;
+      m.vertices.emplace_back((0.7 + 0.25 * std::cos(v)) * std::cos(u),
+                              (0.7 + 0.25 * std::cos(v)) * std::sin(u), 0.25 * std::sin(v));
+    }
+  auto id = [&](int i, int j) { return static_cast<std::uint32_t>((i % nu) * nv + (j % nv)); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return m;
+}
+
+template <class BV, class Density>
+std::vector<std::byte> seed_tree(const Mesh& mesh, bool ids) {
+  Bvh<BV> bvh = Bvh<BV>::build(mesh, {.max_leaf_triangles = 2, .threads = 1});
+  Tree<BV, Density> tree{std::move(bvh), {}};
+  if constexpr (Density::annotated) {  // a stand-in annotation: the reader checks only pc <= g^3
+    for (std::size_t i = 0; i < tree.bvh.nodes().size(); ++i)
+      tree.density.possible_collision_cells.push_back(static_cast<std::uint8_t>(i % (Density::cells + 1)));
+    tree.density.tau = 0.5;
+  }
+  return save_tree_to_buffer(tree, {.triangle_ids = ids});
+}
+
+void write_seeds(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  const Mesh mesh = seed_mesh();
+  const std::vector<std::pair<std::string, std::vector<std::byte>>> seeds = {
+      {"aabb_plain", seed_tree<Aabb, NoDensity>(mesh, true)},
+      {"aabb_adb2", seed_tree<Aabb, AdbDensity<2>>(mesh, true)},
+      {"rbox_plain", seed_tree<RestrictedBox, NoDensity>(mesh, true)},
+      {"rbox_adb2_no_ids", seed_tree<RestrictedBox, AdbDensity<2>>(mesh, false)},
+      {"obb_adb3", seed_tree<Obb, AdbDensity<3>>(mesh, true)},
+      {"dop24_plain", seed_tree<Dop24, NoDensity>(mesh, true)},
+      {"sphere_adb2_no_ids", seed_tree<Sphere, AdbDensity<2>>(mesh, false)},
+      {"dop24_adb4", seed_tree<Dop24, AdbDensity<4>>(mesh, true)},
+  };
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    std::ofstream out(dir / seeds[k].first, std::ios::binary);
+    const char selector = static_cast<char>(k);
+    out.write(&selector, 1);
+    out.write(reinterpret_cast<const char*>(seeds[k].second.data()),
+              static_cast<std::streamsize>(seeds[k].second.size()));
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  if (const char* dir = std::getenv("BVHLAB_FUZZ_WRITE_SEEDS")) {
+    write_seeds(dir);
+    std::exit(0);
+  }
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  const std::uint8_t selector = data[0];
+  std::vector<std::byte> file(size - 1);
+  std::memcpy(file.data(), data + 1, size - 1);
+  if (!(selector & 8) && file.size() >= kSavedTreeHeaderSize) {
+    const std::span<const std::byte> all(file);
+    const std::uint64_t head = saved_tree_detail::fnv1a64(all.first(kChecksumOffset));
+    std::uint64_t sum = saved_tree_detail::fnv1a64(all.subspan(kSavedTreeHeaderSize), head);
+    for (std::size_t i = 0; i < 8; ++i, sum >>= 8)
+      file[kChecksumOffset + i] = static_cast<std::byte>(sum & 0xff);
+  }
+  kLayouts[selector & 7](file);
+  return 0;
+}
