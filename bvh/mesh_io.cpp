@@ -389,6 +389,64 @@ bool ply_header_unterminated(std::string_view start, NextLine next_line) {
 
 constexpr const char* kUnterminatedPly = ": PLY header has no end_header line (truncated file?)";
 
+// OFF and PLY headers declare element counts, and assimp allocates for them before reading a single element:
+// a 60-byte OFF file declaring 14294967295 faces asked for 22 GB (found by tests/fuzz). Every element takes
+// at least one byte of the file, so a count above the file's size is refused up front. `head` is the file's
+// beginning (the header fits in it), `size` its full size. Returns the problem, or "" when none is seen.
+std::string oversized_header_count(std::string_view head, std::uint64_t size) {
+  auto lower = [](std::string_view text) {
+    std::string out(text);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+  };
+  // Counts as written, saturating far above any real file, so an overflowing count is caught as huge.
+  auto count_of = [](std::string_view digits) {
+    std::uint64_t value = 0;
+    for (char c : digits)
+      value = std::min<std::uint64_t>(value * 10 + static_cast<unsigned>(c - '0'), 1ull << 62);
+    return value;
+  };
+  auto too_many = [&](std::uint64_t count, const std::string& what) {
+    return count > size
+               ? "header declares " + std::to_string(count) + " " + what + " but the file has only " +
+                     std::to_string(size) + " bytes (corrupt or truncated?)"
+               : std::string();
+  };
+  std::istringstream in{std::string(head)};
+  std::string token;
+  if (!(in >> token)) return {};
+  const std::string magic = lower(token);
+  if (magic.size() >= 3 && magic.compare(magic.size() - 3, 3, "off") == 0 && magic.size() <= 6) {
+    // OFF: vertex, face (and edge) counts follow the keyword, possibly after comment lines.
+    std::vector<std::uint64_t> counts;
+    while (counts.size() < 2 && in >> token) {
+      if (token.front() == '#') {
+        std::getline(in, token);
+        continue;
+      }
+      if (token.find_first_not_of("0123456789") != std::string::npos) break;
+      counts.push_back(count_of(token));
+    }
+    const char* names[] = {"vertices", "faces"};
+    for (std::size_t i = 0; i < counts.size(); ++i)
+      if (auto problem = too_many(counts[i], names[i]); !problem.empty()) return problem;
+  } else if (magic == "ply") {
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream words(line);
+      std::string keyword, name, digits;
+      if (!(words >> keyword)) continue;
+      if (keyword == "end_header") break;
+      if (keyword != "element" || !(words >> name >> digits)) continue;
+      if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      if (auto problem = too_many(count_of(digits), "'" + name + "' elements"); !problem.empty())
+        return problem;
+    }
+  }
+  return {};
+}
+
+constexpr std::size_t kHeaderBytes = 1 << 16;
+
 }  // namespace
 
 LoadedMesh load_mesh(const std::filesystem::path& path) {
@@ -411,6 +469,13 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
     if (ply_header_unterminated(start,
                                 [&](std::string& line) { return static_cast<bool>(std::getline(in, line)); }))
       throw MeshError(source + kUnterminatedPly);
+    in.clear();
+    in.seekg(0);
+    std::string head(kHeaderBytes, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    if (const std::string problem = oversized_header_count(head, ec ? head.size() : size); !problem.empty())
+      throw MeshError(source + ": " + problem);
   }
   return import_with(source, path.stem().string(),
                      [&](Assimp::Importer& importer) { return importer.ReadFile(source, kPostProcess); });
@@ -430,6 +495,9 @@ LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_
         return true;
       }))
     throw MeshError(source + kUnterminatedPly);
+  if (const std::string problem = oversized_header_count(text.substr(0, kHeaderBytes), text.size());
+      !problem.empty())
+    throw MeshError(source + ": " + problem);
   std::string hint(format_hint);
   if (!hint.empty() && hint.front() == '.') hint.erase(0, 1);
   return import_with(source, std::filesystem::path(source).stem().string(), [&](Assimp::Importer& importer) {

@@ -145,6 +145,36 @@ TEST(BadMeshInput, TruncatedPlyHeaderIsRefusedNotHung) {
   }
 }
 
+// The third: OFF and PLY headers declare element counts that assimp allocates for up front; a 60-byte OFF
+// declaring 14294967295 faces asked for 22 GB. Counts above the file's size are refused before that.
+TEST(BadMeshInput, HeaderCountsBeyondTheFileAreRefusedBeforeAllocating) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"off", "OFF\n# comment\n4 14294967295 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n"},
+      {"off", "OFF 4000000000 1 0\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n"},
+      {"ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+       "property float z\nelement face 3000000000\nproperty list uchar int vertex_indices\nend_header\n"},
+      {"", "ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nproperty float x\nend_header\n"}};
+  for (const auto& [format, text] : cases) {
+    try {
+      load_mesh_from_memory(std::as_bytes(std::span(text.data(), text.size())), format, "big.mesh");
+      ADD_FAILURE() << "loaded " << text;
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("big.mesh: header declares"), std::string::npos) << e.what();
+    }
+    const fs::path file = fs::temp_directory_path() / ("bvhlab-big-" + std::to_string(getpid()) + "." +
+                                                       (format.empty() ? std::string("ply") : format));
+    std::ofstream(file, std::ios::binary) << text;
+    try {
+      load_mesh(file);
+      ADD_FAILURE() << "loaded " << file;
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("header declares"), std::string::npos) << e.what();
+    }
+    fs::remove(file);
+  }
+}
+
 // Truncations and byte flips of every seed: each loads (and then keeps the loader's promises) or is refused
 // with a message naming the input. A crash or an abort fails the whole test binary.
 TEST(BadMeshInput, MutilatedSeedsAreLoadedOrRefusedNeverCrash) {
