@@ -424,7 +424,9 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size) {
         std::getline(in, token);
         continue;
       }
-      if (token.find_first_not_of("0123456789") != std::string::npos) break;
+      // assimp reads a count as the token's leading digits ("12abc" is 12), so this does too.
+      token.resize(std::min(token.find_first_not_of("0123456789"), token.size()));
+      if (token.empty()) break;
       counts.push_back(count_of(token));
     }
     const char* names[] = {"vertices", "faces"};
@@ -437,7 +439,7 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size) {
       if (!(words >> keyword)) continue;
       if (keyword == "end_header") break;
       if (keyword != "element" || !(words >> name >> digits)) continue;
-      if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      digits.resize(std::min(digits.find_first_not_of("0123456789"), digits.size()));
       if (auto problem = too_many(count_of(digits), "'" + name + "' elements"); !problem.empty())
         return problem;
     }

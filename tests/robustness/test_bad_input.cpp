@@ -151,6 +151,7 @@ TEST(BadMeshInput, HeaderCountsBeyondTheFileAreRefusedBeforeAllocating) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"off", "OFF\n# comment\n4 14294967295 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n"},
       {"off", "OFF 4000000000 1 0\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n"},
+      {"off", "OFF\n4 1429496429496mment\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n"},  // leading digits
       {"ply",
        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
        "property float z\nelement face 3000000000\nproperty list uchar int vertex_indices\nend_header\n"},
@@ -262,7 +263,7 @@ TEST(BadSceneInput, RefusalsNameTheFileTheFieldAndTheProblem) {
   expect_scene_refused(scene_with(R"(, "placement": {"rotation": [[1, 0, 0], [0, 1, 0]]})"),
                        "/objects/0/placement/rotation", "3 rows");
   expect_scene_refused(scene_with(R"(, "placement": {"axis_angle_deg": [0, 0, 0, 90]})"),
-                       "/objects/0/placement/axis_angle_deg", "zero length");
+                       "/objects/0/placement/axis_angle_deg", "axis");
   expect_scene_refused(scene_with(R"(, "scale": -1)"), "/objects/0/scale", "");
   expect_scene_refused(scene_with(R"(, "mesh": "x")"), "/objects/0/mesh", "");
   expect_scene_refused(scene_with("", R"(, "workload": {"steps": 0})"), "/workload/steps", "integer in");
