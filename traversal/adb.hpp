@@ -187,6 +187,7 @@ template <TreeVolume BV, int G>
 Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>& b,
                  const RigidTransform& b_to_a, const AdbModel& model, const AdbOptions& options) {
   options.validate();
+  b_to_a.validate();
   if (model.grid() != G) throw std::invalid_argument("adb: the model's grid differs from the trees'");
   if (a.density.tau != model.tau() || b.density.tau != model.tau())
     throw std::invalid_argument("adb: the trees were annotated with another tau than the model's");

@@ -21,6 +21,7 @@ Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_t
                    ContactMode mode = ContactMode::First) {
   using Walker = VolumeWalker<BV>;
   using Working = typename Walker::Working;
+  b_to_a.validate();
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;

@@ -149,6 +149,12 @@ json parse_json(std::string_view text, const std::string& source) {
     const auto cut = what.find("] ");
     throw SceneError(source +
                      ": not valid JSON: " + (cut == std::string::npos ? what : what.substr(cut + 2)));
+  } catch (const json::exception& e) {
+    // Other parser refusals, e.g. a number beyond double's range ("1e999": out_of_range.406).
+    std::string what = e.what();
+    const auto cut = what.find("] ");
+    throw SceneError(source +
+                     ": not valid JSON: " + (cut == std::string::npos ? what : what.substr(cut + 2)));
   }
 }
 
@@ -186,9 +192,18 @@ RigidTransform parse_transform(const Node& node) {
   if (node.has("axis_angle_deg")) {
     const Node aa = node.child("axis_angle_deg");
     const auto v = aa.numbers(4);
-    const Vec3 axis(v[0], v[1], v[2]);
-    if (axis.norm() == 0) aa.fail("the axis [" + number_text(v[0]) + ", 0, 0] has zero length");
-    rotation = Eigen::AngleAxisd(v[3] * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+    Vec3 axis(v[0], v[1], v[2]);
+    // Scale by the largest component before normalising: the norm of [1e200, 1e200, 0] overflows and
+    // that of [1e-200, 1e-200, 0] underflows, and either would silently give a matrix that is no rotation.
+    const double largest = axis.cwiseAbs().maxCoeff();
+    if (!(largest > 0) || !std::isfinite(largest)) aa.fail("the rotation axis must be finite and not zero");
+    axis = (axis / largest).normalized();
+    rotation = Eigen::AngleAxisd(v[3] * M_PI / 180.0, axis).toRotationMatrix();
+    try {
+      return RigidTransform::checked(rotation, translation, 1e-9);
+    } catch (const std::invalid_argument& e) {
+      aa.fail(std::string("not a rotation: ") + e.what());
+    }
   }
   return RigidTransform{rotation, translation};
 }

@@ -135,17 +135,17 @@ TEST(CallerTransforms, MeshNodeTransformsThatBreakCoordinatesAreRefused) {
   }
 }
 
-// DISABLED until the query API validates its pose: a NaN pose passed straight to query_exact (or query_adb)
-// makes every overlap test false, and the answer is "no collision", marked exact -- a silent wrong answer.
-// RigidTransform::checked is the API's door for caller input, but the query functions do not require it.
-// Reported to the lead (a finite-and-orthonormal check costs ~30 flops per query).
-TEST(CallerTransforms, DISABLED_QueriesRefuseAPoseThatIsNoRotation) {
+// A NaN pose passed straight to a query would make every overlap test false, and the answer would be
+// "no collision", marked exact -- a silent wrong answer. Queries validate their pose (about 40 flops).
+TEST(CallerTransforms, QueriesRefuseAPoseThatIsNoRotation) {
   const Mesh cube = robust::make_cube();
   const auto tree = Bvh<Aabb>::build(cube);
   RigidTransform bad;
   bad.translation = Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0);
   EXPECT_THROW((void)query_exact(tree, tree, bad), std::invalid_argument);
   bad = RigidTransform{2.0 * Mat3::Identity(), Vec3::Zero()};
+  EXPECT_THROW((void)query_exact(tree, tree, bad), std::invalid_argument);
+  bad = RigidTransform{-Mat3::Identity(), Vec3::Zero()};  // a reflection
   EXPECT_THROW((void)query_exact(tree, tree, bad), std::invalid_argument);
 }
 
