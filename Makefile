@@ -3,7 +3,7 @@ PRESET ?= release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD_DIR := build/$(PRESET)
 
-.PHONY: demo test deps configure build asan-test clean
+.PHONY: demo test deps configure build asan-test tsan-test fuzz clean
 
 deps:
 	@bash cmake/install-deps.sh
@@ -22,6 +22,20 @@ test: build
 
 asan-test:
 	$(MAKE) test PRESET=asan
+
+# ThreadSanitizer on the multi-threaded query tests (ctest label `threads`), built alone.
+tsan-test:
+	$(MAKE) configure PRESET=tsan
+	cmake --build --preset tsan --target test_robust_threads -j $(JOBS)
+	ctest --preset tsan -j $(JOBS)
+
+# libFuzzer targets (clang, ASan + UBSan): replay the committed corpora, then explore FUZZ_SECONDS per target.
+FUZZ_SECONDS ?= 30
+fuzz:
+	$(MAKE) configure PRESET=fuzz
+	cmake --build --preset fuzz --target bvhlab_fuzzers -j $(JOBS)
+	ctest --preset fuzz
+	tests/fuzz/run_fuzzers.sh build/fuzz $(FUZZ_SECONDS)
 
 clean:
 	rm -rf build
