@@ -203,10 +203,15 @@ class SceneMerger {
     if (!(diagonal >= MeshPrecisionLimits::min_diagonal))
       fail("model has zero size: all triangle vertices coincide (bounding-box diagonal " +
            format_number(diagonal) + ")");
-    if (max_abs / diagonal > MeshPrecisionLimits::warn_offset_ratio) {
+    constexpr bool float_reader = sizeof(ai_real) == sizeof(float);
+    constexpr double warn_ratio = float_reader ? MeshPrecisionLimits::warn_offset_ratio_float_reader
+                                               : MeshPrecisionLimits::warn_offset_ratio_double_reader;
+    if (max_abs / diagonal > warn_ratio) {
       std::ostringstream w;
       w << "coordinates are far from the origin relative to the model size (max |coordinate| / diagonal = "
-        << max_abs / diagonal << " > 1e6): details below ~1e-9 of the model size may not be representable";
+        << max_abs / diagonal << " > " << warn_ratio << "): the file's coordinates were read with "
+        << (float_reader ? "32-bit float" : "double") << " precision, so details below ~"
+        << max_abs / diagonal * (float_reader ? 6e-8 : 1.1e-16) << " of the model size are lost";
       report_.warnings.push_back(w.str());
     }
 

@@ -26,10 +26,12 @@ struct MeshPrecisionLimits {
   static constexpr double max_abs_coordinate = 1e15;
   /// A bounding-box diagonal below this (or zero) is refused: the model has no usable size.
   static constexpr double min_diagonal = 1e-300;
-  /// Warn when max|coordinate| / diagonal exceeds this: the spacing of doubles near the largest coordinate is
-  /// then above ratio * 1.1e-16 of the model size, i.e. above ~1e-10, close to the ~1e-9 relative detail the
-  /// exact queries are expected to resolve.
-  static constexpr double warn_offset_ratio = 1e6;
+  /// Warn when max|coordinate| / diagonal exceeds this. assimp (as Debian builds it) reads coordinates into
+  /// 32-bit floats before they become doubles, rounding each by up to 2^-24 of its magnitude: beyond a
+  /// ratio of 100 that loses more than ~6e-6 of the model's size. With a double-precision assimp the bound
+  /// is 1e6 (loss ~1e-10 of the size, close to what the exact queries resolve).
+  static constexpr double warn_offset_ratio_float_reader = 100;
+  static constexpr double warn_offset_ratio_double_reader = 1e6;
 };
 
 /// What the loader saw, for reports and the `info` command.
