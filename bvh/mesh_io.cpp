@@ -397,8 +397,10 @@ constexpr const char* kUnterminatedPly = ": PLY header has no end_header line (t
 // OFF and PLY headers declare element counts, and assimp allocates for them before reading a single element:
 // a 60-byte OFF file declaring 14294967295 faces asked for 22 GB (found by tests/fuzz). Every element takes
 // at least one byte of the file, so a count above the file's size is refused up front. `head` is the file's
-// beginning (the header fits in it), `size` its full size. Returns the problem, or "" when none is seen.
-std::string oversized_header_count(std::string_view head, std::uint64_t size) {
+// beginning (the header fits in it), `size` its full size, `format` the lower-case format hint or file
+// extension (assimp reads a file named .off as OFF even without the OFF keyword). Returns the problem, or ""
+// when none is seen.
+std::string oversized_header_count(std::string_view head, std::uint64_t size, std::string_view format) {
   auto lower = [](std::string_view text) {
     std::string out(text);
     for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -421,10 +423,14 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size) {
   std::string token;
   if (!(in >> token)) return {};
   const std::string magic = lower(token);
-  if (magic.size() >= 3 && magic.compare(magic.size() - 3, 3, "off") == 0 && magic.size() <= 6) {
-    // OFF: vertex, face (and edge) counts follow the keyword, possibly after comment lines.
+  const bool off_keyword =
+      magic.size() >= 3 && magic.size() <= 6 && magic.compare(magic.size() - 3, 3, "off") == 0;
+  if (off_keyword || format == "off") {
+    // OFF: vertex, face (and edge) counts follow the keyword, if any, possibly after comment lines.
     std::vector<std::uint64_t> counts;
-    while (counts.size() < 2 && in >> token) {
+    bool pending = !off_keyword;  // without the keyword, the first token is already a count
+    while (counts.size() < 2 && (pending || in >> token)) {
+      pending = false;
       if (token.front() == '#') {
         std::getline(in, token);
         continue;
@@ -481,7 +487,11 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
     std::string head(kHeaderBytes, '\0');
     in.read(head.data(), static_cast<std::streamsize>(head.size()));
     head.resize(static_cast<std::size_t>(in.gcount()));
-    if (const std::string problem = oversized_header_count(head, ec ? head.size() : size); !problem.empty())
+    std::string extension = path.extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (const std::string problem = oversized_header_count(
+            head, ec ? head.size() : size, std::string_view(extension).substr(extension.empty() ? 0 : 1));
+        !problem.empty())
       throw MeshError(source + ": " + problem);
   }
   return import_with(source, path.stem().string(),
@@ -502,11 +512,12 @@ LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_
         return true;
       }))
     throw MeshError(source + kUnterminatedPly);
-  if (const std::string problem = oversized_header_count(text.substr(0, kHeaderBytes), text.size());
-      !problem.empty())
-    throw MeshError(source + ": " + problem);
   std::string hint(format_hint);
   if (!hint.empty() && hint.front() == '.') hint.erase(0, 1);
+  for (char& c : hint) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (const std::string problem = oversized_header_count(text.substr(0, kHeaderBytes), text.size(), hint);
+      !problem.empty())
+    throw MeshError(source + ": " + problem);
   return import_with(source, std::filesystem::path(source).stem().string(), [&](Assimp::Importer& importer) {
     return importer.ReadFileFromMemory(buffer.data(), buffer.size(), kPostProcess, hint.c_str());
   });
