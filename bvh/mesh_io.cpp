@@ -387,7 +387,10 @@ bool ply_header_unterminated(std::string_view start, NextLine next_line) {
   while (next_line(line)) {
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos || line.compare(first, 10, "end_header") != 0) continue;
-    if (first + 10 == line.size() || std::isspace(static_cast<unsigned char>(line[first + 10]))) return false;
+    // assimp's token match takes only these after the keyword (a vertical tab, say, still hangs it).
+    if (first + 10 == line.size() ||
+        std::string_view(" \t\r\f\0", 5).find(line[first + 10]) != std::string_view::npos)
+      return false;
   }
   return true;
 }

@@ -82,9 +82,15 @@ void load_and_check(std::span<const std::byte> file) {
     options.budget.max_bv_tests = 4096;
     RigidTransform pose;
     pose.rotation = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
-    const Result r = query_adb(tree, tree, pose, model<Density::grid>(), options);
-    if (!(r.probability >= 0 && r.probability <= 1)) finding("ADB probability outside [0, 1]");
-    if (r.counters.bv_tests > options.budget.max_bv_tests) finding("ADB exceeded its BV-test budget");
+    // A tree annotated with another tau than the model's is refused by the query; that is the contract.
+    try {
+      const Result r = query_adb(tree, tree, pose, model<Density::grid>(), options);
+      if (!(r.probability >= 0 && r.probability <= 1)) finding("ADB probability outside [0, 1]");
+      if (r.counters.bv_tests > options.budget.max_bv_tests) finding("ADB exceeded its BV-test budget");
+    } catch (const std::invalid_argument& e) {
+      if (tree.density.tau == model<Density::grid>().tau())
+        finding(std::string("ADB refused a tree annotated with the model's tau: ") + e.what());
+    }
   }
 }
 

@@ -120,8 +120,10 @@ TEST(BadMeshInput, ConcavePolygonIsStillTriangulatedInsideItself) {
 // The second: assimp's PLY reader never returns on a header without an `end_header` line (any truncated
 // header). The loader refuses it before assimp sees it, from memory and from a file.
 TEST(BadMeshInput, TruncatedPlyHeaderIsRefusedNotHung) {
-  for (const std::string ply : {"ply\nformat ascii 1.0\n", "ply\nformat ascii 1.0\nelement vertex 8\nprop",
-                                "PLY\nformat binary_little_endian 1.0\nend_headerX\n"}) {
+  for (const std::string ply :
+       {"ply\nformat ascii 1.0\n", "ply\nformat ascii 1.0\nelement vertex 8\nprop",
+        "PLY\nformat binary_little_endian 1.0\nend_headerX\n",
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\v1\n"}) {
     try {
       load_mesh_from_memory(std::as_bytes(std::span(ply.data(), ply.size())), "ply", "cut.ply");
       ADD_FAILURE() << "loaded " << ply;
