@@ -335,6 +335,11 @@ LoadedMesh import_with(const std::string& source, std::string name, ReadFn read)
   const aiScene* scene = nullptr;
   std::string problem;
   try {
+    // One import at a time: assimp's DefaultLogger formats every message in one buffer shared by all threads
+    // (ThreadSanitizer: a data race in WriteToStreams), so concurrent loads could swap or garble the messages
+    // this loader reads to detect bad indices. Loading is rarely the bottleneck; being right is not optional.
+    static std::mutex import_mutex;
+    const std::lock_guard lock(import_mutex);
     ScopedCapture scoped(capture);
     scene = read(importer);
     if (scene != nullptr) {
