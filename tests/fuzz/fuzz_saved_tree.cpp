@@ -170,7 +170,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t selector = data[0];
   std::vector<std::byte> file(size - 1);
-  std::memcpy(file.data(), data + 1, size - 1);
+  if (!file.empty()) std::memcpy(file.data(), data + 1, file.size());
   if (!(selector & 8) && file.size() >= kSavedTreeHeaderSize) fix_checksum(file);
   kLayouts[selector & 7](file);
   return 0;

@@ -38,6 +38,7 @@ for target in "${targets[@]}"; do
     result=FAILED
     status=1
     cp "$log" "$artifacts/$target.log"
+    rm -rf "$artifacts/$target-corpus" && cp -r "$work/$target" "$artifacts/$target-corpus"
     grep -E "ERROR|SUMMARY|==[0-9]+==|broken|refusal|Test unit written" "$log" | head -40 >&2 || true
   fi
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
