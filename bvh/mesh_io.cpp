@@ -452,12 +452,23 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size, st
     for (std::size_t i = 0; i < counts.size(); ++i)
       if (auto problem = too_many(counts[i], names[i]); !problem.empty()) return problem;
   } else if (magic == "ply") {
+    // A header that declares an element or the format twice makes assimp size its arrays from one
+    // declaration and fill them from the other: a heap overflow inside assimp (found by tests/fuzz under
+    // valgrind). Such a header is refused.
+    std::vector<std::string> seen;
     for (std::string line; std::getline(in, line);) {
       std::istringstream words(line);
       std::string keyword, name, digits;
       if (!(words >> keyword)) continue;
       if (keyword == "end_header") break;
-      if (keyword != "element" || !(words >> name >> digits)) continue;
+      if (keyword == "format") name = "format";
+      if (keyword == "element" && !(words >> name >> digits)) continue;
+      if (keyword != "element" && keyword != "format") continue;
+      if (std::find(seen.begin(), seen.end(), name) != seen.end())
+        return "PLY header declares " +
+               (keyword == "format" ? std::string("the format") : "element '" + name + "'") + " twice";
+      seen.push_back(name);
+      if (keyword == "format") continue;
       digits.resize(std::min(digits.find_first_not_of("0123456789"), digits.size()));
       if (auto problem = too_many(count_of(digits), "'" + name + "' elements"); !problem.empty())
         return problem;
