@@ -168,8 +168,9 @@ class Builder {
         }
       }
       if (sah_bin >= 0) {
-        const auto [lo, hi] = ranges[sah_dir];
-        const Scalar scale = kBins / (hi - lo);
+        // Plain copies, not a structured binding: clang 14 (the fuzz preset) cannot capture those.
+        const Scalar lo = ranges[sah_dir].first;
+        const Scalar scale = kBins / (ranges[sah_dir].second - lo);
         const Vec3 dir = directions_[sah_dir];
         auto* mid = std::partition(first, last, [&](std::uint32_t t) {
           return bin_of(dir.dot(centroids_[t]), lo, scale) <= sah_bin;
