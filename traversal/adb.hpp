@@ -105,7 +105,8 @@ class AdbModel {
     else if (!a_coarse && face_b > 0)
       s_a *= std::min(1.0, face_a / face_b);
     const double s_real = coarse_cell > 0 ? overlap / coarse_cell : cells;
-    const int s = s_real >= cells ? cells : std::clamp(static_cast<int>(std::ceil(s_real - 1e-9)), 1, cells);
+    const int s =
+        !(s_real < cells) ? cells : std::clamp(static_cast<int>(std::ceil(s_real - 1e-9)), 1, cells);
     s_a = std::min(s_a, double(s));
     s_b = std::min(s_b, double(s));
     return interpolate(s, s_a, s_b);

@@ -6,6 +6,8 @@
 #include "volumes/concept.hpp"
 #include "volumes/storage.hpp"
 
+#include <cmath>
+
 namespace bvhlab {
 
 struct Aabb {
@@ -55,6 +57,13 @@ struct Aabb {
   }
 
   [[nodiscard]] bool empty() const { return lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]; }
+
+  /// For loaders of raw node bytes: a stored node is finite and not empty.
+  [[nodiscard]] bool valid() const {
+    for (int k = 0; k < 3; ++k)
+      if (!(std::isfinite(lo[k]) && std::isfinite(hi[k]) && lo[k] <= hi[k])) return false;
+    return true;
+  }
   [[nodiscard]] Scalar volume() const { return empty() ? 0 : (to_vec(hi) - to_vec(lo)).prod(); }
   [[nodiscard]] Box bounding_box() const {
     if (empty()) return {};

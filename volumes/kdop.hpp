@@ -28,6 +28,7 @@
 #include "volumes/storage.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <vector>
@@ -366,6 +367,15 @@ struct KDop {
   }
 
   [[nodiscard]] bool empty() const { return offsets[0] + offsets[kAxes] < 0; }
+
+  /// For loaders of raw node bytes: a stored node has finite offsets and no empty slab.
+  [[nodiscard]] bool valid() const {
+    for (std::size_t a = 0; a < kAxes; ++a)
+      if (!(std::isfinite(offsets[a]) && std::isfinite(offsets[a + kAxes]) &&
+            double(offsets[a]) + double(offsets[a + kAxes]) >= 0))
+        return false;
+    return true;
+  }
 
   [[nodiscard]] Scalar volume() const {
     if (empty()) return 0;

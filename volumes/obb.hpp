@@ -22,6 +22,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace bvhlab {
@@ -101,6 +102,19 @@ struct Obb {
   }
 
   [[nodiscard]] bool empty() const { return half[0] < 0; }
+
+  /// For loaders of raw node bytes: finite, non-negative half extents and a quaternion that is close to unit
+  /// length (fit stores unit ones; axes_of divides by the squared norm).
+  [[nodiscard]] bool valid() const {
+    double norm2 = 0;
+    for (float q : orientation) {
+      if (!std::isfinite(q)) return false;
+      norm2 += double(q) * q;
+    }
+    for (int k = 0; k < 3; ++k)
+      if (!(std::isfinite(center[k]) && std::isfinite(half[k]) && half[k] >= 0)) return false;
+    return norm2 > 0.5 && norm2 < 2;
+  }
   [[nodiscard]] Scalar volume() const { return empty() ? 0 : 8 * double(half[0]) * half[1] * half[2]; }
 
   [[nodiscard]] Box bounding_box() const {

@@ -11,6 +11,7 @@
 #include "volumes/storage.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 
 namespace bvhlab {
@@ -77,6 +78,12 @@ struct Sphere {
   }
 
   [[nodiscard]] bool empty() const { return radius < 0; }
+
+  /// For loaders of raw node bytes: a finite centre and a finite, non-negative radius.
+  [[nodiscard]] bool valid() const {
+    return std::isfinite(center[0]) && std::isfinite(center[1]) && std::isfinite(center[2]) &&
+           std::isfinite(radius) && radius >= 0;
+  }
   [[nodiscard]] Scalar volume() const {
     return empty() ? 0 : 4.0 / 3.0 * std::numbers::pi * double(radius) * radius * radius;
   }
