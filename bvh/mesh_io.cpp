@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -477,6 +478,148 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size, st
   return {};
 }
 
+// assimp 5.2's PLY reader trusts every list's own count: one face whose ASCII count read 6.6e25 made it
+// allocate until it ran out of memory (found by tests/fuzz). So a PLY body is walked once, element by element
+// as the header declares them, before assimp reads it: every value must be there and every list must fit in
+// what is left of the file. Linear in the file, allocates nothing per element. A header this walk does not
+// understand is refused too (an unknown property type let the same huge count through). Returns the
+// problem, or "" for a PLY file whose body matches its header (and for input that is not PLY).
+std::string ply_body_problem(std::string_view text) {
+  auto lower = [](std::string_view word) {
+    std::string out(word);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+  };
+  if (text.size() < 3 || lower(text.substr(0, 3)) != "ply") return {};
+  // Byte size of a PLY scalar type, 0 when unknown.
+  auto size_of = [](const std::string& type) -> std::size_t {
+    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+    if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
+        type == "float32")
+      return 4;
+    if (type == "double" || type == "float64") return 8;
+    return 0;
+  };
+  struct Property {
+    std::size_t value_size = 0;
+    std::size_t count_size = 0;  // lists only
+  };
+  struct Element {
+    std::string name;
+    std::uint64_t count = 0;
+    std::vector<Property> properties;
+  };
+  std::vector<Element> elements;
+  std::string format;
+  std::size_t position = 0, body = std::string_view::npos;
+  while (position < text.size()) {
+    const std::size_t end = std::min(text.find('\n', position), text.size());
+    std::istringstream words{std::string(text.substr(position, end - position))};
+    position = end + 1;
+    std::string keyword;
+    if (!(words >> keyword)) continue;
+    if (keyword == "end_header") {
+      body = std::min(position, text.size());
+      break;
+    }
+    if (keyword == "format") {
+      words >> format;
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
+        return "PLY header: unknown format '" + format + "'";
+    } else if (keyword == "element") {
+      Element element;
+      std::string digits;
+      if (!(words >> element.name >> digits) || digits.find_first_not_of("0123456789") != std::string::npos)
+        return "PLY header: element line without a name and a count";
+      element.count = std::min<std::uint64_t>(std::stoull(digits.substr(0, 18)), 1ull << 62);
+      elements.push_back(std::move(element));
+    } else if (keyword == "property") {
+      if (elements.empty()) return "PLY header: property before any element";
+      std::string type, count_type, value_type;
+      words >> type;
+      Property property;
+      if (type == "list") {
+        words >> count_type >> value_type;
+        property.count_size = size_of(count_type);
+        property.value_size = size_of(value_type);
+        if (property.count_size == 0 || property.value_size == 0)
+          return "PLY header: list property of unknown types '" + count_type + "' '" + value_type + "'";
+      } else if ((property.value_size = size_of(type)) == 0) {
+        return "PLY header: unknown property type '" + type + "'";
+      }
+      elements.back().properties.push_back(property);
+    } else if (keyword != "comment" && keyword != "obj_info" && lower(keyword) != "ply") {
+      return "PLY header: unknown line '" + keyword + "'";
+    }
+  }
+  if (body == std::string_view::npos) return {};  // refused before (no end_header)
+  if (format.empty()) return "PLY header has no format line";
+  const std::string_view data = text.substr(body);
+  auto ends_early = [&](const Element& element, std::uint64_t i) {
+    return "PLY data ends inside element '" + element.name + "' " + std::to_string(i) + " of " +
+           std::to_string(element.count) + " (corrupt or truncated?)";
+  };
+  auto list_too_long = [&](const Element& element, std::uint64_t i, std::uint64_t count) {
+    return "PLY element '" + element.name + "' " + std::to_string(i) + " holds a list of " +
+           std::to_string(count) + " values, more than the rest of the file (corrupt?)";
+  };
+  if (format == "ascii") {
+    std::size_t at = 0;
+    auto is_space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0 || c == '\0'; };
+    auto next_token = [&](std::string_view& token) {
+      while (at < data.size() && is_space(data[at])) ++at;
+      const std::size_t start = at;
+      while (at < data.size() && !is_space(data[at])) ++at;
+      token = data.substr(start, at - start);
+      return !token.empty();
+    };
+    std::string_view token;
+    for (const Element& element : elements) {
+      if (element.properties.empty()) continue;
+      for (std::uint64_t i = 0; i < element.count; ++i)
+        for (const Property& property : element.properties) {
+          if (!next_token(token)) return ends_early(element, i);
+          if (property.count_size == 0) continue;
+          // A list's count: its leading digits, saturating (assimp reads it as an unsigned integer).
+          std::uint64_t count = 0;
+          for (char c : token) {
+            if (c < '0' || c > '9') break;
+            count = std::min<std::uint64_t>(count * 10 + static_cast<unsigned>(c - '0'), 1ull << 62);
+          }
+          // Each value needs at least one byte and a separator.
+          if (count > (data.size() - at) / 2 + 1) return list_too_long(element, i, count);
+          for (std::uint64_t k = 0; k < count; ++k)
+            if (!next_token(token)) return ends_early(element, i);
+        }
+    }
+    return {};
+  }
+  const bool big_endian = format == "binary_big_endian";
+  std::size_t at = 0;
+  for (const Element& element : elements) {
+    if (element.properties.empty()) continue;
+    for (std::uint64_t i = 0; i < element.count; ++i)
+      for (const Property& property : element.properties) {
+        if (property.count_size == 0) {
+          if (data.size() - at < property.value_size) return ends_early(element, i);
+          at += property.value_size;
+          continue;
+        }
+        if (data.size() - at < property.count_size) return ends_early(element, i);
+        std::uint64_t count = 0;  // read as unsigned: a negative count is as impossible as a huge one
+        for (std::size_t b = 0; b < property.count_size; ++b) {
+          const std::size_t byte = big_endian ? b : property.count_size - 1 - b;
+          count = (count << 8) | static_cast<unsigned char>(data[at + byte]);
+        }
+        at += property.count_size;
+        if (count > (data.size() - at) / property.value_size) return list_too_long(element, i, count);
+        at += count * property.value_size;
+      }
+  }
+  return {};
+}
+
 constexpr std::size_t kHeaderBytes = 1 << 16;
 
 }  // namespace
@@ -512,6 +655,14 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
             head, ec ? head.size() : size, std::string_view(extension).substr(extension.empty() ? 0 : 1));
         !problem.empty())
       throw MeshError(source + ": " + problem);
+    if (head.size() >= 3 && std::tolower(static_cast<unsigned char>(head[0])) == 'p') {
+      // A PLY body is walked whole before assimp reads it (see ply_body_problem).
+      in.clear();
+      in.seekg(0);
+      const std::string whole((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (const std::string problem = ply_body_problem(whole); !problem.empty())
+        throw MeshError(source + ": " + problem);
+    }
   }
   return import_with(source, path.stem().string(),
                      [&](Assimp::Importer& importer) { return importer.ReadFile(source, kPostProcess); });
@@ -536,6 +687,8 @@ LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_
   for (char& c : hint) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (const std::string problem = oversized_header_count(text.substr(0, kHeaderBytes), text.size(), hint);
       !problem.empty())
+    throw MeshError(source + ": " + problem);
+  if (const std::string problem = ply_body_problem(text); !problem.empty())
     throw MeshError(source + ": " + problem);
   return import_with(source, std::filesystem::path(source).stem().string(), [&](Assimp::Importer& importer) {
     return importer.ReadFileFromMemory(buffer.data(), buffer.size(), kPostProcess, hint.c_str());

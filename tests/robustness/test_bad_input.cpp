@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <unistd.h>
+#include <bit>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <random>
@@ -199,6 +201,66 @@ TEST(BadMeshInput, PlyHeaderWithRepeatedDeclarationsIsRefused) {
   EXPECT_EQ(load_mesh_from_memory(std::as_bytes(std::span(good.data(), good.size())), "ply", "once.ply")
                 .mesh.triangle_count(),
             1u);
+}
+
+// The fifth: assimp's PLY reader trusts each list's own count; one face whose ASCII count read 6.6e25 made
+// it allocate until the fuzzer's 2.5 GB limit (found by tests/fuzz). The loader walks a PLY body before
+// assimp does: every value must be present and every list must fit in the rest of the file.
+TEST(BadMeshInput, PlyListsLongerThanTheFileAreRefused) {
+  const std::string vertices = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string faces = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string ascii_head =
+      "ply\nformat ascii 1.0\n" + vertices + faces + "end_header\n0 0 0\n1 0 0\n0 1 0\n";
+  auto binary = [&](bool big_endian, std::uint32_t count, int values) {
+    std::string out = std::string("ply\nformat ") +
+                      (big_endian ? "binary_big_endian" : "binary_little_endian") + " 1.0\n" + vertices +
+                      "element face 1\nproperty list uint int vertex_indices\nend_header\n";
+    auto put = [&](std::uint32_t word) {
+      for (int b = 0; b < 4; ++b)
+        out += static_cast<char>((word >> (big_endian ? 24 - 8 * b : 8 * b)) & 0xff);
+    };
+    const float coordinates[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    for (float c : coordinates) put(std::bit_cast<std::uint32_t>(c));
+    put(count);
+    for (int k = 0; k < values; ++k) put(static_cast<std::uint32_t>(k));
+    return out;
+  };
+  auto load = [](const std::string& ply) {
+    return load_mesh_from_memory(std::as_bytes(std::span(ply.data(), ply.size())), "ply", "list.ply");
+  };
+  // Well-formed files still load, in all three encodings.
+  EXPECT_EQ(load(ascii_head + "3 0 1 2\n").mesh.triangle_count(), 1u);
+  EXPECT_EQ(load(binary(false, 3, 3)).mesh.triangle_count(), 1u);
+  EXPECT_EQ(load(binary(true, 3, 3)).mesh.triangle_count(), 1u);
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {ascii_head + "66666666666666666666666666 0 2 3\n", "list of"},
+      {ascii_head + "255 0 1 2\n", "list of"},
+      {ascii_head + "3 0 1\n", "PLY data ends inside element 'face' 0 of 1"},
+      {"ply\nformat ascii 1.0\n" + vertices + faces + "end_header\n0 0 0\n1 0\n",
+       "ends inside element 'vertex' 1"},
+      {binary(false, 0xffffffffu, 3), "list of 4294967295 values"},
+      {binary(true, 0xffffffffu, 3), "list of 4294967295 values"},
+      {binary(false, 4, 3), "list of 4 values"},
+      {binary(true, 3, 2), "list of 3 values"},
+      // A header the walk does not understand is refused, not waved through (the fuzzer's second input).
+      {"ply\nformat ascii 1.0\nelement vertex 3\nproperty floapmx t x\nend_header\n0\n0\n0\n",
+       "unknown property type 'floapmx'"},
+      {"ply\nformat ascii 1.0\n" + vertices + "element face 1\nproperty list uchar integer v\nend_header\n",
+       "list property of unknown types"},
+      {"ply\nformat ascii 2.0\nformat_extra\nend_header\n", "unknown line 'format_extra'"},
+      {"ply\nformat binary_middle_endian 1.0\nend_header\n", "unknown format"},
+      {"ply\nproperty float x\nend_header\n", "property before any element"},
+      {"ply\n" + vertices + faces + "end_header\n", "no format line"},
+  };
+  for (const auto& [ply, problem] : refused) {
+    try {
+      load(ply);
+      ADD_FAILURE() << "loaded " << ply;
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("list.ply: "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
+    }
+  }
 }
 
 // Truncations and byte flips of every seed: each loads (and then keeps the loader's promises) or is refused
