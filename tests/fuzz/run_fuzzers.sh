@@ -15,6 +15,8 @@ if [ ${#targets[@]} -eq 0 ]; then
 fi
 # Leaks inside assimp itself are known and not ours (see the file); everything else must be clean.
 export LSAN_OPTIONS="suppressions=$here/../robustness/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+# fuzz_scene writes each input to a pose file: on a tmpfs that is memory speed, on a disk it is I/O-bound.
+if [ -z "${TMPDIR:-}" ] && [ -d /dev/shm ] && [ -w /dev/shm ]; then export TMPDIR=/dev/shm; fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 artifacts="$build/fuzz-artifacts"
