@@ -560,26 +560,51 @@ std::string ply_body_problem(std::string_view text) {
     return "PLY data ends inside element '" + element.name + "' " + std::to_string(i) + " of " +
            std::to_string(element.count) + " (corrupt or truncated?)";
   };
+  auto too_few = [&](const Element& element, std::uint64_t i) {
+    return "PLY element '" + element.name + "' " + std::to_string(i) + " has fewer values on its line than " +
+           "the header declares (corrupt?)";
+  };
   auto list_too_long = [&](const Element& element, std::uint64_t i, std::uint64_t count) {
     return "PLY element '" + element.name + "' " + std::to_string(i) + " holds a list of " +
-           std::to_string(count) + " values, more than the rest of the file (corrupt?)";
+           std::to_string(count) + " values, more than its data has (corrupt?)";
   };
   if (format == "ascii") {
-    std::size_t at = 0;
-    auto is_space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0 || c == '\0'; };
+    // assimp reads one element per line (whatever follows its properties on the line is ignored), so every
+    // value of an element, a list's included, must be on that element's line. Lines end at LF, CR LF, CR or
+    // NUL.
+    std::size_t at = 0, line_end = 0;
+    auto ends_line = [](char c) { return c == '\n' || c == '\r' || c == '\0'; };
+    auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\f' || c == '\v'; };
+    // The next element's line. assimp does not skip blank lines (it reads one as an element), so they are
+    // refused here rather than guessed at: 0 = a line, 1 = the data ended, 2 = a blank line.
+    auto next_line = [&] {
+      if (at >= data.size()) return 1;
+      line_end = at;
+      while (line_end < data.size() && !ends_line(data[line_end])) ++line_end;
+      while (at < line_end && is_space(data[at])) ++at;
+      return at < line_end ? 0 : 2;
+    };
+    auto skip_line_end = [&] {
+      at = line_end;
+      if (at < data.size()) at += data[at] == '\r' && at + 1 < data.size() && data[at + 1] == '\n' ? 2 : 1;
+    };
     auto next_token = [&](std::string_view& token) {
-      while (at < data.size() && is_space(data[at])) ++at;
+      while (at < line_end && is_space(data[at])) ++at;
       const std::size_t start = at;
-      while (at < data.size() && !is_space(data[at])) ++at;
+      while (at < line_end && !is_space(data[at])) ++at;
       token = data.substr(start, at - start);
       return !token.empty();
     };
     std::string_view token;
     for (const Element& element : elements) {
       if (element.properties.empty()) continue;
-      for (std::uint64_t i = 0; i < element.count; ++i)
+      for (std::uint64_t i = 0; i < element.count; ++i) {
+        if (const int line = next_line(); line == 1)
+          return ends_early(element, i);
+        else if (line == 2)
+          return "PLY element '" + element.name + "' " + std::to_string(i) + " is a blank line (corrupt?)";
         for (const Property& property : element.properties) {
-          if (!next_token(token)) return ends_early(element, i);
+          if (!next_token(token)) return too_few(element, i);
           if (property.count_size == 0) continue;
           // A list's count: its leading digits, saturating (assimp reads it as an unsigned integer).
           std::uint64_t count = 0;
@@ -587,11 +612,13 @@ std::string ply_body_problem(std::string_view text) {
             if (c < '0' || c > '9') break;
             count = std::min<std::uint64_t>(count * 10 + static_cast<unsigned>(c - '0'), 1ull << 62);
           }
-          // Each value needs at least one byte and a separator.
-          if (count > (data.size() - at) / 2 + 1) return list_too_long(element, i, count);
+          // Each value needs at least one character and a separator on this line.
+          if (count > (line_end - at) / 2 + 1) return list_too_long(element, i, count);
           for (std::uint64_t k = 0; k < count; ++k)
-            if (!next_token(token)) return ends_early(element, i);
+            if (!next_token(token)) return list_too_long(element, i, count);
         }
+        skip_line_end();
+      }
     }
     return {};
   }

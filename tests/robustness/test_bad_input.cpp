@@ -232,12 +232,20 @@ TEST(BadMeshInput, PlyListsLongerThanTheFileAreRefused) {
   EXPECT_EQ(load(ascii_head + "3 0 1 2\n").mesh.triangle_count(), 1u);
   EXPECT_EQ(load(binary(false, 3, 3)).mesh.triangle_count(), 1u);
   EXPECT_EQ(load(binary(true, 3, 3)).mesh.triangle_count(), 1u);
+  std::string crlf;
+  for (char c : ascii_head + "3 0 1 2 \n\n") crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  EXPECT_EQ(load(crlf).mesh.triangle_count(), 1u);  // CRLF line ends, trailing blanks
   const std::vector<std::pair<std::string, std::string>> refused = {
       {ascii_head + "66666666666666666666666666 0 2 3\n", "list of"},
       {ascii_head + "255 0 1 2\n", "list of"},
-      {ascii_head + "3 0 1\n", "PLY data ends inside element 'face' 0 of 1"},
-      {"ply\nformat ascii 1.0\n" + vertices + faces + "end_header\n0 0 0\n1 0\n",
-       "ends inside element 'vertex' 1"},
+      // assimp reads one element per line: a list must fit on its line (the fuzzer's third input ran a face's
+      // count into the next line's digits).
+      {ascii_head + "3 0 1\n", "list of 3 values"},
+      {ascii_head + "3\n0 1 2\n", "list of 3 values"},
+      {ascii_head, "PLY data ends inside element 'face' 0 of 1"},
+      {ascii_head + "\n3 0 1 2\n", "element 'face' 0 is a blank line"},
+      {"ply\nformat ascii 1.0\n" + vertices + faces + "end_header\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n",
+       "element 'vertex' 1 has fewer values on its line"},
       {binary(false, 0xffffffffu, 3), "list of 4294967295 values"},
       {binary(true, 0xffffffffu, 3), "list of 4294967295 values"},
       {binary(false, 4, 3), "list of 4 values"},
