@@ -432,12 +432,19 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size, st
   std::string token;
   if (!(in >> token)) return {};
   const std::string magic = lower(token);
-  const bool off_keyword =
-      magic.size() >= 3 && magic.size() <= 6 && magic.compare(magic.size() - 3, 3, "off") == 0;
+  // The OFF keyword with its optional prefixes (ST, C, N, 4, n). assimp also takes it glued to the first
+  // count ("OFF99999...", found by tests/fuzz), so what follows the keyword in the token is a count.
+  const std::size_t keyword_end = magic.find("off");
+  const bool off_keyword = keyword_end != std::string::npos && keyword_end <= 3 &&
+                           magic.find_first_not_of("abcdefghijklmnopqrstuvwxyz") >= keyword_end;
   if (off_keyword || format == "off") {
     // OFF: vertex, face (and edge) counts follow the keyword, if any, possibly after comment lines.
     std::vector<std::uint64_t> counts;
     bool pending = !off_keyword;  // without the keyword, the first token is already a count
+    if (off_keyword && keyword_end + 3 < token.size()) {
+      token.erase(0, keyword_end + 3);
+      pending = true;
+    }
     while (counts.size() < 2 && (pending || in >> token)) {
       pending = false;
       if (token.front() == '#') {

@@ -156,7 +156,9 @@ TEST(BadMeshInput, HeaderCountsBeyondTheFileAreRefusedBeforeAllocating) {
       {"off", "OFF\n# comment\n4 14294967295 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n"},
       {"off", "OFF 4000000000 1 0\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n"},
       {"off", "OFF\n4 1429496429496mment\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n"},  // leading digits
-      {"off", "8 124294967295 0\n0 1 0\n1 1 0\n0 0 1\n3 0 1 2\n"},  // no OFF keyword: read as OFF by name
+      {"off", "8 124294967295 0\n0 1 0\n1 1 0\n0 0 1\n3 0 1 2\n"},   // no OFF keyword: read as OFF by name
+      {"off", "OFF4000000000 1 0\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n"},  // keyword glued to the count (fuzz)
+      {"", "COFF999999999999999 1 0\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n"},
       {"ply",
        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
        "property float z\nelement face 3000000000\nproperty list uchar int vertex_indices\nend_header\n"},
