@@ -230,7 +230,8 @@ Parts decode(std::span<const std::byte> buffer, const Layout& expected, std::str
   if (grid != expected.grid)
     fail(source, "holds a tree with " + grid_name(grid) + ", expected " + grid_name(expected.grid));
   const double tau = std::bit_cast<double>(get_le(h + kTauAt, 8));
-  if (grid > 0 ? !(std::isfinite(tau) && tau > 0) : tau != 0.0)
+  // Without density the field is all zero bits: -0.0 compares equal to 0 but would not save back the same.
+  if (grid > 0 ? !(std::isfinite(tau) && tau > 0) : std::bit_cast<std::uint64_t>(tau) != 0)
     fail(source, "corrupted header (tau " + std::to_string(tau) + ")");
 
   // Sizes, against the buffer's real length, before any allocation.

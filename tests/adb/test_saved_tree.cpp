@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 
 #include <unistd.h>
 #include <cstddef>
@@ -217,6 +218,14 @@ TEST(SavedTree, RejectsForeignFilesAndTypes) {
   expect_rejected([&] { load_tree_from_buffer<Aabb, NoDensity>(bytes); }, "expected no density");
   const Bytes plain = save_tree_to_buffer(Tree<Aabb>{annotated_torus().bvh, {}});
   expect_rejected([&] { load_adb(plain); }, "with no density");
+  // A tree without density stores tau as zero bits: -0.0 (found by fuzz_saved_tree: it compared equal to 0
+  // and was accepted, then saved back as +0.0) and any other value are corrupt headers.
+  for (const double tau : {-0.0, 0.25}) {
+    Bytes odd = plain;
+    put_u64(odd, 72, std::bit_cast<std::uint64_t>(tau));
+    reseal(odd);
+    expect_rejected([&] { load_tree_from_buffer<Aabb, NoDensity>(odd); }, "corrupted header (tau");
+  }
   // The error names the source.
   expect_rejected([&] { load_tree_from_buffer<Obb, Adb2>(bytes, "somewhere/model.tree"); },
                   "somewhere/model.tree");
