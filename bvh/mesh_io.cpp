@@ -654,6 +654,17 @@ std::string ply_body_problem(std::string_view text) {
   return {};
 }
 
+// OBJ is a text format. assimp 5.2's OBJ reader, given from memory an `mtllib` line whose name holds NUL
+// bytes, writes through a wild pointer (a SEGV, found by tests/fuzz; valgrind shows an invalid write). A NUL
+// byte has no business in an OBJ file, so one is refused up front.
+std::string binary_data_in_obj(std::string_view text, std::string_view format) {
+  if (format != "obj") return {};
+  const std::size_t nul = text.find('\0');
+  return nul == std::string_view::npos
+             ? std::string()
+             : "OBJ is a text format, but byte " + std::to_string(nul) + " is NUL (binary data?)";
+}
+
 constexpr std::size_t kHeaderBytes = 1 << 16;
 
 }  // namespace
@@ -689,13 +700,14 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
             head, ec ? head.size() : size, std::string_view(extension).substr(extension.empty() ? 0 : 1));
         !problem.empty())
       throw MeshError(source + ": " + problem);
-    if (head.size() >= 3 && std::tolower(static_cast<unsigned char>(head[0])) == 'p') {
-      // A PLY body is walked whole before assimp reads it (see ply_body_problem).
+    const std::string_view format = std::string_view(extension).substr(extension.empty() ? 0 : 1);
+    if ((head.size() >= 3 && std::tolower(static_cast<unsigned char>(head[0])) == 'p') || format == "obj") {
+      // A PLY body is walked whole, an OBJ file checked for binary data, before assimp reads them.
       in.clear();
       in.seekg(0);
       const std::string whole((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      if (const std::string problem = ply_body_problem(whole); !problem.empty())
-        throw MeshError(source + ": " + problem);
+      for (const std::string& problem : {ply_body_problem(whole), binary_data_in_obj(whole, format)})
+        if (!problem.empty()) throw MeshError(source + ": " + problem);
     }
   }
   return import_with(source, path.stem().string(),
@@ -722,8 +734,8 @@ LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_
   if (const std::string problem = oversized_header_count(text.substr(0, kHeaderBytes), text.size(), hint);
       !problem.empty())
     throw MeshError(source + ": " + problem);
-  if (const std::string problem = ply_body_problem(text); !problem.empty())
-    throw MeshError(source + ": " + problem);
+  for (const std::string& problem : {ply_body_problem(text), binary_data_in_obj(text, hint)})
+    if (!problem.empty()) throw MeshError(source + ": " + problem);
   return import_with(source, std::filesystem::path(source).stem().string(), [&](Assimp::Importer& importer) {
     return importer.ReadFileFromMemory(buffer.data(), buffer.size(), kPostProcess, hint.c_str());
   });

@@ -273,6 +273,34 @@ TEST(BadMeshInput, PlyListsLongerThanTheFileAreRefused) {
   }
 }
 
+// The sixth: assimp's OBJ reader, from memory, wrote through a wild pointer on an `mtllib` line whose name
+// held NUL bytes (a SEGV in a plain Release build too; found by tests/fuzz). OBJ is text: a NUL byte is
+// refused.
+TEST(BadMeshInput, ObjWithBinaryDataIsRefused) {
+  using namespace std::string_literals;
+  const std::string good = "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib ab\nf 1 2 3\n";
+  const std::string bad = "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib a\0\0\x07b\nf 1 2 3\n"s;
+  auto bytes = [](const std::string& text) { return std::as_bytes(std::span(text.data(), text.size())); };
+  EXPECT_EQ(load_mesh_from_memory(bytes(good), "obj", "text.obj").mesh.triangle_count(), 1u);
+  try {
+    load_mesh_from_memory(bytes(bad), "obj", "binary.obj");
+    ADD_FAILURE() << "loaded an OBJ file with NUL bytes";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("binary.obj: OBJ is a text format, but byte 32 is NUL"),
+              std::string::npos)
+        << e.what();
+  }
+  const fs::path file = fs::temp_directory_path() / ("bvhlab-binary-" + std::to_string(getpid()) + ".obj");
+  std::ofstream(file, std::ios::binary) << bad;
+  try {
+    load_mesh(file);
+    ADD_FAILURE() << "loaded " << file;
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("is NUL"), std::string::npos) << e.what();
+  }
+  fs::remove(file);
+}
+
 // Truncations and byte flips of every seed: each loads (and then keeps the loader's promises) or is refused
 // with a message naming the input. A crash or an abort fails the whole test binary.
 TEST(BadMeshInput, MutilatedSeedsAreLoadedOrRefusedNeverCrash) {
