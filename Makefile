@@ -29,13 +29,15 @@ tsan-test:
 	cmake --build --preset tsan --target test_robust_threads -j $(JOBS)
 	ctest --preset tsan -j $(JOBS)
 
-# libFuzzer targets (clang, ASan + UBSan): replay the committed corpora, then explore FUZZ_SECONDS per target.
+# libFuzzer targets (clang, ASan + UBSan): replay the committed corpora, then explore FUZZ_SECONDS per target
+# (FUZZ_SEED fixes the exploration, as CI does; empty: a fresh seed each run).
 FUZZ_SECONDS ?= 30
+FUZZ_SEED ?=
 fuzz:
 	$(MAKE) configure PRESET=fuzz
 	cmake --build --preset fuzz --target bvhlab_fuzzers -j $(JOBS)
 	ctest --preset fuzz
-	tests/fuzz/run_fuzzers.sh build/fuzz $(FUZZ_SECONDS)
+	FUZZ_SEED=$(FUZZ_SEED) tests/fuzz/run_fuzzers.sh build/fuzz $(FUZZ_SECONDS)
 
 clean:
 	rm -rf build

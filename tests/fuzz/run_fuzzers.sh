@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Explores each libFuzzer target for a while, starting from a scratch copy of its committed corpus.
 #   tests/fuzz/run_fuzzers.sh <fuzz build dir> [seconds per target, default 30] [target ...]
+# FUZZ_SEED=<n> fixes libFuzzer's seed, so that a run explores the same inputs every time (CI does this: a red
+# run must be reproducible; exploring with fresh seeds is what the long runs by hand are for).
 # New inputs stay in the scratch dir (the committed corpus only grows by hand, with reproducers kept small);
 # crashes, leaks, timeouts and OOMs are copied to <build dir>/fuzz-artifacts and fail the run.
 set -euo pipefail
@@ -33,6 +35,7 @@ for target in "${targets[@]}"; do
   args=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -print_final_stats=1
         -artifact_prefix="$artifacts/$target-")
   [ -f "$here/$target.dict" ] && args+=(-dict="$here/$target.dict")
+  [ -n "${FUZZ_SEED:-}" ] && args+=(-seed="$FUZZ_SEED")
   log="$work/$target.log"
   if "$exe" "${args[@]}" "$work/$target" "$here/corpus/$target" >"$log" 2>&1; then
     result=ok
