@@ -54,6 +54,21 @@ std::vector<MeshSeed> mesh_seeds() {
 
 // Loads, and on success checks what every loaded mesh promises; on refusal checks the message names `name`.
 // Returns whether it loaded.
+// Writes `text` to a scratch file with `extension`, loads it through load_mesh, and expects a refusal that
+// contains `problem`.
+void expect_file_refused(const std::string& text, const std::string& extension, const std::string& problem) {
+  const fs::path file =
+      fs::temp_directory_path() / ("bvhlab-refused-" + std::to_string(getpid()) + "." + extension);
+  std::ofstream(file, std::ios::binary) << text;
+  try {
+    load_mesh(file);
+    ADD_FAILURE() << "loaded " << file;
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
+  }
+  fs::remove(file);
+}
+
 bool load_or_refuse(std::span<const std::uint8_t> bytes, const std::string& format, const std::string& name) {
   try {
     const LoadedMesh loaded = load_mesh_from_memory(std::as_bytes(bytes), format, name);
@@ -170,16 +185,7 @@ TEST(BadMeshInput, HeaderCountsBeyondTheFileAreRefusedBeforeAllocating) {
     } catch (const MeshError& e) {
       EXPECT_NE(std::string(e.what()).find("big.mesh: header declares"), std::string::npos) << e.what();
     }
-    const fs::path file = fs::temp_directory_path() / ("bvhlab-big-" + std::to_string(getpid()) + "." +
-                                                       (format.empty() ? std::string("ply") : format));
-    std::ofstream(file, std::ios::binary) << text;
-    try {
-      load_mesh(file);
-      ADD_FAILURE() << "loaded " << file;
-    } catch (const MeshError& e) {
-      EXPECT_NE(std::string(e.what()).find("header declares"), std::string::npos) << e.what();
-    }
-    fs::remove(file);
+    expect_file_refused(text, format.empty() ? std::string("ply") : format, "header declares");
   }
 }
 
@@ -290,15 +296,7 @@ TEST(BadMeshInput, ObjWithBinaryDataIsRefused) {
               std::string::npos)
         << e.what();
   }
-  const fs::path file = fs::temp_directory_path() / ("bvhlab-binary-" + std::to_string(getpid()) + ".obj");
-  std::ofstream(file, std::ios::binary) << bad;
-  try {
-    load_mesh(file);
-    ADD_FAILURE() << "loaded " << file;
-  } catch (const MeshError& e) {
-    EXPECT_NE(std::string(e.what()).find("is NUL"), std::string::npos) << e.what();
-  }
-  fs::remove(file);
+  expect_file_refused(bad, "obj", "is NUL");
 }
 
 // Containment: assimp runs in a reader process, so a crash or an abort inside it (the fuzzers found several;
