@@ -7,21 +7,11 @@
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
 
-#include <fcntl.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <bit>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
-#include <csignal>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -31,34 +21,9 @@
 #include <sstream>
 #include <string>
 #include <system_error>
-#include <type_traits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
-
-// Address and thread sanitizers reserve terabytes of address space: no address-space cap under them.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define BVHLAB_UNDER_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-#define BVHLAB_UNDER_SANITIZER 1
-#endif
-#endif
-#ifndef BVHLAB_UNDER_SANITIZER
-#define BVHLAB_UNDER_SANITIZER 0
-#endif
-// ThreadSanitizer does not support fork() from a multi-threaded process: its child deadlocked in the
-// concurrent-load test (about one run in three). A TSan build reads in-process; it is there to check threads.
-#if defined(__SANITIZE_THREAD__)
-#define BVHLAB_READER_IN_PROCESS 1
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define BVHLAB_READER_IN_PROCESS 1
-#endif
-#endif
-#ifndef BVHLAB_READER_IN_PROCESS
-#define BVHLAB_READER_IN_PROCESS 0
-#endif
 
 namespace bvhlab {
 namespace {
@@ -306,44 +271,31 @@ class SceneMerger {
   std::unordered_map<PositionKey, std::uint32_t, PositionKeyHash> weld_;
 };
 
-/// The triangulated scene as the reader process sends it: sub-meshes (null where assimp left none) and their
-/// instances, in the order of an iterative node walk, each with its composed node transform.
-struct FlatScene {
-  std::vector<std::unique_ptr<aiMesh>> meshes;
-  std::vector<std::pair<std::uint32_t, Mat4>> instances;
-};
-
-/// The node walk, in the reader process. Iterative: a hostile file must not overflow the stack with a deep
-/// node chain.
-std::vector<std::pair<std::uint32_t, Mat4>> instances_of(const aiScene& scene) {
-  std::vector<std::pair<std::uint32_t, Mat4>> instances;
+LoadedMesh merge_scene(const aiScene& scene, const std::string& source, std::string name) {
+  SceneMerger merger(source);
+  std::vector<bool> referenced(scene.mNumMeshes, false);
+  // Iterative walk: a hostile file must not overflow the stack with a deep node chain.
   std::vector<std::pair<const aiNode*, Mat4>> pending;
   if (scene.mRootNode != nullptr) pending.emplace_back(scene.mRootNode, Mat4::Identity());
   while (!pending.empty()) {
     auto [node, parent] = pending.back();
     pending.pop_back();
     const Mat4 global = parent * to_eigen(node->mTransformation);
-    for (unsigned i = 0; i < node->mNumMeshes; ++i) instances.emplace_back(node->mMeshes[i], global);
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      const unsigned m = node->mMeshes[i];
+      if (m >= scene.mNumMeshes || scene.mMeshes[m] == nullptr)
+        merger.fail("scene node refers to sub-mesh " + std::to_string(m) + " which does not exist");
+      referenced[m] = true;
+      merger.add_instance(m, *scene.mMeshes[m], global);
+    }
     for (unsigned c = 0; c < node->mNumChildren; ++c)
       if (node->mChildren[c] != nullptr) pending.emplace_back(node->mChildren[c], global);
   }
-  return instances;
-}
-
-LoadedMesh merge_scene(const FlatScene& scene, const std::string& source, std::string name) {
-  SceneMerger merger(source);
-  std::vector<bool> referenced(scene.meshes.size(), false);
-  for (const auto& [m, global] : scene.instances) {
-    if (m >= scene.meshes.size() || scene.meshes[m] == nullptr)
-      merger.fail("scene node refers to sub-mesh " + std::to_string(m) + " which does not exist");
-    referenced[m] = true;
-    merger.add_instance(m, *scene.meshes[m], global);
-  }
-  for (unsigned m = 0; m < scene.meshes.size(); ++m) {
-    if (referenced[m] || scene.meshes[m] == nullptr) continue;
-    merger.report().warnings.push_back(describe_submesh(m, *scene.meshes[m]) +
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    if (referenced[m] || scene.mMeshes[m] == nullptr) continue;
+    merger.report().warnings.push_back(describe_submesh(m, *scene.mMeshes[m]) +
                                        " is in no scene node; merged untransformed");
-    merger.add_instance(m, *scene.meshes[m], Mat4::Identity());
+    merger.add_instance(m, *scene.mMeshes[m], Mat4::Identity());
   }
   return merger.finish(std::move(name));
 }
@@ -376,263 +328,38 @@ std::string prepare_for_triangulation(aiScene& scene) {
   return {};
 }
 
-// ---------------------------------------------------------------------------------------------------------
-// The reader process. assimp is third-party code reading untrusted bytes, and the fuzzers found one crash in
-// its importers after another (an abort, hangs, wild writes, allocations of tens of gigabytes; each is now
-// refused before assimp sees it). So that the next one cannot take the caller down, assimp runs in a child
-// process: a crash, an abort or a time-out there is a MeshError here, naming the file. Only assimp's import
-// and the node walk run in the child; everything the loader checks and merges runs here, on plain data.
-
-/// Native-endian byte stream between the reader process and this one (same binary on both ends).
-class Wire {
- public:
-  template <class T>
-  void put(const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    bytes_.append(reinterpret_cast<const char*>(&value), sizeof(T));
-  }
-  void put_bytes(const void* data, std::size_t size) {
-    put<std::uint64_t>(size);
-    bytes_.append(static_cast<const char*>(data), size);
-  }
-  void put_string(const std::string& text) { put_bytes(text.data(), text.size()); }
-  [[nodiscard]] const std::string& bytes() const { return bytes_; }
-
- private:
-  std::string bytes_;
-};
-
-class WireReader {
- public:
-  WireReader(std::string_view bytes, const std::string& source) : bytes_(bytes), source_(source) {}
-  template <class T>
-  T get() {
-    T value;
-    std::memcpy(&value, take(sizeof(T)), sizeof(T));
-    return value;
-  }
-  std::string_view get_bytes() {
-    const auto size = get<std::uint64_t>();
-    return {take(size), static_cast<std::size_t>(size)};
-  }
-
- private:
-  const char* take(std::uint64_t size) {
-    if (size > bytes_.size() - at_) throw MeshError(source_ + ": the reader process sent truncated data");
-    const char* out = bytes_.data() + at_;
-    at_ += static_cast<std::size_t>(size);
-    return out;
-  }
-  std::string_view bytes_;
-  const std::string& source_;
-  std::size_t at_ = 0;
-};
-
-enum class ReaderVerdict : std::uint8_t { scene, no_scene, problem, exception };
-
-/// In the reader process: import, check, triangulate, walk, and encode what this side needs.
 template <class ReadFn>
-std::string import_in_reader(ReadFn& read) {
-  Wire wire;
+LoadedMesh import_with(const std::string& source, std::string name, ReadFn read) {
+  install_assimp_logger();
   LogCapture capture;
   Assimp::Importer importer;
   const aiScene* scene = nullptr;
   std::string problem;
-  ReaderVerdict verdict = ReaderVerdict::scene;
-  std::string text;  // assimp's error, our problem, or the exception
   try {
+    // One import at a time: assimp's DefaultLogger formats every message in one buffer shared by all threads
+    // (ThreadSanitizer: a data race in WriteToStreams), so concurrent loads could swap or garble the messages
+    // this loader reads to detect bad indices. Loading is rarely the bottleneck; being right is not optional.
+    static std::mutex import_mutex;
+    const std::lock_guard lock(import_mutex);
     ScopedCapture scoped(capture);
     scene = read(importer);
     if (scene != nullptr) {
       problem = prepare_for_triangulation(*const_cast<aiScene*>(scene));  // the importer's own scene
       if (problem.empty()) scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
     }
-    if (scene == nullptr)
-      verdict = ReaderVerdict::no_scene, text = importer.GetErrorString();
-    else if (!problem.empty())
-      verdict = ReaderVerdict::problem, text = problem;
   } catch (const std::exception& e) {  // assimp reports through GetErrorString; this is for bad_alloc & co.
-    verdict = ReaderVerdict::exception, text = e.what();
+    throw MeshError(source + ": reading failed: " + e.what());
   }
-  wire.put(verdict);
-  wire.put_string(text);
-  wire.put<std::uint64_t>(capture.messages.size());
-  for (const auto& m : capture.messages) wire.put_string(m);
-  if (verdict != ReaderVerdict::scene) return wire.bytes();
-  wire.put<std::uint64_t>(scene->mNumMeshes);
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* mesh = scene->mMeshes[m];
-    wire.put<std::uint8_t>(mesh != nullptr);
-    if (mesh == nullptr) continue;
-    wire.put_string(mesh->mName.C_Str());
-    wire.put<std::uint64_t>(mesh->mNumVertices);
-    wire.put<std::uint8_t>(mesh->mVertices != nullptr);
-    if (mesh->mVertices != nullptr) wire.put_bytes(mesh->mVertices, mesh->mNumVertices * sizeof(aiVector3D));
-    wire.put<std::uint64_t>(mesh->mFaces == nullptr ? 0 : mesh->mNumFaces);
-    for (unsigned f = 0; mesh->mFaces != nullptr && f < mesh->mNumFaces; ++f) {
-      const aiFace& face = mesh->mFaces[f];
-      wire.put_bytes(face.mIndices, face.mIndices == nullptr ? 0 : face.mNumIndices * sizeof(unsigned));
-    }
-  }
-  const auto instances = instances_of(*scene);
-  wire.put<std::uint64_t>(instances.size());
-  for (const auto& [m, global] : instances) {
-    wire.put(m);
-    wire.put_bytes(global.data(), sizeof(double) * 16);
-  }
-  return wire.bytes();
-}
 
-FlatScene decode_scene(WireReader& in) {
-  FlatScene scene;
-  const auto meshes = in.get<std::uint64_t>();
-  for (std::uint64_t m = 0; m < meshes; ++m) {
-    if (in.get<std::uint8_t>() == 0) {
-      scene.meshes.emplace_back();
-      continue;
-    }
-    auto mesh = std::make_unique<aiMesh>();  // owns its arrays: ~aiMesh frees them
-    const std::string_view name = in.get_bytes();
-    mesh->mName.Set(std::string(name));
-    mesh->mNumVertices = static_cast<unsigned>(in.get<std::uint64_t>());
-    if (in.get<std::uint8_t>() != 0) {  // else SceneMerger refuses a mesh without positions
-      const std::string_view positions = in.get_bytes();
-      if (positions.size() != std::size_t{mesh->mNumVertices} * sizeof(aiVector3D))
-        throw MeshError("the reader process sent inconsistent positions");
-      mesh->mVertices = new aiVector3D[mesh->mNumVertices];
-      std::memcpy(static_cast<void*>(mesh->mVertices), positions.data(), positions.size());
-    }
-    mesh->mNumFaces = static_cast<unsigned>(in.get<std::uint64_t>());
-    if (mesh->mNumFaces > 0) mesh->mFaces = new aiFace[mesh->mNumFaces];
-    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-      const std::string_view indices = in.get_bytes();
-      aiFace& face = mesh->mFaces[f];
-      face.mNumIndices = static_cast<unsigned>(indices.size() / sizeof(unsigned));
-      if (face.mNumIndices > 0) {
-        face.mIndices = new unsigned[face.mNumIndices];
-        std::memcpy(face.mIndices, indices.data(), indices.size());
-      }
-    }
-    scene.meshes.push_back(std::move(mesh));
-  }
-  const auto instances = in.get<std::uint64_t>();
-  for (std::uint64_t i = 0; i < instances; ++i) {
-    const auto m = in.get<std::uint32_t>();
-    Mat4 global;
-    std::memcpy(global.data(), in.get_bytes().data(), sizeof(double) * 16);
-    scene.instances.emplace_back(m, global);
-  }
-  return scene;
-}
-
-/// Runs `read` (an assimp import) in a child process and returns what it sent, or throws a MeshError naming
-/// `source` when the child crashed, was stopped by its time limit, or could not be started.
-template <class ReadFn>
-std::string run_reader_process(const std::string& source, std::size_t input_bytes, ReadFn& read) {
-  if constexpr (BVHLAB_READER_IN_PROCESS) return import_in_reader(read);
-  // Generous: the 871k-triangle dragon (35 MB of ASCII PLY) reads in about 3 s; sanitizers are ~10x slower.
-  const unsigned seconds =
-      300 + static_cast<unsigned>(std::min<std::size_t>(input_bytes >> 20, 1u << 20) * 10);
-  int fds[2];
-  if (pipe2(fds, O_CLOEXEC) != 0)
-    throw MeshError(source + ": cannot start the reader process (pipe: " + std::strerror(errno) + ")");
-  std::fflush(nullptr);  // nothing buffered may be written twice
-  const pid_t pid = fork();
-  if (pid < 0) {
-    const int error = errno;
-    close(fds[0]);
-    close(fds[1]);
-    throw MeshError(source + ": cannot start the reader process (fork: " + std::strerror(error) + ")");
-  }
-  if (pid == 0) {
-    // The reader process: a crash must end it plainly (not in the parent's handlers, a fuzzer's among them).
-    close(fds[0]);
-    for (const int signal : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGALRM}) std::signal(signal, SIG_DFL);
-    alarm(seconds);
-    // Fault injection for the tests of this containment (tests/robustness): the reader fails as named.
-    if (const char* fault = std::getenv("BVHLAB_MESH_READER_FAULT")) {
-      if (std::strcmp(fault, "segv") == 0) std::raise(SIGSEGV);
-      if (std::strcmp(fault, "abort") == 0) std::abort();
-    }
-#if !BVHLAB_UNDER_SANITIZER
-    // A memory cap turns an absurd allocation into bad_alloc instead of swapping the machine to a halt: what
-    // the process already maps (inherited from the caller) plus 8 GiB plus 256 bytes per input byte.
-    rlim_t mapped = 0;
-    if (std::FILE* statm = std::fopen("/proc/self/statm", "r")) {
-      unsigned long pages = 0;
-      if (std::fscanf(statm, "%lu", &pages) == 1) mapped = static_cast<rlim_t>(pages) * sysconf(_SC_PAGESIZE);
-      std::fclose(statm);
-    }
-    const rlim_t cap = mapped + (rlim_t{8} << 30) + static_cast<rlim_t>(input_bytes) * 256;
-    const rlimit limit{cap, cap};
-    setrlimit(RLIMIT_AS, &limit);
-#endif
-    std::string out;
-    try {
-      out = import_in_reader(read);
-    } catch (...) {
-      _exit(3);
-    }
-    for (std::size_t at = 0; at < out.size();) {
-      const ssize_t n = write(fds[1], out.data() + at, out.size() - at);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) _exit(4);
-      at += static_cast<std::size_t>(n);
-    }
-    _exit(0);
-  }
-  close(fds[1]);
-  std::string data;
-  char buffer[1 << 16];
-  for (;;) {
-    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    data.append(buffer, static_cast<std::size_t>(n));
-  }
-  close(fds[0]);
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (WIFSIGNALED(status)) {
-    const int signal = WTERMSIG(status);
-    if (signal == SIGALRM)
-      throw MeshError(source + ": the mesh reader (assimp) took longer than " + std::to_string(seconds) +
-                      " s and was stopped (corrupt file?)");
-    throw MeshError(source + ": the mesh reader (assimp) crashed on this input (" + strsignal(signal) +
-                    "); the file is corrupt or not supported");
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw MeshError(source + ": the mesh reader (assimp) failed on this input (exit status " +
-                    std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
-  return data;
-}
-
-template <class ReadFn>
-LoadedMesh import_with(const std::string& source, std::string name, std::size_t input_bytes, ReadFn read) {
-  install_assimp_logger();
-  std::string data;
-  {
-    // One import at a time: assimp's DefaultLogger formats every message in one buffer shared by all threads
-    // (ThreadSanitizer: a data race in WriteToStreams), and a fork is best taken by one thread at a time.
-    static std::mutex import_mutex;
-    const std::lock_guard lock(import_mutex);
-    data = run_reader_process(source, input_bytes, read);
-  }
-  WireReader in(data, source);
-  const auto verdict = in.get<ReaderVerdict>();
-  const std::string text(in.get_bytes());
   std::vector<std::string> log;
-  const auto messages = in.get<std::uint64_t>();
-  for (std::uint64_t i = 0; i < messages; ++i) {
-    std::string message = strip_log_prefix(std::string(in.get_bytes()));
+  for (auto& m : capture.messages) {
+    std::string message = strip_log_prefix(std::move(m));
     // The merger keeps only vertices that triangles use, so this validation remark is no news to the caller.
     if (message.find("There are unreferenced vertices") == std::string::npos)
       log.push_back(std::move(message));
   }
-  if (verdict == ReaderVerdict::exception) throw MeshError(source + ": reading failed: " + text);
-  if (verdict == ReaderVerdict::no_scene) {
-    const std::string& error = text;
+  if (scene == nullptr) {
+    const std::string error = importer.GetErrorString();
     if (error.find("No suitable reader") != std::string::npos)
       throw MeshError(source + ": unknown or unsupported file format (assimp: " + error + ")");
     if (error.find("Validation failed") != std::string::npos &&
@@ -640,12 +367,11 @@ LoadedMesh import_with(const std::string& source, std::string name, std::size_t 
       throw MeshError(source + ": index out of range (assimp: " + error + ")");
     throw MeshError(source + ": assimp could not read it: " + (error.empty() ? "unknown error" : error));
   }
-  if (verdict == ReaderVerdict::problem) throw MeshError(source + ": " + text);
+  if (!problem.empty()) throw MeshError(source + ": " + problem);
   for (const auto& m : log)
     if (reports_bad_index(m)) throw MeshError(source + ": index out of range (assimp: " + m + ")");
 
-  const FlatScene scene = decode_scene(in);
-  LoadedMesh loaded = merge_scene(scene, source, std::move(name));
+  LoadedMesh loaded = merge_scene(*scene, source, std::move(name));
   constexpr std::size_t kMaxLogWarnings = 20;
   for (std::size_t i = 0; i < log.size() && i < kMaxLogWarnings; ++i)
     loaded.report.warnings.push_back("assimp: " + log[i]);
@@ -984,7 +710,7 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
         if (!problem.empty()) throw MeshError(source + ": " + problem);
     }
   }
-  return import_with(source, path.stem().string(), ec ? 0 : static_cast<std::size_t>(size),
+  return import_with(source, path.stem().string(),
                      [&](Assimp::Importer& importer) { return importer.ReadFile(source, kPostProcess); });
 }
 
@@ -1010,10 +736,9 @@ LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_
     throw MeshError(source + ": " + problem);
   for (const std::string& problem : {ply_body_problem(text), binary_data_in_obj(text, hint)})
     if (!problem.empty()) throw MeshError(source + ": " + problem);
-  return import_with(
-      source, std::filesystem::path(source).stem().string(), buffer.size(), [&](Assimp::Importer& importer) {
-        return importer.ReadFileFromMemory(buffer.data(), buffer.size(), kPostProcess, hint.c_str());
-      });
+  return import_with(source, std::filesystem::path(source).stem().string(), [&](Assimp::Importer& importer) {
+    return importer.ReadFileFromMemory(buffer.data(), buffer.size(), kPostProcess, hint.c_str());
+  });
 }
 
 double normalize_to_unit_cube(Mesh& mesh) {

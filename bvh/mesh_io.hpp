@@ -59,9 +59,6 @@ struct LoadedMesh {
 /// Throws MeshError for: a missing, unreadable or empty file; an unknown format; any assimp failure; no
 /// triangles; a NaN or infinite coordinate; an out-of-range index (also when assimp only logs it and
 /// substitutes another vertex); coordinates beyond MeshPrecisionLimits; a zero-size model.
-/// assimp reads the file in a child process (Linux: fork), so that a crash, an abort or a hang inside it on
-/// corrupt input becomes a MeshError naming the file (the environment variable BVHLAB_MESH_READER_FAULT =
-/// segv or abort makes that process fail so, for tests). The loader's own checks and merging run here.
 LoadedMesh load_mesh(const std::filesystem::path& path);
 /// Same from a memory buffer; `format_hint` is a file extension such as "obj" or "ply" (leading dot allowed).
 /// Mesh::name is the stem of `name`. Formats that refer to side files (OBJ's .mtl, glTF's .bin) cannot

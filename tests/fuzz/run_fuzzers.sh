@@ -5,9 +5,6 @@
 # run must be reproducible; exploring with fresh seeds is what the long runs by hand are for).
 # New inputs stay in the scratch dir (the committed corpus only grows by hand, with reproducers kept small);
 # crashes, leaks, timeouts and OOMs are copied to <build dir>/fuzz-artifacts and fail the run.
-# fuzz_mesh_load: assimp reads in a child process (bvh/mesh_io.cpp). When assimp crashes or asks for too much
-# memory there, the child's copy of libFuzzer prints a report and writes an artifact, but the child's death is
-# contained (a MeshError in the fuzzer process): only the fuzzer process's own exit status decides the run.
 set -euo pipefail
 [ $# -ge 1 ] || { echo "usage: $0 <fuzz build dir> [seconds] [target ...]" >&2; exit 2; }
 build=$(cd "$1" && pwd)
