@@ -381,6 +381,24 @@ LoadedMesh import_with(const std::string& source, std::string name, ReadFn read)
   return loaded;
 }
 
+// ASCII lower case, for format keywords and file extensions.
+std::string lower_case(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// A count as assimp reads it: the text's leading digits ("12abc" is 12), saturating far above any real file
+// so that an overflowing count is still caught as huge.
+std::uint64_t leading_count(std::string_view text) {
+  std::uint64_t value = 0;
+  for (char c : text) {
+    if (c < '0' || c > '9') break;
+    value = std::min<std::uint64_t>(value * 10 + static_cast<unsigned>(c - '0'), 1ull << 62);
+  }
+  return value;
+}
+
 // assimp 5.2's PLY reader never returns when the header ends without an `end_header` line (any truncated
 // header; found by tests/fuzz), so such input is refused before assimp sees it. `next_line` yields the
 // input's lines until it returns false.
@@ -410,18 +428,6 @@ constexpr const char* kUnterminatedPly = ": PLY header has no end_header line (t
 // extension (assimp reads a file named .off as OFF even without the OFF keyword). Returns the problem, or ""
 // when none is seen.
 std::string oversized_header_count(std::string_view head, std::uint64_t size, std::string_view format) {
-  auto lower = [](std::string_view text) {
-    std::string out(text);
-    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return out;
-  };
-  // Counts as written, saturating far above any real file, so an overflowing count is caught as huge.
-  auto count_of = [](std::string_view digits) {
-    std::uint64_t value = 0;
-    for (char c : digits)
-      value = std::min<std::uint64_t>(value * 10 + static_cast<unsigned>(c - '0'), 1ull << 62);
-    return value;
-  };
   auto too_many = [&](std::uint64_t count, const std::string& what) {
     return count > size
                ? "header declares " + std::to_string(count) + " " + what + " but the file has only " +
@@ -431,7 +437,7 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size, st
   std::istringstream in{std::string(head)};
   std::string token;
   if (!(in >> token)) return {};
-  const std::string magic = lower(token);
+  const std::string magic = lower_case(token);
   // The OFF keyword with its optional prefixes (ST, C, N, 4, n). assimp also takes it glued to the first
   // count ("OFF99999...", found by tests/fuzz), so what follows the keyword in the token is a count.
   const std::size_t keyword_end = magic.find("off");
@@ -454,7 +460,7 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size, st
       // assimp reads a count as the token's leading digits ("12abc" is 12), so this does too.
       token.resize(std::min(token.find_first_not_of("0123456789"), token.size()));
       if (token.empty()) break;
-      counts.push_back(count_of(token));
+      counts.push_back(leading_count(token));
     }
     const char* names[] = {"vertices", "faces"};
     for (std::size_t i = 0; i < counts.size(); ++i)
@@ -477,8 +483,7 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size, st
                (keyword == "format" ? std::string("the format") : "element '" + name + "'") + " twice";
       seen.push_back(name);
       if (keyword == "format") continue;
-      digits.resize(std::min(digits.find_first_not_of("0123456789"), digits.size()));
-      if (auto problem = too_many(count_of(digits), "'" + name + "' elements"); !problem.empty())
+      if (auto problem = too_many(leading_count(digits), "'" + name + "' elements"); !problem.empty())
         return problem;
     }
   }
@@ -492,12 +497,7 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size, st
 // understand is refused too (an unknown property type let the same huge count through). Returns the
 // problem, or "" for a PLY file whose body matches its header (and for input that is not PLY).
 std::string ply_body_problem(std::string_view text) {
-  auto lower = [](std::string_view word) {
-    std::string out(word);
-    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return out;
-  };
-  if (text.size() < 3 || lower(text.substr(0, 3)) != "ply") return {};
+  if (text.size() < 3 || lower_case(text.substr(0, 3)) != "ply") return {};
   // Byte size of a PLY scalar type, 0 when unknown.
   auto size_of = [](const std::string& type) -> std::size_t {
     if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
@@ -539,7 +539,7 @@ std::string ply_body_problem(std::string_view text) {
       std::string digits;
       if (!(words >> element.name >> digits) || digits.find_first_not_of("0123456789") != std::string::npos)
         return "PLY header: element line without a name and a count";
-      element.count = std::min<std::uint64_t>(std::stoull(digits.substr(0, 18)), 1ull << 62);
+      element.count = leading_count(digits);
       elements.push_back(std::move(element));
     } else if (keyword == "property") {
       if (elements.empty()) return "PLY header: property before any element";
@@ -556,7 +556,7 @@ std::string ply_body_problem(std::string_view text) {
         return "PLY header: unknown property type '" + type + "'";
       }
       elements.back().properties.push_back(property);
-    } else if (keyword != "comment" && keyword != "obj_info" && lower(keyword) != "ply") {
+    } else if (keyword != "comment" && keyword != "obj_info" && lower_case(keyword) != "ply") {
       return "PLY header: unknown line '" + keyword + "'";
     }
   }
@@ -613,12 +613,7 @@ std::string ply_body_problem(std::string_view text) {
         for (const Property& property : element.properties) {
           if (!next_token(token)) return too_few(element, i);
           if (property.count_size == 0) continue;
-          // A list's count: its leading digits, saturating (assimp reads it as an unsigned integer).
-          std::uint64_t count = 0;
-          for (char c : token) {
-            if (c < '0' || c > '9') break;
-            count = std::min<std::uint64_t>(count * 10 + static_cast<unsigned>(c - '0'), 1ull << 62);
-          }
+          const std::uint64_t count = leading_count(token);
           // Each value needs at least one character and a separator on this line.
           if (count > (line_end - at) / 2 + 1) return list_too_long(element, i, count);
           for (std::uint64_t k = 0; k < count; ++k)
@@ -695,7 +690,7 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
     in.read(head.data(), static_cast<std::streamsize>(head.size()));
     head.resize(static_cast<std::size_t>(in.gcount()));
     std::string extension = path.extension().string();
-    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    extension = lower_case(extension);
     if (const std::string problem = oversized_header_count(
             head, ec ? head.size() : size, std::string_view(extension).substr(extension.empty() ? 0 : 1));
         !problem.empty())
@@ -730,7 +725,7 @@ LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_
     throw MeshError(source + kUnterminatedPly);
   std::string hint(format_hint);
   if (!hint.empty() && hint.front() == '.') hint.erase(0, 1);
-  for (char& c : hint) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  hint = lower_case(hint);
   if (const std::string problem = oversized_header_count(text.substr(0, kHeaderBytes), text.size(), hint);
       !problem.empty())
     throw MeshError(source + ": " + problem);
