@@ -1,5 +1,7 @@
 #include "bvh/mesh_io.hpp"
 
+#include "bvh/gltf_reduce.hpp"
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -17,6 +19,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -662,6 +665,33 @@ std::string binary_data_in_obj(std::string_view text, std::string_view format) {
 
 constexpr std::size_t kHeaderBytes = 1 << 16;
 
+// glTF input goes to assimp reduced (bvh/gltf_reduce.hpp); other input as it is (`read_original`).
+template <class ReadOriginal>
+LoadedMesh import_maybe_gltf(std::string_view bytes, std::string_view format, const std::string& source,
+                             std::string name, const std::optional<std::string>& asset_directory,
+                             ReadOriginal read_original) {
+  std::optional<detail::ReducedGltf> gltf;
+  try {
+    gltf = detail::reduce_gltf(bytes, format, asset_directory);
+  } catch (const detail::GltfRefused& e) {
+    throw MeshError(source + ": " + e.what());
+  }
+  if (!gltf) return import_with(source, std::move(name), read_original);
+  LoadedMesh loaded = import_with(source, std::move(name), [&](Assimp::Importer& importer) {
+    return importer.ReadFileFromMemory(gltf->bytes.data(), gltf->bytes.size(), kPostProcess,
+                                       gltf->format.c_str());
+  });
+  loaded.report.ignored_lines += gltf->dropped_line_segments;
+  for (auto& warning : gltf->warnings) loaded.report.warnings.push_back("glTF: " + std::move(warning));
+  return loaded;
+}
+
+// Where assimp looks for a file's side files: the path up to its last separator.
+std::string asset_directory_of(const std::string& path) {
+  const std::size_t slash = path.find_last_of("/\\");
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
 }  // namespace
 
 LoadedMesh load_mesh(const std::filesystem::path& path) {
@@ -696,17 +726,25 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
         !problem.empty())
       throw MeshError(source + ": " + problem);
     const std::string_view format = std::string_view(extension).substr(extension.empty() ? 0 : 1);
-    if ((head.size() >= 3 && std::tolower(static_cast<unsigned char>(head[0])) == 'p') || format == "obj") {
-      // A PLY body is walked whole, an OBJ file checked for binary data, before assimp reads them.
+    const std::size_t first = head.find_first_not_of(" \t\r\n");
+    const bool maybe_gltf =
+        format == "glb" || (first == std::string::npos ? head.size() == kHeaderBytes : head[first] == '{');
+    std::string whole;
+    if ((head.size() >= 3 && std::tolower(static_cast<unsigned char>(head[0])) == 'p') || format == "obj" ||
+        maybe_gltf) {
+      // A PLY body is walked whole, an OBJ file checked for binary data, a glTF file reduced, before assimp
+      // reads them.
       in.clear();
       in.seekg(0);
-      const std::string whole((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      whole.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
       for (const std::string& problem : {ply_body_problem(whole), binary_data_in_obj(whole, format)})
         if (!problem.empty()) throw MeshError(source + ": " + problem);
     }
+    return import_maybe_gltf(
+        maybe_gltf ? std::string_view(whole) : std::string_view(), format, source, path.stem().string(),
+        asset_directory_of(source),
+        [&](Assimp::Importer& importer) { return importer.ReadFile(source, kPostProcess); });
   }
-  return import_with(source, path.stem().string(),
-                     [&](Assimp::Importer& importer) { return importer.ReadFile(source, kPostProcess); });
 }
 
 LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_view format_hint,
@@ -731,9 +769,11 @@ LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_
     throw MeshError(source + ": " + problem);
   for (const std::string& problem : {ply_body_problem(text), binary_data_in_obj(text, hint)})
     if (!problem.empty()) throw MeshError(source + ": " + problem);
-  return import_with(source, std::filesystem::path(source).stem().string(), [&](Assimp::Importer& importer) {
-    return importer.ReadFileFromMemory(buffer.data(), buffer.size(), kPostProcess, hint.c_str());
-  });
+  return import_maybe_gltf(text, hint, source, std::filesystem::path(source).stem().string(), std::nullopt,
+                           [&](Assimp::Importer& importer) {
+                             return importer.ReadFileFromMemory(buffer.data(), buffer.size(), kPostProcess,
+                                                                hint.c_str());
+                           });
 }
 
 double normalize_to_unit_cube(Mesh& mesh) {
