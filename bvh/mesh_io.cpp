@@ -89,7 +89,8 @@ bool reports_bad_index(const std::string& message) {
       R"((out of range|out of bounds|outside|overflow))"
       R"(|(invalid|bad) (vertex|face|triangle) (index|ind|reference))"
       R"(|(vertex|face) has an invalid index)"
-      R"(|index overflow in [a-z0-9 ]{0,20}vertex)",
+      R"(|index overflow in [a-z0-9 ]{0,20}vertex)"
+      R"(|faces had out-of-range indices)",  // glTF: those faces were dropped
       std::regex::icase);
   return std::regex_search(message, bad_index);
 }

@@ -56,13 +56,18 @@ struct LoadedMesh {
 /// All sub-meshes are merged with their scene-graph transforms applied, polygons triangulated, vertices with
 /// exactly equal positions joined (across sub-meshes too), point and line primitives dropped and counted.
 /// Mesh::name is the file stem. Coordinates pass through assimp's float (ai_real) before becoming double.
+/// glTF 2.0 (text or GLB) is checked and reduced before assimp reads it (bvh/gltf_reduce.hpp): only the
+/// default scene's node trees and their meshes' float positions and unsigned indices are read; skins,
+/// animations, morph targets and materials are not; line loops and strips are left out like other lines;
+/// files needing what that leaves out (sparse or compressed data, glTF 1, unknown required extensions) are
+/// refused.
 /// Throws MeshError for: a missing, unreadable or empty file; an unknown format; any assimp failure; no
 /// triangles; a NaN or infinite coordinate; an out-of-range index (also when assimp only logs it and
 /// substitutes another vertex); coordinates beyond MeshPrecisionLimits; a zero-size model.
 LoadedMesh load_mesh(const std::filesystem::path& path);
 /// Same from a memory buffer; `format_hint` is a file extension such as "obj" or "ply" (leading dot allowed).
 /// Mesh::name is the stem of `name`. Formats that refer to side files (OBJ's .mtl, glTF's .bin) cannot
-/// resolve them from memory.
+/// resolve them from memory: a glTF buffer in a side file is refused.
 LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_view format_hint,
                                  std::string_view name = "<memory>");
 

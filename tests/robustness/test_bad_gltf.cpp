@@ -192,6 +192,14 @@ TEST(BadGltf, AccessorsAndViewsOutsideTheirBufferAreRefused) {
   expect_refused(glb(doc, tetrahedron_data()), "glb", "short.glb", "exceeds the GLB BIN chunk");
 }
 
+// assimp drops a glTF face with an out-of-range index and only logs it: the loader refuses the file, as it
+// does for every format, rather than return a mesh with a hole.
+TEST(BadGltf, OutOfRangeIndexIsRefused) {
+  std::string data = tetrahedron_data();
+  data[48] = 9;  // the first index: vertex 9 of 4
+  expect_refused(tetrahedron(data).dump(), "gltf", "bad-index.gltf", "index out of range");
+}
+
 // An interleaved (strided) vertex buffer is read as it should be.
 TEST(BadGltf, StridedPositionsLoad) {
   std::string data;
