@@ -92,6 +92,35 @@ TEST(BadMeshInput, EverySeedLoadsAndEveryReproducerIsRefused) {
   }
 }
 
+// assimp picks an importer by content too, so a file named for one format could reach any of its ~40
+// importers: Quick3D content behind a glTF hint allocated 4 TB (fuzz finding; its reproducer is in the
+// corpus). The loader reads only the formats it checks; others are refused by name, by content or by hint.
+TEST(BadMeshInput, FormatsTheLoaderDoesNotCheckAreRefused) {
+  const std::string raw = "0 0 0 1 0 0 0 1 0\n";  // one triangle in assimp's RAW format
+  for (const std::string hint : {"raw", ""}) {
+    try {
+      load_mesh_from_memory(std::as_bytes(std::span(raw.data(), raw.size())), hint, "triangle.raw");
+      ADD_FAILURE() << "read a RAW file with hint '" << hint << "'";
+    } catch (const MeshError& e) {
+      EXPECT_NE(
+          std::string(e.what()).find("triangle.raw: unknown or unsupported file format; the loader reads"),
+          std::string::npos)
+          << e.what();
+    }
+  }
+  const std::string quick3d =
+      "quick3doAsDAAAAA\xe7\xe7"
+      "ADAAEAAgADAe:AR\"}]}";
+  for (const std::string hint : {"gltf", "obj", ""}) {
+    try {
+      load_mesh_from_memory(std::as_bytes(std::span(quick3d.data(), quick3d.size())), hint, "q.q3o");
+      ADD_FAILURE() << "read Quick3D content with hint '" << hint << "'";
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("q.q3o"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // The first fuzz finding: an OFF file that declares more faces than it holds (any truncated OFF file) makes
 // assimp leave faces without indices, and its TriangulateProcess then hit an ai_assert that aborted the whole
 // process; a PLY face line with a stray character did the same. The loader now checks the scene before
