@@ -244,10 +244,10 @@ class SceneMerger {
 
   LoadReport& report() { return report_; }
 
- private:
   static constexpr std::uint32_t kUnset = std::numeric_limits<std::uint32_t>::max();
-  static constexpr std::size_t kMaxIndex = kUnset;
+  static constexpr std::size_t kMaxIndex = kUnset;  ///< triangles and vertices a Mesh holds
 
+ private:
   std::uint32_t vertex(unsigned mesh_index, const aiMesh& mesh, unsigned v, const Eigen::Matrix3d& linear,
                        const Eigen::Vector3d& offset, std::vector<std::uint32_t>& merged_index) {
     if (merged_index[v] != kUnset) return merged_index[v];
@@ -280,6 +280,14 @@ class SceneMerger {
 LoadedMesh merge_scene(const aiScene& scene, const std::string& source, std::string name) {
   SceneMerger merger(source);
   std::vector<bool> referenced(scene.mNumMeshes, false);
+  // Every (sub-mesh, global transform) the scene places, found first: instancing multiplies faces (a 1 MB
+  // glTF file can place one mesh 10^5 times), so their total is checked before anything is merged.
+  std::vector<std::pair<unsigned, Mat4>> instances;
+  std::uint64_t instanced_faces = 0;
+  auto place = [&](unsigned m, const Mat4& global) {
+    instances.emplace_back(m, global);
+    instanced_faces += scene.mMeshes[m]->mNumFaces;
+  };
   // Iterative walk: a hostile file must not overflow the stack with a deep node chain.
   std::vector<std::pair<const aiNode*, Mat4>> pending;
   if (scene.mRootNode != nullptr) pending.emplace_back(scene.mRootNode, Mat4::Identity());
@@ -292,7 +300,7 @@ LoadedMesh merge_scene(const aiScene& scene, const std::string& source, std::str
       if (m >= scene.mNumMeshes || scene.mMeshes[m] == nullptr)
         merger.fail("scene node refers to sub-mesh " + std::to_string(m) + " which does not exist");
       referenced[m] = true;
-      merger.add_instance(m, *scene.mMeshes[m], global);
+      place(m, global);
     }
     for (unsigned c = 0; c < node->mNumChildren; ++c)
       if (node->mChildren[c] != nullptr) pending.emplace_back(node->mChildren[c], global);
@@ -301,8 +309,12 @@ LoadedMesh merge_scene(const aiScene& scene, const std::string& source, std::str
     if (referenced[m] || scene.mMeshes[m] == nullptr) continue;
     merger.report().warnings.push_back(describe_submesh(m, *scene.mMeshes[m]) +
                                        " is in no scene node; merged untransformed");
-    merger.add_instance(m, *scene.mMeshes[m], Mat4::Identity());
+    place(m, Mat4::Identity());
   }
+  if (instanced_faces > SceneMerger::kMaxIndex)
+    merger.fail("the scene places " + std::to_string(instanced_faces) +
+                " faces (instances counted), more than the 2^32-1 triangles a mesh holds");
+  for (const auto& [m, global] : instances) merger.add_instance(m, *scene.mMeshes[m], global);
   return merger.finish(std::move(name));
 }
 
@@ -334,34 +346,34 @@ std::string prepare_for_triangulation(aiScene& scene) {
   return {};
 }
 
-// The formats the loader reads: those whose input it checks before assimp does (above and in
-// bvh/gltf_reduce.hpp) and that tests/fuzz covers. assimp picks an importer by content as well as by name, so
-// any of its ~40 importers could otherwise be handed a file: Quick3D, reached with a glTF hint, allocated
-// 4 TB for a 37-byte file (found by tests/fuzz). The others are taken out of each importer instance.
+// The formats the loader reads: those whose input it checks before assimp does (below and in
+// bvh/gltf_reduce.hpp) and that tests/fuzz covers.
 constexpr std::string_view kReadFormats[] = {"obj", "ply", "stl", "off", "ms3d", "gltf", "glb"};
 constexpr const char* kReadFormatList = "OBJ, PLY, STL, OFF, MS3D, glTF 2 and GLB";
 
-void keep_only_read_formats(Assimp::Importer& importer) {
+// assimp picks an importer by content as well as by name, so any of its ~40 importers could be handed a file
+// checked as another format: Quick3D content behind a glTF hint allocated 4 TB, OBJ content behind a glTF
+// hint reached the OBJ reader's NUL-byte crash (both found by tests/fuzz). Each import keeps only the
+// importer(s) of the one format its input was checked as.
+void keep_only_importers_of(Assimp::Importer& importer, std::string_view format) {
   for (std::size_t i = importer.GetImporterCount(); i-- > 0;) {
     const aiImporterDesc* info = importer.GetImporterInfo(i);
     std::istringstream extensions(info != nullptr && info->mFileExtensions != nullptr ? info->mFileExtensions
                                                                                       : "");
-    bool read = false;
-    for (std::string extension; extensions >> extension;)
-      read = read ||
-             std::find(std::begin(kReadFormats), std::end(kReadFormats), extension) != std::end(kReadFormats);
-    if (read) continue;
-    Assimp::BaseImporter* unread = importer.GetImporter(i);
-    if (importer.UnregisterLoader(unread) == AI_SUCCESS) delete unread;  // unregistering does not delete it
+    bool keep = false;
+    for (std::string extension; extensions >> extension;) keep = keep || extension == format;
+    if (keep) continue;
+    Assimp::BaseImporter* other = importer.GetImporter(i);
+    if (importer.UnregisterLoader(other) == AI_SUCCESS) delete other;  // unregistering does not delete it
   }
 }
 
 template <class ReadFn>
-LoadedMesh import_with(const std::string& source, std::string name, ReadFn read) {
+LoadedMesh import_with(const std::string& source, std::string name, std::string_view format, ReadFn read) {
   install_assimp_logger();
   LogCapture capture;
   Assimp::Importer importer;
-  keep_only_read_formats(importer);
+  keep_only_importers_of(importer, format);
   const aiScene* scene = nullptr;
   std::string problem;
   try {
@@ -390,8 +402,7 @@ LoadedMesh import_with(const std::string& source, std::string name, ReadFn read)
   if (scene == nullptr) {
     const std::string error = importer.GetErrorString();
     if (error.find("No suitable reader") != std::string::npos)
-      throw MeshError(source + ": unknown or unsupported file format; the loader reads " + kReadFormatList +
-                      " (assimp: " + error + ")");
+      throw MeshError(source + ": not a readable " + std::string(format) + " file (assimp: " + error + ")");
     if (error.find("Validation failed") != std::string::npos &&
         error.find("out of range") != std::string::npos)
       throw MeshError(source + ": index out of range (assimp: " + error + ")");
@@ -430,17 +441,15 @@ std::uint64_t leading_count(std::string_view text) {
 }
 
 // assimp 5.2's PLY reader never returns when the header ends without an `end_header` line (any truncated
-// header; found by tests/fuzz), so such input is refused before assimp sees it. `next_line` yields the
-// input's lines until it returns false.
-template <class NextLine>
-bool ply_header_unterminated(std::string_view start, NextLine next_line) {
-  auto lower = [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); };
-  if (start.size() < 3 || lower(start[0]) != 'p' || lower(start[1]) != 'l' || lower(start[2]) != 'y')
-    return false;
-  std::string line;
-  while (next_line(line)) {
+// header; found by tests/fuzz), so such input is refused before assimp sees it.
+bool ply_header_unterminated(std::string_view text) {
+  if (text.size() < 3 || lower_case(text.substr(0, 3)) != "ply") return false;
+  for (std::size_t position = 0; position < text.size();) {
+    const std::size_t end = std::min(text.find('\n', position), text.size());
+    const std::string_view line = text.substr(position, end - position);
+    position = end + 1;
     const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line.compare(first, 10, "end_header") != 0) continue;
+    if (first == std::string_view::npos || line.compare(first, 10, "end_header") != 0) continue;
     // assimp's token match takes only these after the keyword (a vertical tab, say, still hangs it).
     if (first + 10 == line.size() ||
         std::string_view(" \t\r\f\0", 5).find(line[first + 10]) != std::string_view::npos)
@@ -450,6 +459,15 @@ bool ply_header_unterminated(std::string_view start, NextLine next_line) {
 }
 
 constexpr const char* kUnterminatedPly = ": PLY header has no end_header line (truncated file?)";
+
+// Where the OFF keyword, with its optional prefixes (ST, C, N, 4, n), ends in a lower-case first token;
+// npos when the token does not start with it.
+std::size_t off_keyword_end(std::string_view token) {
+  const std::size_t at = token.find("off");
+  const bool keyword =
+      at != std::string_view::npos && at <= 3 && token.find_first_not_of("abcdefghijklmnopqrstuvwxyz") >= at;
+  return keyword ? at + 3 : std::string_view::npos;
+}
 
 // OFF and PLY headers declare element counts, and assimp allocates for them before reading a single element:
 // a 60-byte OFF file declaring 14294967295 faces asked for 22 GB (found by tests/fuzz). Every element takes
@@ -468,17 +486,16 @@ std::string oversized_header_count(std::string_view head, std::uint64_t size, st
   std::string token;
   if (!(in >> token)) return {};
   const std::string magic = lower_case(token);
-  // The OFF keyword with its optional prefixes (ST, C, N, 4, n). assimp also takes it glued to the first
-  // count ("OFF99999...", found by tests/fuzz), so what follows the keyword in the token is a count.
-  const std::size_t keyword_end = magic.find("off");
-  const bool off_keyword = keyword_end != std::string::npos && keyword_end <= 3 &&
-                           magic.find_first_not_of("abcdefghijklmnopqrstuvwxyz") >= keyword_end;
+  // assimp also takes the OFF keyword glued to the first count ("OFF99999...", found by tests/fuzz), so what
+  // follows the keyword in the token is a count.
+  const std::size_t keyword_end = off_keyword_end(magic);
+  const bool off_keyword = keyword_end != std::string::npos;
   if (off_keyword || format == "off") {
     // OFF: vertex, face (and edge) counts follow the keyword, if any, possibly after comment lines.
     std::vector<std::uint64_t> counts;
     bool pending = !off_keyword;  // without the keyword, the first token is already a count
-    if (off_keyword && keyword_end + 3 < token.size()) {
-      token.erase(0, keyword_end + 3);
+    if (off_keyword && keyword_end < token.size()) {
+      token.erase(0, keyword_end);
       pending = true;
     }
     while (counts.size() < 2 && (pending || in >> token)) {
@@ -692,25 +709,75 @@ std::string binary_data_in_obj(std::string_view text, std::string_view format) {
 
 constexpr std::size_t kHeaderBytes = 1 << 16;
 
-// glTF input goes to assimp reduced (bvh/gltf_reduce.hpp); other input as it is (`read_original`).
-template <class ReadOriginal>
-LoadedMesh import_maybe_gltf(std::string_view bytes, std::string_view format, const std::string& source,
-                             std::string name, const std::optional<std::string>& asset_directory,
-                             ReadOriginal read_original) {
-  std::optional<detail::ReducedGltf> gltf;
-  try {
-    gltf = detail::reduce_gltf(bytes, format, asset_directory);
-  } catch (const detail::GltfRefused& e) {
-    throw MeshError(source + ": " + e.what());
+// The format the input is read as. A hint naming a read format decides (assimp then picks that importer by
+// name alone); otherwise the content does, much as assimp would guess it. "" when it is none of them.
+std::string read_format(std::string_view bytes, const std::string& hint) {
+  if (std::find(std::begin(kReadFormats), std::end(kReadFormats), hint) != std::end(kReadFormats))
+    return hint;
+  const std::size_t first = bytes.find_first_not_of(" \t\r\n");
+  const std::string_view start = first == std::string_view::npos ? std::string_view() : bytes.substr(first);
+  const std::string token =
+      lower_case(start.substr(0, std::min<std::size_t>(start.find_first_of(" \t\r\n"), 64)));
+  if (bytes.substr(0, 4) == "glTF") return "glb";
+  if (start.substr(0, 1) == "{") return "gltf";
+  if (lower_case(bytes.substr(0, 3)) == "ply") return "ply";
+  if (bytes.substr(0, 10) == "MS3D000000") return "ms3d";
+  if (off_keyword_end(token) != std::string::npos) return "off";
+  if (token.rfind("solid", 0) == 0) return "stl";
+  if (bytes.size() >= 84) {  // binary STL: an 80-byte header, a count, 50 bytes per triangle
+    std::uint64_t count = 0;
+    for (int i = 3; i >= 0; --i) count = (count << 8) | static_cast<unsigned char>(bytes[80 + i]);
+    if (84 + 50 * count == bytes.size()) return "stl";
   }
-  if (!gltf) return import_with(source, std::move(name), read_original);
-  LoadedMesh loaded = import_with(source, std::move(name), [&](Assimp::Importer& importer) {
-    return importer.ReadFileFromMemory(gltf->bytes.data(), gltf->bytes.size(), kPostProcess,
-                                       gltf->format.c_str());
+  // OBJ: a line with one of its statements among the first lines.
+  const std::string_view head = bytes.substr(0, 4096);
+  for (std::size_t position = 0; position < head.size();) {
+    const std::size_t end = std::min(head.find('\n', position), head.size());
+    std::string_view line = head.substr(position, end - position);
+    position = end + 1;
+    line.remove_prefix(std::min(line.find_first_not_of(" \t"), line.size()));
+    for (const char* statement : {"v ", "vt ", "vn ", "f ", "o ", "g ", "s ", "mtllib ", "usemtl "})
+      if (line.rfind(statement, 0) == 0) return "obj";
+  }
+  return {};
+}
+
+// The checks every input gets, then assimp's read. `file` is the input's path when `bytes` are that file's
+// content (assimp then reads the file itself when its name gives the format, so that side files such as
+// OBJ's .mtl resolve), empty for input from memory. `asset_directory` as for detail::reduce_gltf.
+LoadedMesh load_checked(std::string_view bytes, const std::string& hint, const std::string& source,
+                        std::string name, const std::string& file,
+                        const std::optional<std::string>& asset_directory) {
+  if (ply_header_unterminated(bytes)) throw MeshError(source + kUnterminatedPly);
+  const std::string format = read_format(bytes, hint);
+  if (format.empty())
+    throw MeshError(source + ": unknown or unsupported file format" +
+                    (hint.empty() ? "" : " ('" + hint + "')") + "; the loader reads " + kReadFormatList);
+  for (const std::string& problem :
+       {oversized_header_count(bytes.substr(0, kHeaderBytes), bytes.size(), format), ply_body_problem(bytes),
+        binary_data_in_obj(bytes, format)})
+    if (!problem.empty()) throw MeshError(source + ": " + problem);
+  if (format == "gltf" || format == "glb") {
+    std::optional<detail::ReducedGltf> gltf;
+    try {
+      gltf = detail::reduce_gltf(bytes, format, asset_directory);
+    } catch (const detail::GltfRefused& e) {
+      throw MeshError(source + ": " + e.what());
+    }
+    if (!gltf) throw MeshError(source + ": not glTF: glTF is JSON text that starts with '{'");
+    LoadedMesh loaded = import_with(source, std::move(name), format, [&](Assimp::Importer& importer) {
+      return importer.ReadFileFromMemory(gltf->bytes.data(), gltf->bytes.size(), kPostProcess,
+                                         gltf->format.c_str());
+    });
+    loaded.report.ignored_lines += gltf->dropped_line_segments;
+    for (auto& warning : gltf->warnings) loaded.report.warnings.push_back("glTF: " + std::move(warning));
+    return loaded;
+  }
+  return import_with(source, std::move(name), format, [&](Assimp::Importer& importer) {
+    return !file.empty() && hint == format
+               ? importer.ReadFile(file, kPostProcess)
+               : importer.ReadFileFromMemory(bytes.data(), bytes.size(), kPostProcess, format.c_str());
   });
-  loaded.report.ignored_lines += gltf->dropped_line_segments;
-  for (auto& warning : gltf->warnings) loaded.report.warnings.push_back("glTF: " + std::move(warning));
-  return loaded;
 }
 
 // Where assimp looks for a file's side files: the path up to its last separator.
@@ -727,80 +794,25 @@ LoadedMesh load_mesh(const std::filesystem::path& path) {
   const auto status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status)) throw MeshError(source + ": file not found");
   if (std::filesystem::is_directory(status)) throw MeshError(source + ": is a directory, not a mesh file");
-  if (!std::ifstream(path, std::ios::binary).is_open())
-    throw MeshError(source + ": cannot be opened for reading");
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size == 0) throw MeshError(source + ": file is empty");
-  {
-    std::ifstream in(path, std::ios::binary);
-    char magic[3] = {};
-    in.read(magic, 3);
-    const std::string_view start(magic, static_cast<std::size_t>(in.gcount()));
-    in.clear();
-    in.seekg(0);
-    if (ply_header_unterminated(start,
-                                [&](std::string& line) { return static_cast<bool>(std::getline(in, line)); }))
-      throw MeshError(source + kUnterminatedPly);
-    in.clear();
-    in.seekg(0);
-    std::string head(kHeaderBytes, '\0');
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(in.gcount()));
-    std::string extension = path.extension().string();
-    extension = lower_case(extension);
-    if (const std::string problem = oversized_header_count(
-            head, ec ? head.size() : size, std::string_view(extension).substr(extension.empty() ? 0 : 1));
-        !problem.empty())
-      throw MeshError(source + ": " + problem);
-    const std::string_view format = std::string_view(extension).substr(extension.empty() ? 0 : 1);
-    const std::size_t first = head.find_first_not_of(" \t\r\n");
-    const bool maybe_gltf =
-        format == "glb" || (first == std::string::npos ? head.size() == kHeaderBytes : head[first] == '{');
-    std::string whole;
-    if ((head.size() >= 3 && std::tolower(static_cast<unsigned char>(head[0])) == 'p') || format == "obj" ||
-        maybe_gltf) {
-      // A PLY body is walked whole, an OBJ file checked for binary data, a glTF file reduced, before assimp
-      // reads them.
-      in.clear();
-      in.seekg(0);
-      whole.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-      for (const std::string& problem : {ply_body_problem(whole), binary_data_in_obj(whole, format)})
-        if (!problem.empty()) throw MeshError(source + ": " + problem);
-    }
-    return import_maybe_gltf(
-        maybe_gltf ? std::string_view(whole) : std::string_view(), format, source, path.stem().string(),
-        asset_directory_of(source),
-        [&](Assimp::Importer& importer) { return importer.ReadFile(source, kPostProcess); });
-  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in.is_open()) throw MeshError(source + ": cannot be opened for reading");
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw MeshError(source + ": reading failed");
+  if (bytes.empty()) throw MeshError(source + ": file is empty");
+  const std::string extension = lower_case(path.extension().string());
+  return load_checked(bytes, extension.empty() ? extension : extension.substr(1), source,
+                      path.stem().string(), source, asset_directory_of(source));
 }
 
 LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_view format_hint,
                                  std::string_view name) {
   const std::string source(name);
   if (buffer.empty()) throw MeshError(source + ": buffer is empty");
-  const std::string_view text(reinterpret_cast<const char*>(buffer.data()), buffer.size());
-  std::size_t position = 0;
-  if (ply_header_unterminated(text, [&](std::string& line) {
-        if (position >= text.size()) return false;
-        const std::size_t end = std::min(text.find('\n', position), text.size());
-        line.assign(text.substr(position, end - position));
-        position = end + 1;
-        return true;
-      }))
-    throw MeshError(source + kUnterminatedPly);
   std::string hint(format_hint);
   if (!hint.empty() && hint.front() == '.') hint.erase(0, 1);
-  hint = lower_case(hint);
-  if (const std::string problem = oversized_header_count(text.substr(0, kHeaderBytes), text.size(), hint);
-      !problem.empty())
-    throw MeshError(source + ": " + problem);
-  for (const std::string& problem : {ply_body_problem(text), binary_data_in_obj(text, hint)})
-    if (!problem.empty()) throw MeshError(source + ": " + problem);
-  return import_maybe_gltf(text, hint, source, std::filesystem::path(source).stem().string(), std::nullopt,
-                           [&](Assimp::Importer& importer) {
-                             return importer.ReadFileFromMemory(buffer.data(), buffer.size(), kPostProcess,
-                                                                hint.c_str());
-                           });
+  return load_checked(std::string_view(reinterpret_cast<const char*>(buffer.data()), buffer.size()),
+                      lower_case(hint), source, std::filesystem::path(source).stem().string(), std::string(),
+                      std::nullopt);
 }
 
 double normalize_to_unit_cube(Mesh& mesh) {

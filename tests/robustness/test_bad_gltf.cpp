@@ -216,13 +216,14 @@ TEST(BadGltf, StridedPositionsLoad) {
   EXPECT_EQ(loaded.report.bounds.max, Vec3(1, 1, 1));
 }
 
-// assimp's JSON parser recurses once per nesting level: 200000 levels overflowed its stack (SEGV), whatever
-// the format hint, because assimp tries JSON input as glTF.
+// assimp's JSON parser recurses once per nesting level: 200000 levels overflowed its stack (SEGV), with a
+// glTF hint or none (assimp then tries JSON input as glTF). With an OBJ hint, only the OBJ reader sees it.
 TEST(BadGltf, DeepJsonIsRefused) {
   const std::string deep = R"({"asset": {"version": "2.0"}, "extras": )" + std::string(200000, '[') +
                            std::string(200000, ']') + "}";
-  for (const std::string format : {"gltf", "", "obj"})
+  for (const std::string format : {"gltf", ""})
     expect_refused(deep, format, "deep.gltf", "nested deeper than");
+  expect_refused(deep, "obj", "deep.obj", "deep.obj: ");
 }
 
 // Nodes must form trees. Two children lists naming the same node 40 times over made assimp build 2^40
@@ -250,6 +251,28 @@ TEST(BadGltf, NodeGraphsThatAreNotTreesAreRefused) {
   for (int i = 0; i < 100; ++i) doc["nodes"].push_back({{"children", {i + 1}}, {"translation", {1, 0, 0}}});
   doc["nodes"].push_back({{"mesh", 0}});
   EXPECT_EQ(load(doc.dump(), "gltf", "chain100.gltf").report.bounds.max.x(), 101.0);
+}
+
+// Instancing multiplies faces: 65537 nodes placing one mesh of 65536 triangles (a 1 MB file) would make a
+// mesh of 2^32 + 65536 triangles, more than its 32-bit indices hold (and about 50 GB). Refused before
+// merging.
+TEST(BadGltf, InstancingBeyondTheTriangleLimitIsRefusedUpFront) {
+  std::string data;
+  for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) append(data, x);
+  for (int t = 0; t < 65536; ++t) data += std::string("\0\1\2", 3);  // uint8 indices
+  Json doc = tetrahedron(data);
+  doc["bufferViews"][0]["byteLength"] = 36;
+  doc["bufferViews"][1] = {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 3 * 65536}};
+  doc["accessors"][0]["count"] = 3;
+  doc["accessors"][1] = {
+      {"bufferView", 1}, {"componentType", 5121}, {"count", 3 * 65536}, {"type", "SCALAR"}};
+  doc["nodes"] = Json::array();
+  doc["scenes"][0]["nodes"] = Json::array();
+  for (int n = 0; n < 65537; ++n) {
+    doc["nodes"].push_back({{"mesh", 0}});
+    doc["scenes"][0]["nodes"].push_back(n);
+  }
+  expect_refused(doc, "instances.gltf", "the scene places 4295032832 faces");
 }
 
 // A skin without inverseBindMatrices made assimp dereference null; animation samplers with short outputs
