@@ -53,7 +53,8 @@ struct LoadedMesh {
 };
 
 /// Loads and validates a mesh file in one of the formats the loader checks before assimp reads it: OBJ, PLY,
-/// STL, OFF, MS3D, glTF 2 and GLB (assimp's other importers are not used; their input is refused).
+/// STL, OFF, MS3D, glTF 2 and GLB. The file extension names the format when it is one of these, else the
+/// content does; assimp reads the input with that format's importer only (its others are not used).
 /// All sub-meshes are merged with their scene-graph transforms applied, polygons triangulated, vertices with
 /// exactly equal positions joined (across sub-meshes too), point and line primitives dropped and counted.
 /// Mesh::name is the file stem. Coordinates pass through assimp's float (ai_real) before becoming double.
