@@ -11,6 +11,7 @@
 #include <assimp/LogStream.hpp>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cctype>
 #include <cmath>
@@ -469,50 +470,78 @@ std::size_t off_keyword_end(std::string_view token) {
   return keyword ? at + 3 : std::string_view::npos;
 }
 
+constexpr std::size_t kHeaderBytes = 1 << 16;  // a PLY header fits in it
+
+// The vertex and face counts assimp 5.2's OFF reader takes from `text`, found by walking the header as it
+// does: optional ST, C, N, 4, n prefixes and the keyword, then numbers, where a '#' after a number starts a
+// comment to the end of the line ("8### 12 0" is 8 and then the next line's number), and a count wraps
+// around at 2^32 as its strtoul10 does. Tokenising the header differently let a 275-byte file ask for 64 GB
+// (found by tests/fuzz).
+std::array<std::uint32_t, 2> off_header_counts(std::string_view text) {
+  text = text.substr(0, text.find('\0'));                          // assimp's copy ends at the first NUL
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // and has no UTF-8 byte-order mark
+  std::size_t car = 0;
+  auto skip_blanks = [&] {
+    while (car < text.size() && std::string_view(" \t\r\n").find(text[car]) != std::string_view::npos) ++car;
+  };
+  auto next_token = [&] {
+    skip_blanks();
+    while (car < text.size() && (text[car] == '#' || text[car] == '\n' || text[car] == '\r')) {
+      while (car < text.size() && text[car] != '\r' && text[car] != '\n') ++car;
+      skip_blanks();
+    }
+  };
+  auto take = [&](std::string_view prefix) {
+    const bool match = text.substr(car, prefix.size()) == prefix;
+    if (match) car += prefix.size();
+    return match;
+  };
+  auto number = [&] {
+    std::uint32_t value = 0;
+    for (; car < text.size() && text[car] >= '0' && text[car] <= '9'; ++car)
+      value = value * 10 + static_cast<std::uint32_t>(text[car] - '0');
+    return value;
+  };
+  next_token();
+  take("ST");
+  take("C");
+  take("N");
+  take("4");
+  const bool dimension = take("n");
+  take("OFF");
+  next_token();
+  if (dimension) {
+    number();
+    next_token();
+  }
+  next_token();
+  const std::uint32_t vertices = number();
+  next_token();
+  return {vertices, number()};
+}
+
 // OFF and PLY headers declare element counts, and assimp allocates for them before reading a single element:
 // a 60-byte OFF file declaring 14294967295 faces asked for 22 GB (found by tests/fuzz). Every element takes
-// at least one byte of the file, so a count above the file's size is refused up front. `head` is the file's
-// beginning (the header fits in it), `size` its full size, `format` the lower-case format hint or file
-// extension (assimp reads a file named .off as OFF even without the OFF keyword). Returns the problem, or ""
-// when none is seen.
-std::string oversized_header_count(std::string_view head, std::uint64_t size, std::string_view format) {
+// at least one byte of the file, so a count above the file's size is refused up front. `format` is the
+// format the input is read as. Returns the problem, or "" when none is seen.
+std::string oversized_header_count(std::string_view text, std::string_view format) {
+  const std::uint64_t size = text.size();
   auto too_many = [&](std::uint64_t count, const std::string& what) {
     return count > size
                ? "header declares " + std::to_string(count) + " " + what + " but the file has only " +
                      std::to_string(size) + " bytes (corrupt or truncated?)"
                : std::string();
   };
-  std::istringstream in{std::string(head)};
+  if (format == "off") {
+    const auto [vertices, faces] = off_header_counts(text);
+    if (auto problem = too_many(vertices, "vertices"); !problem.empty()) return problem;
+    return too_many(faces, "faces");
+  }
+  std::istringstream in{std::string(text.substr(0, kHeaderBytes))};
   std::string token;
   if (!(in >> token)) return {};
   const std::string magic = lower_case(token);
-  // assimp also takes the OFF keyword glued to the first count ("OFF99999...", found by tests/fuzz), so what
-  // follows the keyword in the token is a count.
-  const std::size_t keyword_end = off_keyword_end(magic);
-  const bool off_keyword = keyword_end != std::string::npos;
-  if (off_keyword || format == "off") {
-    // OFF: vertex, face (and edge) counts follow the keyword, if any, possibly after comment lines.
-    std::vector<std::uint64_t> counts;
-    bool pending = !off_keyword;  // without the keyword, the first token is already a count
-    if (off_keyword && keyword_end < token.size()) {
-      token.erase(0, keyword_end);
-      pending = true;
-    }
-    while (counts.size() < 2 && (pending || in >> token)) {
-      pending = false;
-      if (token.front() == '#') {
-        std::getline(in, token);
-        continue;
-      }
-      // assimp reads a count as the token's leading digits ("12abc" is 12), so this does too.
-      token.resize(std::min(token.find_first_not_of("0123456789"), token.size()));
-      if (token.empty()) break;
-      counts.push_back(leading_count(token));
-    }
-    const char* names[] = {"vertices", "faces"};
-    for (std::size_t i = 0; i < counts.size(); ++i)
-      if (auto problem = too_many(counts[i], names[i]); !problem.empty()) return problem;
-  } else if (magic == "ply") {
+  if (magic == "ply") {
     // A header that declares an element or the format twice makes assimp size its arrays from one
     // declaration and fill them from the other: a heap overflow inside assimp (found by tests/fuzz under
     // valgrind). Such a header is refused.
@@ -707,7 +736,25 @@ std::string binary_data_in_obj(std::string_view text, std::string_view format) {
              : "OBJ is a text format, but byte " + std::to_string(nul) + " is NUL (binary data?)";
 }
 
-constexpr std::size_t kHeaderBytes = 1 << 16;
+// Binary STL, as assimp recognises it: an 80-byte header, a triangle count, 50 bytes per triangle.
+bool is_binary_stl(std::string_view bytes) {
+  if (bytes.size() < 84) return false;
+  std::uint64_t count = 0;
+  for (int i = 3; i >= 0; --i) count = (count << 8) | static_cast<unsigned char>(bytes[80 + i]);
+  return 84 + 50 * count == bytes.size();
+}
+
+// assimp converts text that starts with a UTF-16 or UTF-32 byte-order mark in ways it does not check (its
+// UTF-32 path reads past its buffer), and the checks here read text formats as single bytes: such text is
+// refused.
+std::string wide_text_problem(std::string_view bytes, std::string_view format) {
+  const bool text_format = format == "obj" || format == "off" || (format == "stl" && !is_binary_stl(bytes));
+  const auto byte = [&](std::size_t i) {
+    return i < bytes.size() ? static_cast<unsigned char>(bytes[i]) : 0u;
+  };
+  const bool wide = (byte(0) == 0xFE && byte(1) == 0xFF) || (byte(0) == 0xFF && byte(1) == 0xFE);
+  return text_format && wide ? "text in UTF-16 or UTF-32 is not read (save it as ASCII or UTF-8)" : "";
+}
 
 // The format the input is read as. A hint naming a read format decides (assimp then picks that importer by
 // name alone); otherwise the content does, much as assimp would guess it. "" when it is none of them.
@@ -724,11 +771,7 @@ std::string read_format(std::string_view bytes, const std::string& hint) {
   if (bytes.substr(0, 10) == "MS3D000000") return "ms3d";
   if (off_keyword_end(token) != std::string::npos) return "off";
   if (token.rfind("solid", 0) == 0) return "stl";
-  if (bytes.size() >= 84) {  // binary STL: an 80-byte header, a count, 50 bytes per triangle
-    std::uint64_t count = 0;
-    for (int i = 3; i >= 0; --i) count = (count << 8) | static_cast<unsigned char>(bytes[80 + i]);
-    if (84 + 50 * count == bytes.size()) return "stl";
-  }
+  if (is_binary_stl(bytes)) return "stl";
   // OBJ: a line with one of its statements among the first lines.
   const std::string_view head = bytes.substr(0, 4096);
   for (std::size_t position = 0; position < head.size();) {
@@ -753,9 +796,8 @@ LoadedMesh load_checked(std::string_view bytes, const std::string& hint, const s
   if (format.empty())
     throw MeshError(source + ": unknown or unsupported file format" +
                     (hint.empty() ? "" : " ('" + hint + "')") + "; the loader reads " + kReadFormatList);
-  for (const std::string& problem :
-       {oversized_header_count(bytes.substr(0, kHeaderBytes), bytes.size(), format), ply_body_problem(bytes),
-        binary_data_in_obj(bytes, format)})
+  for (const std::string& problem : {wide_text_problem(bytes, format), oversized_header_count(bytes, format),
+                                     ply_body_problem(bytes), binary_data_in_obj(bytes, format)})
     if (!problem.empty()) throw MeshError(source + ": " + problem);
   if (format == "gltf" || format == "glb") {
     std::optional<detail::ReducedGltf> gltf;

@@ -202,6 +202,9 @@ TEST(BadMeshInput, HeaderCountsBeyondTheFileAreRefusedBeforeAllocating) {
       {"off", "8 124294967295 0\n0 1 0\n1 1 0\n0 0 1\n3 0 1 2\n"},   // no OFF keyword: read as OFF by name
       {"off", "OFF4000000000 1 0\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n"},  // keyword glued to the count (fuzz)
       {"", "COFF999999999999999 1 0\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n"},
+      // '#' right after a count starts a comment: the face count is on the next line, and it wraps around
+      // at 2^32 to 4294967286 (fuzz finding: 64 GB asked for by 275 bytes).
+      {"off", "OFF\n8##### 12 0\n42949672950 0 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
       {"ply",
        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
        "property float z\nelement face 3000000000\nproperty list uchar int vertex_indices\nend_header\n"},
@@ -213,7 +216,9 @@ TEST(BadMeshInput, HeaderCountsBeyondTheFileAreRefusedBeforeAllocating) {
     } catch (const MeshError& e) {
       EXPECT_NE(std::string(e.what()).find("big.mesh: header declares"), std::string::npos) << e.what();
     }
-    expect_file_refused(text, format.empty() ? std::string("ply") : format, "header declares");
+    // A file is named for what it holds (a .ply name would make it PLY, whatever the content).
+    const std::string extension = !format.empty() ? format : text.rfind("ply", 0) == 0 ? "ply" : "off";
+    expect_file_refused(text, extension, "header declares");
   }
 }
 
@@ -336,6 +341,22 @@ TEST(BadMeshInput, ObjWithBinaryDataIsRefused) {
     }
   }
   EXPECT_EQ(load_mesh_from_memory(bytes(good), "txt", "text.txt").mesh.triangle_count(), 1u);
+}
+
+// assimp converts text behind a UTF-16 or UTF-32 byte-order mark without checking it (its UTF-32 path reads
+// past its buffer), and the header checks read single bytes: such text is refused for the text formats.
+TEST(BadMeshInput, WideTextIsRefused) {
+  using namespace std::string_literals;
+  for (const auto& [format, bom] : {std::pair{"obj"s, "\xFF\xFE"s}, std::pair{"off"s, "\xFE\xFF\0\0"s}}) {
+    const std::string text =
+        bom + (format == "obj" ? "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n" : "OFF\n3 1 0\n");
+    try {
+      load_mesh_from_memory(std::as_bytes(std::span(text.data(), text.size())), format, "wide." + format);
+      ADD_FAILURE() << "read wide text as " << format;
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("UTF-16 or UTF-32 is not read"), std::string::npos) << e.what();
+    }
+  }
 }
 
 // Truncations and byte flips of every seed: each loads (and then keeps the loader's promises) or is refused
