@@ -796,6 +796,10 @@ LoadedMesh load_checked(std::string_view bytes, const std::string& hint, const s
   if (format.empty())
     throw MeshError(source + ": unknown or unsupported file format" +
                     (hint.empty() ? "" : " ('" + hint + "')") + "; the loader reads " + kReadFormatList);
+  // The PLY checks start at the magic; assimp's reader skips what precedes it (NUL bytes let a header without
+  // end_header through to its endless loop; found by tests/fuzz). The PLY rules put the magic first.
+  if (format == "ply" && lower_case(bytes.substr(0, 3)) != "ply")
+    throw MeshError(source + ": not a PLY file: it must start with 'ply'");
   for (const std::string& problem : {wide_text_problem(bytes, format), oversized_header_count(bytes, format),
                                      ply_body_problem(bytes), binary_data_in_obj(bytes, format)})
     if (!problem.empty()) throw MeshError(source + ": " + problem);

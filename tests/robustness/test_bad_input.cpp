@@ -181,6 +181,18 @@ TEST(BadMeshInput, TruncatedPlyHeaderIsRefusedNotHung) {
     EXPECT_THROW(load_mesh(file), MeshError);
     fs::remove(file);
   }
+  // Behind leading bytes assimp skips (a fuzz finding: it hung), PLY is refused: the magic comes first.
+  for (const std::string lead : {std::string(8, '\0'), std::string("\n"), std::string(" ")}) {
+    const std::string ply = lead + "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\n";
+    try {
+      load_mesh_from_memory(std::as_bytes(std::span(ply.data(), ply.size())), "ply", "lead.ply");
+      ADD_FAILURE() << "loaded PLY behind " << lead.size() << " leading bytes";
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("lead.ply: not a PLY file: it must start with 'ply'"),
+                std::string::npos)
+          << e.what();
+    }
+  }
   // A complete header still loads, with end_header as the very last bytes or followed by CRLF.
   for (const std::string tail : {"end_header", "end_header\r\n"}) {
     const std::string ply = "ply\r\nformat ascii 1.0\r\nelement vertex 0\r\nproperty float x\r\n" + tail;
