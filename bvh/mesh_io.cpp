@@ -736,6 +736,63 @@ std::string binary_data_in_obj(std::string_view text, std::string_view format) {
              : "OBJ is a text format, but byte " + std::to_string(nul) + " is NUL (binary data?)";
 }
 
+// assimp 5.2's MS3D reader checks a group's triangle indices and a triangle's vertex indices with > where it
+// needs >=: index n of n is read past the end of its list, or through null when the list is empty (a group
+// naming triangle 0 of none; found by tests/fuzz). It also builds the joint tree recursively. So the indices,
+// the groups' materials and the joint count are checked first, walking the file as assimp reads it. Where
+// the file ends early assimp stops with an error of its own, and so does this walk, silently.
+constexpr std::size_t kMaxMs3dJoints = 1024;  // MilkShape itself allows 128
+
+std::string ms3d_problem(std::string_view bytes) {
+  std::size_t at = 14;  // magic and version, which assimp checks
+  bool whole = true;
+  auto skip = [&](std::uint64_t n) {
+    whole = whole && n <= bytes.size() - std::min(at, bytes.size());
+    at = whole ? at + n : bytes.size();
+  };
+  auto unsigned_le = [&](std::size_t n) {
+    std::uint32_t value = 0;
+    const std::size_t start = at;
+    skip(n);
+    for (std::size_t i = 0; whole && i < n; ++i)
+      value |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[start + i])) << (8 * i);
+    return value;
+  };
+  const std::uint32_t vertices = unsigned_le(2);
+  skip(15ull * vertices);  // flags, position, bone, reference count
+  const std::uint32_t triangles = unsigned_le(2);
+  for (std::uint32_t t = 0; whole && t < triangles; ++t) {
+    skip(2);
+    for (int k = 0; k < 3; ++k)
+      if (const std::uint32_t v = unsigned_le(2); whole && v >= vertices)
+        return "MS3D triangle " + std::to_string(t) + " refers to vertex " + std::to_string(v) + " of " +
+               std::to_string(vertices);
+    skip(36 + 24 + 2);  // normals, uv, smoothing group, group
+  }
+  const std::uint32_t groups = unsigned_le(2);
+  std::vector<std::uint32_t> group_materials;
+  for (std::uint32_t g = 0; whole && g < groups; ++g) {
+    skip(33);  // flags, name
+    const std::uint32_t count = unsigned_le(2);
+    for (std::uint32_t j = 0; whole && j < count; ++j)
+      if (const std::uint32_t t = unsigned_le(2); whole && t >= triangles)
+        return "MS3D group " + std::to_string(g) + " refers to triangle " + std::to_string(t) + " of " +
+               std::to_string(triangles);
+    group_materials.push_back(unsigned_le(1));
+  }
+  const std::uint32_t materials = unsigned_le(2);
+  for (std::size_t g = 0; whole && materials > 0 && g < group_materials.size(); ++g)
+    if (group_materials[g] != 0xFF && group_materials[g] >= materials)
+      return "MS3D group " + std::to_string(g) + " uses material " + std::to_string(group_materials[g]) +
+             " of " + std::to_string(materials);
+  skip(361ull * materials + 12);  // materials; fps, current time, frame count
+  const std::uint32_t joints = unsigned_le(2);
+  if (whole && joints > kMaxMs3dJoints)
+    return "MS3D file has " + std::to_string(joints) + " joints; more than " +
+           std::to_string(kMaxMs3dJoints) + " are not read";
+  return {};
+}
+
 // Binary STL, as assimp recognises it: an 80-byte header, a triangle count, 50 bytes per triangle.
 bool is_binary_stl(std::string_view bytes) {
   if (bytes.size() < 84) return false;
@@ -800,8 +857,9 @@ LoadedMesh load_checked(std::string_view bytes, const std::string& hint, const s
   // end_header through to its endless loop; found by tests/fuzz). The PLY rules put the magic first.
   if (format == "ply" && lower_case(bytes.substr(0, 3)) != "ply")
     throw MeshError(source + ": not a PLY file: it must start with 'ply'");
-  for (const std::string& problem : {wide_text_problem(bytes, format), oversized_header_count(bytes, format),
-                                     ply_body_problem(bytes), binary_data_in_obj(bytes, format)})
+  for (const std::string& problem :
+       {wide_text_problem(bytes, format), oversized_header_count(bytes, format), ply_body_problem(bytes),
+        binary_data_in_obj(bytes, format), format == "ms3d" ? ms3d_problem(bytes) : std::string()})
     if (!problem.empty()) throw MeshError(source + ": " + problem);
   if (format == "gltf" || format == "glb") {
     std::optional<detail::ReducedGltf> gltf;

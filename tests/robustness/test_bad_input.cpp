@@ -11,11 +11,13 @@
 #include <gtest/gtest.h>
 
 #include <unistd.h>
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <random>
+#include <tuple>
 
 namespace bvhlab {
 namespace {
@@ -367,6 +369,78 @@ TEST(BadMeshInput, WideTextIsRefused) {
       ADD_FAILURE() << "read wide text as " << format;
     } catch (const MeshError& e) {
       EXPECT_NE(std::string(e.what()).find("UTF-16 or UTF-32 is not read"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// A MilkShape 3D file: `vertex_count` vertices on the axes, `triangles`, `groups` (triangle lists), `joints`
+// joints each parented to the previous one.
+std::string ms3d(std::uint16_t vertex_count, const std::vector<std::array<std::uint16_t, 3>>& triangles,
+                 const std::vector<std::vector<std::uint16_t>>& groups, std::uint16_t joints = 0) {
+  std::string out = "MS3D000000";
+  auto put = [&](auto value) { out.append(reinterpret_cast<const char*>(&value), sizeof(value)); };
+  put(std::int32_t{4});
+  put(vertex_count);
+  for (std::uint16_t v = 0; v < vertex_count; ++v) {
+    put(std::uint8_t{0});
+    for (int k = 0; k < 3; ++k) put(static_cast<float>(v % 3 == k && v > 0));
+    put(std::uint8_t{0xFF});  // no bone
+    put(std::uint8_t{1});
+  }
+  put(static_cast<std::uint16_t>(triangles.size()));
+  for (const auto& t : triangles) {
+    put(std::uint16_t{0});
+    for (auto i : t) put(i);
+    out.append(36 + 24, '\0');  // normals, uv
+    put(std::uint8_t{0});
+    put(std::uint8_t{0});
+  }
+  put(static_cast<std::uint16_t>(groups.size()));
+  for (const auto& g : groups) {
+    put(std::uint8_t{0});
+    out.append(32, 'g');
+    put(static_cast<std::uint16_t>(g.size()));
+    for (auto t : g) put(t);
+    put(std::uint8_t{0xFF});  // no material
+  }
+  put(std::uint16_t{0});  // materials
+  put(24.f);
+  put(0.f);
+  put(std::uint32_t{1});
+  put(joints);
+  for (std::uint16_t j = 0; j < joints; ++j) {
+    put(std::uint8_t{0});
+    std::string name = "j" + std::to_string(j), parent = j > 0 ? "j" + std::to_string(j - 1) : "";
+    name.resize(32, '\0');
+    parent.resize(32, '\0');
+    out += name + parent;
+    out.append(24, '\0');  // rotation, position
+    put(std::uint16_t{1});  // one rotation key frame (assimp refuses an animation without any)
+    put(std::uint16_t{0});
+    out.append(16, '\0');  // its time and value
+  }
+  return out;
+}
+
+// assimp's MS3D reader checks indices with > where it needs >=: a group naming triangle 0 of none read
+// through null (fuzz finding, SEGV), vertex n of n read past the end. Its joint tree is built recursively.
+TEST(BadMeshInput, Ms3dIndicesAndJointsAreCheckedFirst) {
+  auto load = [](const std::string& bytes, const std::string& name) {
+    return load_mesh_from_memory(std::as_bytes(std::span(bytes.data(), bytes.size())), "ms3d", name);
+  };
+  EXPECT_EQ(load(ms3d(3, {{0, 1, 2}}, {{0}}, 3), "good.ms3d").mesh.triangle_count(), 1u);
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+      {ms3d(3, {}, {{0}}), "none.ms3d", "group 0 refers to triangle 0 of 0"},
+      {ms3d(3, {{0, 1, 2}}, {{0, 1}}), "past.ms3d", "group 0 refers to triangle 1 of 1"},
+      {ms3d(3, {{0, 1, 3}}, {{0}}), "vertex.ms3d", "triangle 0 refers to vertex 3 of 3"},
+      {ms3d(0, {{0, 0, 0}}, {{0}}), "novertex.ms3d", "triangle 0 refers to vertex 0 of 0"},
+      {ms3d(3, {{0, 1, 2}}, {{0}}, 5000), "joints.ms3d", "file has 5000 joints; more than 1024 are not read"}};
+  for (const auto& [bytes, name, problem] : cases) {
+    try {
+      load(bytes, name);
+      ADD_FAILURE() << "loaded " << name;
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find(name + ": MS3D " + problem), std::string::npos) << e.what();
     }
   }
 }
