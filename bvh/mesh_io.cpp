@@ -374,7 +374,6 @@ LoadedMesh import_with(const std::string& source, std::string name, std::string_
   install_assimp_logger();
   LogCapture capture;
   Assimp::Importer importer;
-  keep_only_importers_of(importer, format);
   const aiScene* scene = nullptr;
   std::string problem;
   try {
@@ -383,6 +382,7 @@ LoadedMesh import_with(const std::string& source, std::string name, std::string_
     // this loader reads to detect bad indices. Loading is rarely the bottleneck; being right is not optional.
     static std::mutex import_mutex;
     const std::lock_guard lock(import_mutex);
+    keep_only_importers_of(importer, format);  // logs through the same buffer
     ScopedCapture scoped(capture);
     scene = read(importer);
     if (scene != nullptr) {
