@@ -414,7 +414,7 @@ std::string ms3d(std::uint16_t vertex_count, const std::vector<std::array<std::u
     name.resize(32, '\0');
     parent.resize(32, '\0');
     out += name + parent;
-    out.append(24, '\0');  // rotation, position
+    out.append(24, '\0');   // rotation, position
     put(std::uint16_t{1});  // one rotation key frame (assimp refuses an animation without any)
     put(std::uint16_t{0});
     out.append(16, '\0');  // its time and value
@@ -434,7 +434,8 @@ TEST(BadMeshInput, Ms3dIndicesAndJointsAreCheckedFirst) {
       {ms3d(3, {{0, 1, 2}}, {{0, 1}}), "past.ms3d", "group 0 refers to triangle 1 of 1"},
       {ms3d(3, {{0, 1, 3}}, {{0}}), "vertex.ms3d", "triangle 0 refers to vertex 3 of 3"},
       {ms3d(0, {{0, 0, 0}}, {{0}}), "novertex.ms3d", "triangle 0 refers to vertex 0 of 0"},
-      {ms3d(3, {{0, 1, 2}}, {{0}}, 5000), "joints.ms3d", "file has 5000 joints; more than 1024 are not read"}};
+      {ms3d(3, {{0, 1, 2}}, {{0}}, 5000), "joints.ms3d",
+       "file has 5000 joints; more than 1024 are not read"}};
   for (const auto& [bytes, name, problem] : cases) {
     try {
       load(bytes, name);
