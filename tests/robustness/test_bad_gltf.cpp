@@ -107,6 +107,14 @@ void expect_refused(const Json& doc, const std::string& name, const std::string&
   expect_refused(doc.dump(), "gltf", name, problem);
 }
 
+// The tetrahedron with the value at JSON pointer `pointer` replaced: refused for `problem`.
+void expect_refused_with(const char* pointer, const Json& value, const std::string& name,
+                         const std::string& problem) {
+  Json doc = tetrahedron();
+  doc[Json::json_pointer(pointer)] = value;
+  expect_refused(doc, name, problem);
+}
+
 TEST(BadGltf, WellFormedTetrahedronLoadsAsTextAndAsGlb) {
   for (const auto& [bytes, format] : {std::pair{tetrahedron().dump(), std::string("gltf")},
                                       std::pair{glb(tetrahedron(), tetrahedron_data()), std::string("glb")},
@@ -168,26 +176,16 @@ TEST(BadGltf, FansAndStripsWithoutATriangleAreLeftOut) {
 // buffer (ASan: heap-buffer-overflow). Every element must now lie inside its view, and the view inside its
 // buffer, without overflow.
 TEST(BadGltf, AccessorsAndViewsOutsideTheirBufferAreRefused) {
-  Json doc = tetrahedron();
-  doc["accessors"][0]["byteOffset"] = 28;
-  expect_refused(doc, "offset.gltf", "run past the end of bufferViews[0]");
-  doc = tetrahedron();
-  doc["accessors"][1]["count"] = 13;
-  expect_refused(doc, "count.gltf", "run past the end");
-  doc = tetrahedron();
-  doc["bufferViews"][1]["byteOffset"] = 18446744073709551608ull;  // offset + length wraps around to 16
-  expect_refused(doc, "wrap.gltf", "run past the end of buffers[0]");
-  doc = tetrahedron();
-  doc["bufferViews"][0]["byteStride"] = 8;  // smaller than a VEC3 of floats
-  expect_refused(doc, "stride.gltf", "overlap");
-  doc = tetrahedron();
-  doc["accessors"][0]["bufferView"] = 7;
-  expect_refused(doc, "ref.gltf", "bufferViews[7], which does not exist");
-  doc = tetrahedron();
-  doc["accessors"][0]["count"] = 0;
-  expect_refused(doc, "zero.gltf", "count 0");
+  expect_refused_with("/accessors/0/byteOffset", 28, "offset.gltf", "run past the end of bufferViews[0]");
+  expect_refused_with("/accessors/1/count", 13, "count.gltf", "run past the end");
+  // offset + length wraps around to 16:
+  expect_refused_with("/bufferViews/1/byteOffset", 18446744073709551608ull, "wrap.gltf",
+                      "run past the end of buffers[0]");
+  expect_refused_with("/bufferViews/0/byteStride", 8, "stride.gltf", "overlap");  // below a VEC3 of floats
+  expect_refused_with("/accessors/0/bufferView", 7, "ref.gltf", "bufferViews[7], which does not exist");
+  expect_refused_with("/accessors/0/count", 0, "zero.gltf", "count 0");
   // A GLB whose buffer is longer than its BIN chunk.
-  doc = tetrahedron();
+  Json doc = tetrahedron();
   doc["buffers"][0]["byteLength"] = 200;
   expect_refused(glb(doc, tetrahedron_data()), "glb", "short.glb", "exceeds the GLB BIN chunk");
 }
@@ -235,12 +233,9 @@ TEST(BadGltf, NodeGraphsThatAreNotTreesAreRefused) {
   for (int i = 0; i < 40; ++i) doc["nodes"].push_back({{"children", {i + 1, i + 1}}});
   doc["nodes"].push_back({{"mesh", 0}});
   expect_refused(doc, "dag.gltf", "reached twice");
-  doc = tetrahedron();
-  doc["nodes"] = {{{"children", {1}}}, {{"children", {0}}, {"mesh", 0}}};
-  expect_refused(doc, "cycle.gltf", "nodes[0] is reached twice");
-  doc = tetrahedron();
-  doc["scenes"][0]["nodes"] = {0, 0};
-  expect_refused(doc, "twice.gltf", "reached twice");
+  expect_refused_with("/nodes", {{{"children", {1}}}, {{"children", {0}}, {"mesh", 0}}}, "cycle.gltf",
+                      "nodes[0] is reached twice");
+  expect_refused_with("/scenes/0/nodes", {0, 0}, "twice.gltf", "reached twice");
   doc = tetrahedron();
   doc["nodes"] = Json::array();
   for (int i = 0; i < 300; ++i) doc["nodes"].push_back({{"children", {i + 1}}});
@@ -289,35 +284,22 @@ TEST(BadGltf, SkinsAndAnimationsAreNotRead) {
 }
 
 TEST(BadGltf, WhatTheLoaderCannotReadFaithfullyIsRefused) {
+  expect_refused_with("/asset/version", "1.0", "v1.gltf", "version '1.0' is not read");
+  expect_refused_with("/extensionsRequired", {"KHR_draco_mesh_compression"}, "draco.gltf",
+                      "requires the extension KHR_draco_mesh_compression");
   Json doc = tetrahedron();
-  doc["asset"]["version"] = "1.0";
-  expect_refused(doc, "v1.gltf", "version '1.0' is not read");
-  doc = tetrahedron();
-  doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
-  expect_refused(doc, "draco.gltf", "requires the extension KHR_draco_mesh_compression");
   doc["extensionsRequired"] = {"KHR_materials_unlit"};  // appearance only: read
   EXPECT_EQ(load(doc.dump(), "gltf", "unlit.gltf").mesh.triangle_count(), 4u);
-  doc = tetrahedron();
-  doc["accessors"][0]["sparse"] = {{"count", 1}};
-  expect_refused(doc, "sparse.gltf", "sparse accessors are not read");
-  doc = tetrahedron();
-  doc["accessors"][0]["componentType"] = 5123;
-  expect_refused(doc, "quantised.gltf", "not float VEC3");
-  doc = tetrahedron();
-  doc["accessors"][1]["componentType"] = 5126;
-  expect_refused(doc, "float-indices.gltf", "not unsigned integer scalars");
-  doc = tetrahedron();
-  doc["meshes"][0]["primitives"][0]["mode"] = 7;
-  expect_refused(doc, "mode.gltf", "mode 7 is not a glTF primitive mode");
-  doc = tetrahedron();
-  doc["buffers"][0]["uri"] = "data:text/plain,abc";
-  expect_refused(doc, "raw-uri.gltf", "only base64 data URIs are read");
-  doc = tetrahedron();
-  doc["buffers"][0]["byteLength"] = 71;
-  expect_refused(doc, "length.gltf", "holds 72 bytes, byteLength says 71");
-  doc = tetrahedron();
-  doc["buffers"][0]["uri"] = "tetra.bin";
-  expect_refused(doc, "external.gltf", "which a mesh read from memory cannot use");
+  expect_refused_with("/accessors/0/sparse", {{"count", 1}}, "sparse.gltf", "sparse accessors are not read");
+  expect_refused_with("/accessors/0/componentType", 5123, "quantised.gltf", "not float VEC3");
+  expect_refused_with("/accessors/1/componentType", 5126, "float-indices.gltf",
+                      "not unsigned integer scalars");
+  expect_refused_with("/meshes/0/primitives/0/mode", 7, "mode.gltf", "mode 7 is not a glTF primitive mode");
+  expect_refused_with("/buffers/0/uri", "data:text/plain,abc", "raw-uri.gltf",
+                      "only base64 data URIs are read");
+  expect_refused_with("/buffers/0/byteLength", 71, "length.gltf", "holds 72 bytes, byteLength says 71");
+  expect_refused_with("/buffers/0/uri", "tetra.bin", "external.gltf",
+                      "which a mesh read from memory cannot use");
   expect_refused(R"({"asset": {"version": "2.0"}, "scenes": [)", "gltf", "cut.gltf", "does not parse");
   expect_refused("{\"asset\": {}}", "", "noversion.gltf", "no asset.version");
 }
