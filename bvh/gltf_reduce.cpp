@@ -177,11 +177,9 @@ class Reducer {
   const Json& entry(Section& section, std::uint64_t index, const std::string& referrer) {
     open(section);
     if (index >= section.in->size())
-      refuse(referrer + " refers to " + section.name + "[" + std::to_string(index) +
-             "], which does not exist");
+      refuse(referrer + " refers to " + where(section, index) + ", which does not exist");
     const Json& e = (*section.in)[index];
-    if (!e.is_object())
-      refuse(std::string(section.name) + "[" + std::to_string(index) + "] is not an object");
+    if (!e.is_object()) refuse(where(section, index) + " is not an object");
     return e;
   }
 

@@ -441,10 +441,15 @@ std::uint64_t leading_count(std::string_view text) {
   return value;
 }
 
+// Whether `text` starts with the PLY magic (either case), where every PLY check here starts reading.
+bool has_ply_magic(std::string_view text) {
+  return lower_case(text.substr(0, 3)) == "ply";
+}
+
 // assimp 5.2's PLY reader never returns when the header ends without an `end_header` line (any truncated
 // header; found by tests/fuzz), so such input is refused before assimp sees it.
 bool ply_header_unterminated(std::string_view text) {
-  if (text.size() < 3 || lower_case(text.substr(0, 3)) != "ply") return false;
+  if (!has_ply_magic(text)) return false;
   for (std::size_t position = 0; position < text.size();) {
     const std::size_t end = std::min(text.find('\n', position), text.size());
     const std::string_view line = text.substr(position, end - position);
@@ -461,13 +466,11 @@ bool ply_header_unterminated(std::string_view text) {
 
 constexpr const char* kUnterminatedPly = ": PLY header has no end_header line (truncated file?)";
 
-// Where the OFF keyword, with its optional prefixes (ST, C, N, 4, n), ends in a lower-case first token;
-// npos when the token does not start with it.
-std::size_t off_keyword_end(std::string_view token) {
+// Whether a lower-case first token starts with the OFF keyword and its optional prefixes (ST, C, N, 4, n).
+bool starts_with_off_keyword(std::string_view token) {
   const std::size_t at = token.find("off");
-  const bool keyword =
-      at != std::string_view::npos && at <= 3 && token.find_first_not_of("abcdefghijklmnopqrstuvwxyz") >= at;
-  return keyword ? at + 3 : std::string_view::npos;
+  return at != std::string_view::npos && at <= 3 &&
+         token.find_first_not_of("abcdefghijklmnopqrstuvwxyz") >= at;
 }
 
 constexpr std::size_t kHeaderBytes = 1 << 16;  // a PLY header fits in it
@@ -573,7 +576,7 @@ std::string oversized_header_count(std::string_view text, std::string_view forma
 // understand is refused too (an unknown property type let the same huge count through). Returns the
 // problem, or "" for a PLY file whose body matches its header (and for input that is not PLY).
 std::string ply_body_problem(std::string_view text) {
-  if (text.size() < 3 || lower_case(text.substr(0, 3)) != "ply") return {};
+  if (!has_ply_magic(text)) return {};
   // Byte size of a PLY scalar type, 0 when unknown.
   auto size_of = [](const std::string& type) -> std::size_t {
     if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
@@ -824,9 +827,9 @@ std::string read_format(std::string_view bytes, const std::string& hint) {
       lower_case(start.substr(0, std::min<std::size_t>(start.find_first_of(" \t\r\n"), 64)));
   if (bytes.substr(0, 4) == "glTF") return "glb";
   if (start.substr(0, 1) == "{") return "gltf";
-  if (lower_case(bytes.substr(0, 3)) == "ply") return "ply";
+  if (has_ply_magic(bytes)) return "ply";
   if (bytes.substr(0, 10) == "MS3D000000") return "ms3d";
-  if (off_keyword_end(token) != std::string::npos) return "off";
+  if (starts_with_off_keyword(token)) return "off";
   if (token.rfind("solid", 0) == 0) return "stl";
   if (is_binary_stl(bytes)) return "stl";
   // OBJ: a line with one of its statements among the first lines.
@@ -855,7 +858,7 @@ LoadedMesh load_checked(std::string_view bytes, const std::string& hint, const s
                     (hint.empty() ? "" : " ('" + hint + "')") + "; the loader reads " + kReadFormatList);
   // The PLY checks start at the magic; assimp's reader skips what precedes it (NUL bytes let a header without
   // end_header through to its endless loop; found by tests/fuzz). The PLY rules put the magic first.
-  if (format == "ply" && lower_case(bytes.substr(0, 3)) != "ply")
+  if (format == "ply" && !has_ply_magic(bytes))
     throw MeshError(source + ": not a PLY file: it must start with 'ply'");
   for (const std::string& problem :
        {wide_text_problem(bytes, format), oversized_header_count(bytes, format), ply_body_problem(bytes),
