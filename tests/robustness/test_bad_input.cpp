@@ -184,7 +184,7 @@ TEST(BadMeshInput, TruncatedPlyHeaderIsRefusedNotHung) {
     fs::remove(file);
   }
   // Behind leading bytes assimp skips (a fuzz finding: it hung), PLY is refused: the magic comes first.
-  for (const std::string lead : {std::string(8, '\0'), std::string("\n"), std::string(" ")}) {
+  for (const std::string& lead : {std::string(8, '\0'), std::string("\n"), std::string(" ")}) {
     const std::string ply = lead + "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\n";
     try {
       load_mesh_from_memory(std::as_bytes(std::span(ply.data(), ply.size())), "ply", "lead.ply");
