@@ -1,4 +1,4 @@
-// ADB density annotation (ADB-METHOD.md section 1): for every node V, the number pc(V) of "possible
+// ADB density annotation (adb/README.md, section 1): for every node V, the number pc(V) of "possible
 // collision cells" among the g x g x g cells laid on V's bounding box.
 //
 // Definitions (the open points of the method, decided here)

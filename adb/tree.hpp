@@ -18,7 +18,7 @@ struct NoDensity {
 static_assert(std::is_empty_v<NoDensity::Storage>);
 
 /// ADB annotation: per node, pc = the number of the node's g^3 grid cells (laid on the node's bounding box)
-/// that hold at least `tau` times the cell's mean face area of polygon area (ADB-METHOD.md section 1).
+/// that hold at least `tau` times the cell's mean face area of polygon area (adb/README.md, section 1).
 template <int G>
 struct AdbDensity {
   static_assert(G >= 2 && G <= 6, "grid must be 2..6 cells per axis (pc fits a byte)");

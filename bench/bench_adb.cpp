@@ -1,4 +1,4 @@
-// ADB error and speed on the protocol (ADB-METHOD.md section 4): ADB on AABB (g = 2) for a list of p_min,
+// ADB error and speed on the protocol (adb/README.md, section 4): ADB on AABB (g = 2) for a list of p_min,
 // side by side with bvhlab's exact trees, in one binary. Per (mesh, strategy, distance): time per query,
 // false-positive and false-negative rates against exact ground truth, BV tests per query. At the end, a
 // summary per mesh: for every p_min the mean time, the total error, and the speed-up over each exact tree;

@@ -1,4 +1,4 @@
-// The exact-query protocol (ADB-METHOD.md section 4) as Google Benchmark suites: mesh x BV x distance,
+// The exact-query protocol (adb/README.md, section 4) as Google Benchmark suites: mesh x BV x distance,
 // with FCL 0.7's OBB and OBBRSS on the same meshes and poses in the same binary, so ratios come from one run.
 //
 //   bench_protocol [--meshes=a.stl,b.obj] [--steps=500] [--volumes=aabb,dop24] [benchmark flags]

@@ -178,7 +178,7 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
      << " build, commit `" << env.git_commit << "`.\n\n";
   const WorkloadSpec& w = scene.workload;
   if (w.kind == WorkloadSpec::Kind::Protocol) {
-    md << "Workload: the tumbling protocol (ADB-METHOD.md section 4): two copies of each model, normalised "
+    md << "Workload: the tumbling protocol (adb/README.md, section 4): two copies of each model, normalised "
           "to "
           "[-1, 1]^3; B at (d, 0, 0) turns a full R_z(θ)R_x(θ) in "
        << w.steps << " steps per distance d ∈ {";

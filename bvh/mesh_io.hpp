@@ -73,7 +73,7 @@ LoadedMesh load_mesh(const std::filesystem::path& path);
 LoadedMesh load_mesh_from_memory(std::span<const std::byte> buffer, std::string_view format_hint,
                                  std::string_view name = "<memory>");
 
-/// The protocol normalisation (ADB-METHOD.md section 4): bounding-box centre to the origin, uniform scale
+/// The protocol normalisation (adb/README.md, section 4): bounding-box centre to the origin, uniform scale
 /// so the longest bounding-box side is 2. Returns the applied scale. Throws MeshError on an empty mesh, a
 /// non-finite coordinate or a zero-size bounding box.
 double normalize_to_unit_cube(Mesh& mesh);

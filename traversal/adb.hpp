@@ -1,4 +1,4 @@
-// ADB traversal (ADB-METHOD.md section 3): best-first descent ordered by the estimated probability that
+// ADB traversal (adb/README.md, section 3): best-first descent ordered by the estimated probability that
 // a BV pair holds intersecting polygons. One loop, parameterised by options, serves three strategies:
 //   - probability-guided with p_min: answer "collision" as soon as a pair's estimate exceeds p_min;
 //   - time-critical: the same, under a budget of BV tests and/or a deadline; on exhaustion, a best effort;

@@ -1,4 +1,4 @@
-// Zachmann's benchmark protocol (ADB-METHOD.md section 4): B tumbles a full turn at distance d from A.
+// Zachmann's benchmark protocol (adb/README.md, section 4): B tumbles a full turn at distance d from A.
 #pragma once
 
 #include "volumes/geometry.hpp"
