@@ -1,5 +1,5 @@
-// ADB density annotation (adb/README.md, section 1): for every node V, the number pc(V) of "possible
-// collision cells" among the g x g x g cells laid on V's bounding box.
+// ADB cell counting (adb/README.md, section 1), the work behind AdbDensity (adb/adb_density.hpp): for every
+// node V, the number pc(V) of "possible collision cells" among the g x g x g cells laid on V's bounding box.
 //
 // Definitions (the open points of the method, decided here)
 // - Grid: V's bounding box (BV::bounding_box(), so a non-box BV uses its bounding box), cut into g cells per
@@ -68,21 +68,6 @@ struct AnnotateOptions {
   std::function<void(std::size_t, std::size_t)> progress;
 };
 
-/// What one annotation run did: the caller's evidence that annotation ran, and how it spent its time.
-struct AnnotateStats {
-  double seconds = 0;
-  unsigned threads = 0;
-  std::size_t nodes = 0;
-  std::size_t triangle_node_pairs = 0;  ///< sum over nodes of the node's triangle count
-  std::size_t fast_path_triangles = 0;  ///< pairs whose triangle lies inside one cell: no clipping
-  std::size_t clipped_triangles = 0;    ///< pairs that needed clipping
-  std::size_t clip_calls = 0;     ///< CGAL intersections (one per open candidate cell of a clipped pair)
-  std::size_t skipped_clips = 0;  ///< candidate cells already decided by area bounds: not clipped
-  std::size_t derived_areas = 0;  ///< candidate cells whose area was the triangle's minus the others'
-  std::size_t degenerate_triangles = 0;  ///< pairs skipped because the triangle has zero area
-  std::size_t exact_cells = 0;           ///< cells whose decision needed exact arithmetic (ties, near-ties)
-};
-
 struct CellCounts {
   std::vector<std::uint8_t> counts;  ///< pc per node
   AnnotateStats stats;
@@ -101,24 +86,5 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
 /// Area of the part of `triangle` inside the closed box `cell` (CGAL clipping, Epeck), to double precision.
 /// 0 for degenerate triangles, boxes that miss the triangle, and empty boxes.
 double triangle_area_in_box(const TrianglePoints& triangle, const Box& cell);
-
-/// Annotates a built tree (which must still hold its polygons): pc(V) for every node, on V's bounding box
-/// (decoded top-down for volumes stored relative to their parent). `stats`, when given, receives what the
-/// run did.
-template <int G, TreeVolume BV>
-Tree<BV, AdbDensity<G>> annotate(Bvh<BV> bvh, const AnnotateOptions& options = {},
-                                 AnnotateStats* stats = nullptr) {
-  if (!bvh.has_polygons())
-    throw std::invalid_argument(
-        "annotate: the tree holds no polygons (a tree loaded without them cannot be annotated)");
-  const std::vector<Box> boxes = bvh.node_boxes();
-  const auto ranges = node_triangle_ranges(bvh.nodes());
-  CellCounts result = annotate_counts(boxes, ranges, bvh.triangles(), G, options);
-  if (stats) *stats = result.stats;
-  Tree<BV, AdbDensity<G>> tree{std::move(bvh), {}};
-  tree.density.possible_collision_cells = std::move(result.counts);
-  tree.density.tau = options.tau;
-  return tree;
-}
 
 }  // namespace bvhlab

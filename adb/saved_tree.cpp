@@ -21,13 +21,14 @@ static_assert(sizeof(TreeNode) == 8 && std::is_trivially_copyable_v<TreeNode>);
 constexpr std::array<char, 8> kMagic = {'B', 'V', 'H', 'L', 'T', 'R', 'E', 'E'};
 constexpr std::uint32_t kByteOrderMark = 0x01020304;
 constexpr std::uint32_t kFlagTriangleIds = 1;
-constexpr std::size_t kNameField = 32;
+constexpr std::size_t kNameField = 32, kDensityNameField = 16;
 constexpr std::size_t kChecksumOffset = 120;
 
 // Header field offsets.
 constexpr std::size_t kVersionAt = 8, kByteOrderAt = 12, kHeaderSizeAt = 16, kFlagsAt = 20, kNameAt = 24,
-                      kVolumeSizeAt = 56, kRootSizeAt = 60, kGridAt = 64, kReserved0At = 68, kTauAt = 72,
-                      kNodesAt = 80, kTrianglesAt = 88, kPayloadAt = 96, kReserved1At = 104;
+                      kVolumeSizeAt = 56, kRootSizeAt = 60, kDensityNameAt = 64, kDensityVersionAt = 80,
+                      kReservedAt = 84, kNodesAt = 88, kTrianglesAt = 96, kDensityBytesAt = 104,
+                      kPayloadAt = 112;
 
 [[noreturn]] void fail(std::string_view source, const std::string& problem) {
   throw SavedTreeError("saved tree '" + std::string(source) + "': " + problem);
@@ -120,8 +121,13 @@ bool is_permutation_of_range(std::span<const std::uint32_t> ids) {
   return true;
 }
 
-std::string grid_name(std::uint64_t grid) {
-  return grid == 0 ? std::string("no density") : "an ADB grid of " + std::to_string(grid) + " cells per axis";
+/// A NUL-padded name field: 1 to size-1 characters, then NULs only.
+std::string_view name_field(const std::byte* at, std::size_t size) {
+  const char* field = reinterpret_cast<const char*>(at);
+  const std::size_t length = std::find(field, field + size, '\0') - field;
+  if (length == 0 || length == size || std::any_of(field + length, field + size, [](char c) { return c; }))
+    return {};
+  return {field, length};
 }
 
 }  // namespace
@@ -139,6 +145,8 @@ std::vector<std::byte> encode(const View& view, std::string_view source) {
   const std::size_t n = view.nodes.size();
   if (layout.bv_name.empty() || layout.bv_name.size() >= kNameField)
     fail(source, "BV name '" + std::string(layout.bv_name) + "' must have 1 to 31 characters");
+  if (layout.density_name.empty() || layout.density_name.size() >= kDensityNameField)
+    fail(source, "density name '" + std::string(layout.density_name) + "' must have 1 to 15 characters");
   if (n >= std::numeric_limits<std::uint32_t>::max() ||
       view.triangle_count >= std::numeric_limits<std::uint32_t>::max())
     fail(source, "too many nodes or triangles for 32-bit indices");
@@ -149,18 +157,9 @@ std::vector<std::byte> encode(const View& view, std::string_view source) {
   if (!view.triangle_ids.empty() && view.triangle_ids.size() != view.triangle_count)
     fail(source, "cannot save: " + std::to_string(view.triangle_ids.size()) + " triangle ids for " +
                      std::to_string(view.triangle_count) + " triangles");
-  if (layout.grid > 0) {
-    if (view.pc.size() != n)
-      fail(source, "cannot save: " + std::to_string(view.pc.size()) + " pc counts for " + std::to_string(n) +
-                       " nodes (was the tree annotated?)");
-    if (!std::isfinite(view.tau) || !(view.tau > 0)) fail(source, "cannot save: tau must be finite and > 0");
-    const std::uint64_t cells = std::uint64_t{layout.grid} * layout.grid * layout.grid;
-    if (std::any_of(view.pc.begin(), view.pc.end(), [&](std::uint8_t c) { return c > cells; }))
-      fail(source, "cannot save: a pc count exceeds the grid's " + std::to_string(cells) + " cells");
-  }
 
   const std::size_t payload = layout.root_volume_size + n * sizeof(TreeNode) + view.volumes.size() +
-                              view.triangle_ids.size() * sizeof(std::uint32_t) + (layout.grid > 0 ? n : 0);
+                              view.triangle_ids.size() * sizeof(std::uint32_t) + view.density.size();
   std::vector<std::byte> out(kSavedTreeHeaderSize + payload, std::byte{0});
   std::byte* h = out.data();
   std::memcpy(h, kMagic.data(), kMagic.size());
@@ -171,10 +170,11 @@ std::vector<std::byte> encode(const View& view, std::string_view source) {
   std::memcpy(h + kNameAt, layout.bv_name.data(), layout.bv_name.size());
   put_le(h + kVolumeSizeAt, layout.volume_size, 4);
   put_le(h + kRootSizeAt, layout.root_volume_size, 4);
-  put_le(h + kGridAt, layout.grid, 4);
-  put_le(h + kTauAt, std::bit_cast<std::uint64_t>(layout.grid > 0 ? view.tau : 0.0), 8);
+  std::memcpy(h + kDensityNameAt, layout.density_name.data(), layout.density_name.size());
+  put_le(h + kDensityVersionAt, layout.density_version, 4);
   put_le(h + kNodesAt, n, 8);
   put_le(h + kTrianglesAt, view.triangle_count, 8);
+  put_le(h + kDensityBytesAt, view.density.size(), 8);
   put_le(h + kPayloadAt, payload, 8);
 
   std::byte* at = out.data() + kSavedTreeHeaderSize;
@@ -186,12 +186,12 @@ std::vector<std::byte> encode(const View& view, std::string_view source) {
   append(std::as_bytes(view.nodes));
   append(view.volumes);
   append(std::as_bytes(view.triangle_ids));
-  if (layout.grid > 0) append(std::as_bytes(view.pc));
+  append(view.density);
   put_le(h + kChecksumOffset, checksum_of(out), 8);
   return out;
 }
 
-Parts decode(std::span<const std::byte> buffer, const Layout& expected, std::string_view source) {
+Header read_header(std::span<const std::byte> buffer, std::string_view source, bool whole) {
   if (buffer.size() < kSavedTreeHeaderSize)
     fail(source, "truncated: " + std::to_string(buffer.size()) + " bytes, shorter than the " +
                      std::to_string(kSavedTreeHeaderSize) + "-byte header");
@@ -201,7 +201,7 @@ Parts decode(std::span<const std::byte> buffer, const Layout& expected, std::str
   const std::uint64_t version = get_le(h + kVersionAt, 4);
   if (version != kSavedTreeVersion)
     fail(source, "format version " + std::to_string(version) + ", this build reads version " +
-                     std::to_string(kSavedTreeVersion));
+                     std::to_string(kSavedTreeVersion) + " (build the tree again)");
   std::uint32_t byte_order = 0;
   std::memcpy(&byte_order, h + kByteOrderAt, 4);
   if (byte_order != kByteOrderMark) fail(source, "written on a machine of another byte order (or corrupted)");
@@ -209,83 +209,89 @@ Parts decode(std::span<const std::byte> buffer, const Layout& expected, std::str
     fail(source, "corrupted header (bad header size)");
   const std::uint64_t flags = get_le(h + kFlagsAt, 4);
   if ((flags & ~std::uint64_t{kFlagTriangleIds}) != 0) fail(source, "unknown flags " + std::to_string(flags));
-  if (get_le(h + kReserved0At, 4) != 0 || get_le(h + kReserved1At, 8) != 0 ||
-      get_le(h + kReserved1At + 8, 8) != 0)
-    fail(source, "corrupted header (reserved bytes are not zero)");
+  if (get_le(h + kReservedAt, 4) != 0) fail(source, "corrupted header (reserved bytes are not zero)");
 
-  const char* name_field = reinterpret_cast<const char*>(h + kNameAt);
-  const std::size_t name_length = std::find(name_field, name_field + kNameField, '\0') - name_field;
-  if (name_length == 0 || name_length == kNameField) fail(source, "corrupted header (bad BV name field)");
-  const std::string_view name(name_field, name_length);
-  if (name != expected.bv_name)
-    fail(source,
-         "holds '" + std::string(name) + "' volumes, expected '" + std::string(expected.bv_name) + "'");
-  const std::uint64_t volume_size = get_le(h + kVolumeSizeAt, 4), root_size = get_le(h + kRootSizeAt, 4);
-  if (volume_size != expected.volume_size || root_size != expected.root_volume_size)
-    fail(source, "'" + std::string(name) + "' volumes of " + std::to_string(volume_size) + " bytes (root " +
-                     std::to_string(root_size) + "), this build's are " +
-                     std::to_string(expected.volume_size) + " (root " +
-                     std::to_string(expected.root_volume_size) + ")");
-  const std::uint64_t grid = get_le(h + kGridAt, 4);
-  if (grid != expected.grid)
-    fail(source, "holds a tree with " + grid_name(grid) + ", expected " + grid_name(expected.grid));
-  const double tau = std::bit_cast<double>(get_le(h + kTauAt, 8));
-  // Without density the field is all zero bits: -0.0 compares equal to 0 but would not save back the same.
-  if (grid > 0 ? !(std::isfinite(tau) && tau > 0) : std::bit_cast<std::uint64_t>(tau) != 0)
-    fail(source, "corrupted header (tau " + std::to_string(tau) + ")");
+  Header header;
+  header.bv_name = name_field(h + kNameAt, kNameField);
+  if (header.bv_name.empty()) fail(source, "corrupted header (bad BV name field)");
+  header.density_name = name_field(h + kDensityNameAt, kDensityNameField);
+  if (header.density_name.empty()) fail(source, "corrupted header (bad density name field)");
+  header.density_version = static_cast<std::uint32_t>(get_le(h + kDensityVersionAt, 4));
+  header.volume_size = static_cast<std::uint32_t>(get_le(h + kVolumeSizeAt, 4));
+  header.root_volume_size = static_cast<std::uint32_t>(get_le(h + kRootSizeAt, 4));
+  header.has_triangle_ids = (flags & kFlagTriangleIds) != 0;
+  header.nodes = get_le(h + kNodesAt, 8);
+  header.triangles = get_le(h + kTrianglesAt, 8);
+  header.density_bytes = get_le(h + kDensityBytesAt, 8);
+  header.payload = get_le(h + kPayloadAt, 8);
 
-  // Sizes, against the buffer's real length, before any allocation.
-  const std::uint64_t n = get_le(h + kNodesAt, 8), triangles = get_le(h + kTrianglesAt, 8);
-  const std::uint64_t payload = get_le(h + kPayloadAt, 8);
-  const bool has_ids = (flags & kFlagTriangleIds) != 0;
-  const std::uint64_t per_node = sizeof(TreeNode) + volume_size + (grid > 0 ? 1 : 0);
+  // Sizes, against each other and the buffer's real length, before any allocation.
+  const std::uint64_t n = header.nodes, triangles = header.triangles;
   std::uint64_t expected_payload = 0;
   if (n == 0 || n >= std::numeric_limits<std::uint32_t>::max() ||
       triangles >= std::numeric_limits<std::uint32_t>::max() ||
-      !mul_add(n, per_node, root_size, expected_payload) ||
-      !mul_add(has_ids ? triangles : 0, sizeof(std::uint32_t), expected_payload, expected_payload))
+      !mul_add(n, sizeof(TreeNode) + std::uint64_t{header.volume_size}, header.root_volume_size,
+               expected_payload) ||
+      !mul_add(header.has_triangle_ids ? triangles : 0, sizeof(std::uint32_t), expected_payload,
+               expected_payload) ||
+      !mul_add(1, header.density_bytes, expected_payload, expected_payload))
     fail(source, "corrupted header (absurd counts: " + std::to_string(n) + " nodes, " +
                      std::to_string(triangles) + " triangles)");
-  if (payload != expected_payload)
-    fail(source, "corrupted header (payload size " + std::to_string(payload) + " does not match " +
-                     std::to_string(n) + " nodes and " + std::to_string(triangles) + " triangles)");
+  if (header.payload != expected_payload)
+    fail(source, "corrupted header (payload size " + std::to_string(header.payload) + " does not match " +
+                     std::to_string(n) + " nodes, " + std::to_string(triangles) + " triangles and " +
+                     std::to_string(header.density_bytes) + " bytes of density data)");
+  if (!whole) return header;
   const std::uint64_t available = buffer.size() - kSavedTreeHeaderSize;
-  if (available < payload)
+  if (available < header.payload)
     fail(source, "truncated: the payload has " + std::to_string(available) + " of " +
-                     std::to_string(payload) + " bytes");
-  if (available > payload)
-    fail(source, std::to_string(available - payload) + " trailing bytes after the payload");
+                     std::to_string(header.payload) + " bytes");
+  if (available > header.payload)
+    fail(source, std::to_string(available - header.payload) + " trailing bytes after the payload");
   if (get_le(h + kChecksumOffset, 8) != checksum_of(buffer))
     fail(source, "checksum mismatch: the file is corrupted");
+  return header;
+}
 
+Parts decode(std::span<const std::byte> buffer, const Layout& expected, std::string_view source) {
+  const Header header = read_header(buffer, source);
+  if (header.bv_name != expected.bv_name)
+    fail(source, "holds '" + header.bv_name + "' volumes, expected '" + std::string(expected.bv_name) + "'");
+  if (header.volume_size != expected.volume_size || header.root_volume_size != expected.root_volume_size)
+    fail(source, "'" + header.bv_name + "' volumes of " + std::to_string(header.volume_size) +
+                     " bytes (root " + std::to_string(header.root_volume_size) + "), this build's are " +
+                     std::to_string(expected.volume_size) + " (root " +
+                     std::to_string(expected.root_volume_size) + ")");
+  if (header.density_name != expected.density_name)
+    fail(source, "holds a tree with density '" + header.density_name + "', expected '" +
+                     std::string(expected.density_name) + "'");
+  if (header.density_version != expected.density_version)
+    fail(source, "density '" + header.density_name + "' data of version " +
+                     std::to_string(header.density_version) + ", this build reads version " +
+                     std::to_string(expected.density_version));
+
+  const std::uint64_t n = header.nodes, triangles = header.triangles;
   Parts parts;
-  parts.tau = grid > 0 ? tau : 0.0;
   parts.triangle_count = triangles;
   const std::byte* at = buffer.data() + kSavedTreeHeaderSize;
-  parts.root_volume = {at, static_cast<std::size_t>(root_size)};
-  at += root_size;
+  parts.root_volume = {at, static_cast<std::size_t>(header.root_volume_size)};
+  at += header.root_volume_size;
   parts.nodes.resize(n);
   std::memcpy(parts.nodes.data(), at, n * sizeof(TreeNode));
   at += n * sizeof(TreeNode);
-  parts.volumes = {at, static_cast<std::size_t>(n * volume_size)};
-  at += n * volume_size;
-  if (has_ids) {
+  parts.volumes = {at, static_cast<std::size_t>(n * header.volume_size)};
+  at += n * header.volume_size;
+  if (header.has_triangle_ids) {
     parts.triangle_ids.resize(triangles);
     std::memcpy(parts.triangle_ids.data(), at, triangles * sizeof(std::uint32_t));
     at += triangles * sizeof(std::uint32_t);
   }
-  if (grid > 0)
-    parts.pc.assign(reinterpret_cast<const std::uint8_t*>(at), reinterpret_cast<const std::uint8_t*>(at) + n);
+  parts.density = {at, static_cast<std::size_t>(header.density_bytes)};
 
   std::string problem;
   if (!valid_topology(parts.nodes, triangles, problem)) fail(source, "bad topology: " + problem);
-  if (has_ids && !is_permutation_of_range(parts.triangle_ids))
+  if (header.has_triangle_ids && !is_permutation_of_range(parts.triangle_ids))
     fail(source, "the triangle ids are not a permutation of 0.." + std::to_string(triangles - 1));
-  const std::uint64_t cells = grid * grid * grid;
-  for (std::size_t k = 0; k < parts.pc.size(); ++k)
-    if (parts.pc[k] > cells)
-      fail(source, "node " + std::to_string(k) + " has pc " + std::to_string(parts.pc[k]) +
-                       ", more than the grid's " + std::to_string(cells) + " cells");
   return parts;
 }
 

@@ -1,52 +1,60 @@
-// Tree<BV, Density>: a hierarchy plus an optional per-node density annotation stored beside the nodes.
-// A tree without density pays nothing: NoDensity's storage is an empty member.
+// Tree<BV, Density>: a hierarchy plus a per-node density annotation stored beside the nodes
+// (adb/concept.hpp). A tree without density pays nothing: NoDensity's storage is an empty member.
 #pragma once
 
+#include "adb/concept.hpp"
 #include "bvh/bvh.hpp"
 
-#include <cstdint>
+#include <stdexcept>
 #include <type_traits>
-#include <vector>
 
 namespace bvhlab {
 
-/// No annotation: no preprocessing, zero bytes per node.
+/// No annotation: no preprocessing, zero bytes per node, nothing saved.
 struct NoDensity {
-  static constexpr bool annotated = false;
-  struct Storage {};
-};
-static_assert(std::is_empty_v<NoDensity::Storage>);
-
-/// ADB annotation: per node, pc = the number of the node's g^3 grid cells (laid on the node's bounding box)
-/// that hold at least `tau` times the cell's mean face area of polygon area (adb/README.md, section 1).
-template <int G>
-struct AdbDensity {
-  static_assert(G >= 2 && G <= 6, "grid must be 2..6 cells per axis (pc fits a byte)");
-  static constexpr bool annotated = true;
-  static constexpr int grid = G;
-  static constexpr int cells = G * G * G;
-  struct Storage {
-    std::vector<std::uint8_t> possible_collision_cells;  ///< pc(V) per node, same index as the nodes
-    double tau = 0;                                      ///< the threshold it was computed with
+  struct Params {
+    friend bool operator==(const Params&, const Params&) = default;
   };
-};
+  struct Storage {};
 
-template <class D>
-concept DensityPolicy = requires {
-  { D::annotated } -> std::convertible_to<bool>;
-  typename D::Storage;
+  static constexpr std::string_view name() { return "none"; }
+  static constexpr std::uint32_t version() { return 1; }
+  static std::span<const ParamSpec> parameters() { return {}; }
+  static Params make_params(const ParamValues&) { return {}; }
+  template <TreeVolume BV>
+  static Storage annotate(const Bvh<BV>&, const Params&, const AnnotationContext&, AnnotateStats*) {
+    return {};
+  }
+  static std::string describe(const Storage&) { return "none"; }
+  static std::vector<std::byte> encode(const Storage&) { return {}; }
+  static Storage decode(std::span<const std::byte> bytes, std::size_t) {
+    if (!bytes.empty())
+      throw std::invalid_argument("density 'none' stores no bytes, found " + std::to_string(bytes.size()));
+    return {};
+  }
+  static std::size_t memory_bytes(const Storage&) { return 0; }
 };
+static_assert(std::is_empty_v<NoDensity::Storage> && Density<NoDensity>);
 
-template <TreeVolume BV, DensityPolicy Density = NoDensity>
+template <TreeVolume BV, Density D = NoDensity>
 struct Tree {
   using Volume = BV;
-  using DensityType = Density;
+  using DensityType = D;
   Bvh<BV> bvh;
-  [[no_unique_address]] typename Density::Storage density;
+  [[no_unique_address]] typename D::Storage density;
 };
 
 /// True when Tree<BV, NoDensity> is exactly as large as the bare Bvh<BV> (checked per BV where used).
 template <TreeVolume BV>
 inline constexpr bool no_density_is_free = sizeof(Tree<BV, NoDensity>) == sizeof(Bvh<BV>);
+
+/// Annotates a built tree (which must still hold its polygons) with density D.
+template <class D, TreeVolume BV>
+requires DensityFor<D, BV> Tree<BV, D> annotate_tree(Bvh<BV> bvh, const typename D::Params& params,
+                                                     const AnnotationContext& context = {},
+                                                     AnnotateStats* stats = nullptr) {
+  typename D::Storage storage = D::annotate(bvh, params, context, stats);
+  return Tree<BV, D>{std::move(bvh), std::move(storage)};
+}
 
 }  // namespace bvhlab

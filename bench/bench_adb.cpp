@@ -6,7 +6,7 @@
 //
 //   bench_adb [--meshes=a,b] [--steps=200] [--p-min=0.5,0.7,...] [--exact=aabb,dop24] [--grid=2]
 //             [--tau=0.5] [--distances=1.2,1.4,...] [benchmark flags]
-#include "adb/annotate.hpp"
+#include "adb/adb_density.hpp"
 #include "bench/core/arguments.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
@@ -74,10 +74,9 @@ template <int G>
 void register_adb(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w,
                   const std::vector<double>& p_mins, double tau) {
   AnnotateStats stats;
-  auto tree = std::make_shared<const Tree<Aabb, AdbDensity<G>>>(
-      annotate<G>(Bvh<Aabb>::build(mesh), AnnotateOptions{.tau = tau}, &stats));
+  auto tree = std::make_shared<const Tree<Aabb, AdbDensity>>(
+      annotate_adb(Bvh<Aabb>::build(mesh), G, tau, {}, &stats));
   std::fprintf(stderr, "bench_adb: %s annotated (g = %d) in %.2f s\n", label.c_str(), G, stats.seconds);
-  auto model = std::make_shared<const AdbModel>(G, tau);
   for (double p_min : p_mins) {
     char strategy[64];
     std::snprintf(strategy, sizeof strategy, "adb_aabb_g%d/p:%.2f", G, p_min);
@@ -88,8 +87,7 @@ void register_adb(const std::string& label, const Mesh& mesh, const std::shared_
         AdbOptions options;
         options.p_min = p_min;
         run_poses(
-            state, *w, d,
-            [&](const RigidTransform& pose) { return query_adb(*tree, *tree, pose, *model, options); },
+            state, *w, d, [&](const RigidTransform& pose) { return query_adb(*tree, *tree, pose, options); },
             g_measured[{label, strategy}][w->distances[d]]);
       })->Unit(benchmark::kMillisecond);
     }

@@ -10,7 +10,7 @@
 //
 // Meshes missing from the cache are skipped with an error (fetch with meshes/fetch.sh); `generated_torus`
 // needs no file. Annotation runs on 2 threads unless --threads=N is given before the benchmark flags.
-#include "adb/annotate.hpp"
+#include "adb/adb_density.hpp"
 #include "adb/saved_tree.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "volumes/aabb.hpp"
@@ -114,7 +114,7 @@ void BM_Annotate(benchmark::State& state, const std::string& name) {
     Bvh<Aabb> copy = bvh;
     state.ResumeTiming();
     const double cpu_start = process_cpu_seconds();
-    auto tree = annotate<2>(std::move(copy), options, &stats);
+    auto tree = annotate_adb(std::move(copy), 2, options, &stats);
     cpu = process_cpu_seconds() - cpu_start;
     benchmark::DoNotOptimize(tree.density.possible_collision_cells.data());
   }
@@ -145,7 +145,7 @@ void BM_SavedBytes(benchmark::State& state, const std::string& name, std::uint32
     state.PauseTiming();
     Bvh<Aabb> copy = bvh;
     state.ResumeTiming();
-    const auto tree = annotate<2>(std::move(copy), options, &stats);
+    const auto tree = annotate_adb(std::move(copy), 2, options, &stats);
     state.PauseTiming();
     with_ids = save_tree_to_buffer(tree).size();
     without_ids = save_tree_to_buffer(tree, SaveOptions{.triangle_ids = false}).size();

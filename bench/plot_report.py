@@ -2,7 +2,11 @@
 """Draws the five figures of a bvhlab report from its results.csv and calibration.csv.
 
     plot_report.py REPORT_DIR [--quality-min 1.2] [--quality-max 2.0]
-                   [--operating-hierarchy aabb] [--operating-p-min 0.9]
+                   [--operating-strategy adb] [--operating-hierarchy aabb] [--operating-p-min 0.9]
+
+Strategies are told apart by the columns results.csv takes from bvhlab's strategy table: "exact" (1 for an
+exact strategy), "strategy" (its name) and "label" (name, labelled parameters, budget); no strategy name is
+spelled out here.
 
 Figures (PNG, in REPORT_DIR):
   fig1_time_vs_distance.png   mean time per query against distance, every hierarchy
@@ -38,16 +42,15 @@ def num(value):
 
 
 def series_label(row):
-    label = row["strategy"]
-    if row["p_min"]:
-        label += f" p_min={float(row['p_min']):g}"
-    if row["budget"]:
-        label += " " + row["budget"].replace("bv_tests=", "budget ").replace("deadline_us=", "deadline µs ")
-    return label
+    return row["label"].replace("bv_tests=", "budget ").replace("deadline_us=", "deadline µs ")
 
 
 def series_key(row):
-    return (row["hierarchy"], row["strategy"], row["p_min"], row["budget"])
+    return (row["hierarchy"], row.get("label") or (row["strategy"], row["p_min"], row["budget"]))
+
+
+def is_exact(row):
+    return row["exact"] == "1"
 
 
 def meshes_of(rows):
@@ -59,7 +62,7 @@ def meshes_of(rows):
 
 
 def grouped(rows):
-    """{(hierarchy, strategy, p_min, budget): [rows sorted by distance]}, in first-appearance order."""
+    """{(hierarchy, series label): [rows sorted by distance]}, in first-appearance order."""
     out = {}
     for r in rows:
         out.setdefault(series_key(r), []).append(r)
@@ -127,29 +130,39 @@ def legend_below(fig, axes):
                    fontsize=9, frameon=False)
 
 
-def style_for(hierarchy, strategy, hierarchies):
+LINES = ["-", "--", ":", "-.", (0, (5, 1, 1, 1))]
+MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
+
+
+def style_for(hierarchy, strategy, hierarchies, strategies):
+    """Colour by hierarchy, line and marker by strategy (in the order the strategies first appear)."""
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     colour = colours[hierarchies.index(hierarchy) % len(colours)]
-    line = {"exact": "-", "guided_exact": "--", "adb": ":", "time_critical": "-."}.get(strategy, "-")
-    marker = {"exact": "o", "guided_exact": "s", "adb": "^", "time_critical": "D"}.get(strategy, "o")
-    return colour, line, marker
+    index = strategies.index(strategy) if strategy in strategies else 0
+    return colour, LINES[index % len(LINES)], MARKERS[index % len(MARKERS)]
 
 
 def is_operating(row, args):
-    return (row["strategy"] == "adb" and row["hierarchy"] == args.operating_hierarchy and row["p_min"]
-            and abs(float(row["p_min"]) - args.operating_p_min) < 1e-12)
+    return (row["strategy"] == args.operating_strategy and row["hierarchy"] == args.operating_hierarchy
+            and row["p_min"] and not row["budget"] and abs(float(row["p_min"]) - args.operating_p_min) < 1e-12)
+
+
+def is_sweep(row, args):
+    """A point of the operating strategy's curve over p_min (no budget)."""
+    return row["strategy"] == args.operating_strategy and row["p_min"] and not row["budget"]
 
 
 def figure_time_vs_distance(rows, args, out):
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
+    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
     for (ax,), mesh in zip(per_mesh, meshes):
         for key, series in grouped([r for r in rows if r["mesh"] == mesh]).items():
             first = series[0]
-            if first["strategy"] not in ("exact", "guided_exact") and not is_operating(first, args):
+            if not is_exact(first) and not is_operating(first, args):
                 continue
-            colour, line, marker = style_for(first["hierarchy"], first["strategy"], hierarchies)
+            colour, line, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
             ax.plot([num(r["distance"]) for r in series], [num(r["mean_time_us"]) for r in series], line,
                     marker=marker, color=colour, label=f"{first['hierarchy']}: {series_label(first)}")
         ax.set_yscale("log")
@@ -164,24 +177,25 @@ def figure_time_vs_distance(rows, args, out):
 
 def figure_errors_vs_distance(rows, args, out):
     meshes = meshes_of(rows)
-    inexact = [r for r in rows if r["strategy"] in ("adb", "time_critical")]
+    inexact = [r for r in rows if not is_exact(r)]
     fig, per_mesh, axes = subplots(len(meshes), rows_per_mesh=2, height=3.6)
     cmap = plt.get_cmap("viridis")
     for (fp_ax, fn_ax), mesh in zip(per_mesh, meshes):
         series_list = list(grouped([r for r in inexact if r["mesh"] == mesh]).values())
-        adb_count = sum(1 for s in series_list if s[0]["strategy"] == "adb")
+        adb_count = sum(1 for s in series_list if is_sweep(s[0], args))
         other_count = len(series_list) - adb_count
         adb_index = other_index = 0
         for series in series_list:
             first = series[0]
-            # ADB over p_min in viridis, time-critical budgets in warm colours: two families, told apart at a glance.
-            if first["strategy"] == "adb":
+            # The operating strategy over p_min in viridis, the other inexact series (budgets, other strategies) in
+            # warm colours: two families, told apart at a glance.
+            if is_sweep(first, args):
                 colour = cmap(adb_index / max(1, adb_count - 1) * 0.85)
                 adb_index += 1
             else:
                 colour = plt.get_cmap("autumn")(other_index / max(1, other_count) * 0.7)
                 other_index += 1
-            marker = "^" if first["strategy"] == "adb" else "D"
+            marker = "^" if is_sweep(first, args) else "D"
             label = f"{first['hierarchy']}: {series_label(first)}"
             d = [num(r["distance"]) for r in series]
             fp_ax.plot(d, [100 * num(r["fp_rate"]) for r in series], marker=marker, color=colour, label=label)
@@ -203,6 +217,7 @@ def figure_errors_vs_distance(rows, args, out):
 def figure_error_vs_time(rows, args, out):
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
+    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
     for (ax,), mesh in zip(per_mesh, meshes):
         groups = grouped([r for r in rows if r["mesh"] == mesh])
@@ -213,20 +228,20 @@ def figure_error_vs_time(rows, args, out):
             agg = aggregate(series, args.quality_min, args.quality_max)
             if agg is None:
                 continue
-            if first["strategy"] == "adb":
+            if is_sweep(first, args):
                 curves.setdefault(first["hierarchy"], []).append((float(first["p_min"]), agg))
                 continue
-            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies)
-            if first["strategy"] == "time_critical":
+            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
+            if first["budget"]:
                 marker = next(budget_markers, "D")
             ax.plot([agg["time"]], [100 * (agg["fp"] + agg["fn"])], marker, color=colour, markersize=8,
                     linestyle="none", label=f"{first['hierarchy']}: {series_label(first)}")
         for hierarchy, points in curves.items():
             points.sort(key=lambda p: p[0])
-            colour, line, marker = style_for(hierarchy, "adb", hierarchies)
+            colour, line, marker = style_for(hierarchy, args.operating_strategy, hierarchies, strategies)
             xs = [p[1]["time"] for p in points]
             ys = [100 * (p[1]["fp"] + p[1]["fn"]) for p in points]
-            ax.plot(xs, ys, "-", marker="^", color=colour, label=f"{hierarchy}: adb over p_min")
+            ax.plot(xs, ys, "-", marker="^", color=colour, label=f"{hierarchy}: {args.operating_strategy} over p_min")
             for (p, _), x, y in zip(points, xs, ys):
                 ax.annotate(f"{p:g}", (x, y), textcoords="offset points", xytext=(5, 4), fontsize=8, color=colour)
         ax.set_xscale("log")
@@ -247,7 +262,7 @@ def figure_calibration(calibration, args, out):
     cmap = plt.get_cmap("viridis")
     for (ax,), mesh in zip(per_mesh, meshes):
         ax.plot([0, 1], [0, 1], "--", color="grey", label="perfect calibration")
-        series = grouped([c for c in calibration if c["mesh"] == mesh and c["strategy"] == "adb"])
+        series = grouped([c for c in calibration if c["mesh"] == mesh and c["strategy"] == args.operating_strategy])
         for i, (key, bins) in enumerate(series.items()):
             used = [b for b in bins if int(b["count"]) >= MIN_BIN_ANSWERS]
             if not used:
@@ -278,16 +293,17 @@ def figure_calibration(calibration, args, out):
 def figure_time_vs_size(rows, args, out):
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
+    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
     for (ax,), mesh in zip(per_mesh, meshes):
         for key, series in grouped([r for r in rows if r["mesh"] == mesh]).items():
             first = series[0]
-            if first["strategy"] not in ("exact", "guided_exact") and not is_operating(first, args):
+            if not is_exact(first) and not is_operating(first, args):
                 continue
             agg = aggregate(series, -1e300, 1e300)
             if agg is None or not math.isfinite(agg["bytes"]):
                 continue
-            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies)
+            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
             label = f"{first['hierarchy']}: {series_label(first)}"
             ax.plot([agg["bytes"]], [agg["time"]], marker, color=colour, markersize=9, linestyle="none", label=label)
         ax.set_yscale("log")
@@ -306,6 +322,7 @@ def main():
     parser.add_argument("report_dir")
     parser.add_argument("--quality-min", type=float, default=1.2)
     parser.add_argument("--quality-max", type=float, default=2.0)
+    parser.add_argument("--operating-strategy", default="")
     parser.add_argument("--operating-hierarchy", default="")
     parser.add_argument("--operating-p-min", type=float, default=-1)
     args = parser.parse_args()

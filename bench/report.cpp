@@ -31,19 +31,11 @@ std::string p_min_text(double p) {
 }
 
 std::string series_name(const SeriesSummary& s) {
-  std::string out = s.strategy;
-  if (s.p_min >= 0) out += " p_min=" + fmt("%g", s.p_min);
-  if (!s.budget.empty()) out += " " + s.budget;
-  return out;
+  return s.label;
 }
 
 std::string series_key(const ResultRow& r) {
-  return r.mesh + '\x1f' + r.hierarchy + '\x1f' + r.strategy + '\x1f' + fmt("%.17g", r.p_min) + '\x1f' +
-         r.budget;
-}
-
-bool is_inexact(const std::string& strategy) {
-  return strategy == "adb" || strategy == "time_critical";
+  return r.mesh + '\x1f' + r.hierarchy + '\x1f' + r.label;
 }
 
 std::string shell_quote(const std::string& s) {
@@ -100,6 +92,8 @@ std::vector<SeriesSummary> summarize(const std::vector<ResultRow>& rows, double 
       s.bv = r.bv;
       s.annotation = r.annotation;
       s.strategy = r.strategy;
+      s.label = r.label;
+      s.exact_strategy = r.exact_strategy;
       s.budget = r.budget;
       s.p_min = r.p_min;
       s.bytes_per_triangle = r.bytes_per_triangle;
@@ -150,10 +144,10 @@ std::vector<OperatingPoint> operating_points(const RunOutput& run) {
     const SeriesSummary *adb = nullptr, *base = nullptr;
     for (const auto& s : series) {
       if (s.mesh != mesh) continue;
-      if (s.hierarchy == spec.operating_hierarchy && s.strategy == "adb" && s.p_min == spec.operating_p_min)
+      if (s.hierarchy == spec.operating_hierarchy && s.strategy == spec.operating_strategy &&
+          s.p_min == spec.operating_p_min && s.budget.empty())
         adb = &s;
-      if (s.hierarchy == spec.baseline_hierarchy && s.strategy == to_string(spec.baseline_strategy) && !base)
-        base = &s;
+      if (s.hierarchy == spec.baseline_hierarchy && s.strategy == spec.baseline_strategy && !base) base = &s;
     }
     if (!adb || !base) continue;
     out.push_back({mesh, *adb, *base, adb->mean_time_us > 0 ? base->mean_time_us / adb->mean_time_us : 0});
@@ -188,10 +182,9 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
     md << "Workload: " << w.groups.size() << " pose groups from `" << w.pose_file.filename().string()
        << "`.\n\n";
   }
-  if (scene.annotation.adb)
-    md << "ADB annotation: " << scene.annotation.grid << "×" << scene.annotation.grid << "×"
-       << scene.annotation.grid << " cells per node, threshold tau = " << fmt("%g", scene.annotation.tau)
-       << " of the cell face area.\n\n";
+  if (scene.density.name != NoDensity::name())
+    md << "Density annotation of the trees that need one: `" << scene.density.label()
+       << "` (parameters in `bvhlab policies`; the ADB method in adb/README.md).\n\n";
   md << "Times are per query, measured one by one with a steady clock (less its own cost, "
      << fmt("%.3f", stats.clock_overhead_us)
      << " µs, measured at the start of the run), all strategies on the same poses in one process.\n\n";
@@ -201,10 +194,11 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
   md << "## Result at the operating point\n\n";
   const auto points = operating_points(run);
   if (points.empty()) {
-    md << "No operating point: the scene has no `adb` strategy at p_min = "
-       << p_min_text(scene.report.operating_p_min) << " on `" << scene.report.operating_hierarchy
-       << "`, or no baseline `" << to_string(scene.report.baseline_strategy) << "` on `"
-       << scene.report.baseline_hierarchy << "`.\n\n";
+    md << "No operating point: the scene has no `"
+       << (scene.report.operating_strategy.empty() ? std::string("adb") : scene.report.operating_strategy)
+       << "` strategy at p_min = " << p_min_text(scene.report.operating_p_min) << " on `"
+       << scene.report.operating_hierarchy << "`, or no baseline `" << scene.report.baseline_strategy
+       << "` on `" << scene.report.baseline_hierarchy << "`.\n\n";
   }
   for (const auto& p : points) {
     md << "- **" << p.mesh << "** (" << range_text << ", " << p.adb.queries << " queries): ADB on `"
@@ -257,7 +251,7 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
     for (std::size_t i = 0; i < distances.size(); ++i) md << "---:|";
     md << "\n";
     for (const auto& s : summarize(run.rows, -1e300, 1e300)) {
-      if (inexact_only && !is_inexact(s.strategy)) continue;
+      if (inexact_only && s.exact_strategy) continue;
       md << "| " << s.mesh << " | " << s.hierarchy << " | " << series_name(s) << " |";
       for (double d : distances) {
         const ResultRow* row = nullptr;
@@ -273,8 +267,7 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
   };
   per_distance_table("Mean time per query (µs) by distance", false,
                      [](const ResultRow& r) { return micros(r.mean_time_us); });
-  if (std::any_of(run.rows.begin(), run.rows.end(),
-                  [](const ResultRow& r) { return is_inexact(r.strategy); }))
+  if (std::any_of(run.rows.begin(), run.rows.end(), [](const ResultRow& r) { return !r.exact_strategy; }))
     per_distance_table("False positives / false negatives (%) by distance", true,
                        [](const ResultRow& r) { return percent(r.fp_rate) + " / " + percent(r.fn_rate); });
 
@@ -392,7 +385,8 @@ ReportFiles write_report(const RunOutput& run, const std::filesystem::path& dir,
                             fmt("%.17g", fell_back ? -1e300 : lo) + " --quality-max " +
                             fmt("%.17g", fell_back ? 1e300 : hi);
       if (!r.operating_hierarchy.empty())
-        command += " --operating-hierarchy " + shell_quote(r.operating_hierarchy) + " --operating-p-min " +
+        command += " --operating-strategy " + shell_quote(r.operating_strategy) + " --operating-hierarchy " +
+                   shell_quote(r.operating_hierarchy) + " --operating-p-min " +
                    fmt("%.17g", r.operating_p_min);
       const std::filesystem::path log = files.dir / "plot.log";
       const int status = std::system((command + " > " + shell_quote(log.string()) + " 2>&1").c_str());

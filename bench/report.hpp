@@ -20,7 +20,8 @@ const std::vector<FigureSpec>& report_figures();
 /// One (mesh, hierarchy, strategy, p_min, budget) series aggregated over a range of distances, weighting each
 /// distance by its number of queries.
 struct SeriesSummary {
-  std::string mesh, hierarchy, bv, annotation, strategy, budget;
+  std::string mesh, hierarchy, bv, annotation, strategy, label, budget;
+  bool exact_strategy = true;
   double p_min = -1;
   std::size_t queries = 0;
   double mean_time_us = 0, max_time_us = 0, fp_rate = 0, fn_rate = 0;

@@ -1,13 +1,12 @@
 #include "bench/run.hpp"
 
-#include "adb/annotate.hpp"
 #include "bench/core/content_hash.hpp"
 #include "bench/core/ground_truth.hpp"
+#include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
 #include "bench/core/tree_cache.hpp"
 #include "bvh/mesh_io.hpp"
-#include "traversal/adb.hpp"
-#include "traversal/exact.hpp"
+#include "traversal/strategies.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
 #include <fcl/geometry/bvh/BVH_model.h>
@@ -143,63 +142,55 @@ double clock_overhead_us() {
 class PreparedHierarchy {
  public:
   virtual ~PreparedHierarchy() = default;
+  /// Times `variant` on every pose (one dispatch to the strategy's type per series, none per query).
   virtual void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
                    std::vector<QueryRecord>& out) const = 0;
   /// Exact first-contact answer (the ground truth's source).
   [[nodiscard]] virtual bool exact_collides(const RigidTransform& pose) const = 0;
   [[nodiscard]] virtual bool has_counters() const { return true; }
   /// One untimed query with the full result (witness, contacts).
-  [[nodiscard]] virtual Result query(const StrategyVariant& variant, const RigidTransform& pose,
-                                     ContactMode mode) const = 0;
+  [[nodiscard]] virtual Result query(const StrategyVariant& variant, const RigidTransform& pose) const = 0;
   ModelInfo model;  ///< A's tree
 };
 
-template <class BV, DensityPolicy D>
+template <class BV, class D>
 class BvhlabHierarchy final : public PreparedHierarchy {
  public:
-  BvhlabHierarchy(std::shared_ptr<const Tree<BV, D>> a, std::shared_ptr<const Tree<BV, D>> b,
-                  std::shared_ptr<const AdbModel> adb_model)
-      : a_(std::move(a)), b_(std::move(b)), adb_model_(std::move(adb_model)) {}
+  BvhlabHierarchy(std::shared_ptr<const Tree<BV, D>> a, std::shared_ptr<const Tree<BV, D>> b)
+      : a_(std::move(a)), b_(std::move(b)) {}
 
   void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
            std::vector<QueryRecord>& out) const override {
-    if (variant.kind == StrategyKind::Exact) {
+    with_configured(variant, [&]<class S>(std::type_identity<S>, const typename S::Options& options) {
       timed_series(poses, warmup, out,
-                   [&](const RigidTransform& p) { return query_exact(a_->bvh, b_->bvh, p); });
-      return;
-    }
-    if constexpr (D::annotated) {
-      const AdbOptions options = adb_options(variant);
-      timed_series(poses, warmup, out,
-                   [&](const RigidTransform& p) { return query_adb(*a_, *b_, p, *adb_model_, options); });
-    } else {
-      throw std::logic_error("runner: strategy " + variant.label() + " reached a tree without annotation");
-    }
+                   [&](const RigidTransform& p) { return S::query(*a_, *b_, p, options); });
+    });
   }
-  [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose,
-                             ContactMode mode) const override {
-    if (variant.kind == StrategyKind::Exact) return query_exact(a_->bvh, b_->bvh, pose, mode);
-    if constexpr (D::annotated)
-      return query_adb(*a_, *b_, pose, *adb_model_, adb_options(variant));
-    else
-      throw std::invalid_argument("strategy " + variant.label() + " needs an ADB-annotated tree");
+  [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
+    Result result;
+    with_configured(variant, [&]<class S>(std::type_identity<S>, const typename S::Options& options) {
+      result = S::query(*a_, *b_, pose, options);
+    });
+    return result;
   }
   [[nodiscard]] bool exact_collides(const RigidTransform& pose) const override {
     return query_exact(a_->bvh, b_->bvh, pose).collides;
   }
 
  private:
-  static AdbOptions adb_options(const StrategyVariant& variant) {
-    AdbOptions options;
-    options.p_min = variant.p_min >= 0 ? variant.p_min : 1.0;
-    options.budget = variant.budget;
-    options.best_effort_threshold = variant.best_effort_threshold;
-    options.exact_leaves = variant.kind == StrategyKind::GuidedExact;
-    options.validate();
-    return options;
+  /// Calls f(type_identity<S>, options) for the variant's strategy S, configured; throws when S cannot run
+  /// on these trees.
+  template <class F>
+  static void with_configured(const StrategyVariant& variant, F&& f) {
+    with_strategy(variant.strategy, [&]<class S>(std::type_identity<S> strategy) {
+      if constexpr (S::template accepts<D>)
+        f(strategy, strategy_options<S>(variant.values, variant.budget));
+      else
+        throw std::invalid_argument("strategy " + variant.label() + " does not run on trees with density '" +
+                                    std::string(D::name()) + "'");
+    });
   }
   std::shared_ptr<const Tree<BV, D>> a_, b_;
-  std::shared_ptr<const AdbModel> adb_model_;
 };
 
 #ifdef BVHLAB_HAVE_FCL
@@ -212,7 +203,7 @@ class FclHierarchy final : public PreparedHierarchy {
 
   void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
            std::vector<QueryRecord>& out) const override {
-    if (variant.kind != StrategyKind::Exact)
+    if (variant.strategy != ExactStrategy::name())
       throw std::logic_error("runner: FCL hierarchies run the exact strategy only");
     timed_series(poses, warmup, out, [&](const RigidTransform& p) { return query(p); });
   }
@@ -220,9 +211,8 @@ class FclHierarchy final : public PreparedHierarchy {
     return query(pose).collides;
   }
   [[nodiscard]] bool has_counters() const override { return false; }
-  [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose,
-                             ContactMode mode) const override {
-    if (variant.kind != StrategyKind::Exact || mode != ContactMode::First)
+  [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
+    if (variant.strategy != ExactStrategy::name())
       throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only");
     return query(pose);
   }
@@ -243,23 +233,6 @@ class FclHierarchy final : public PreparedHierarchy {
   std::shared_ptr<const Model> a_, b_;
 };
 #endif
-
-template <class F>
-void with_grid(int grid, F&& f) {
-  switch (grid) {
-    case 2:
-      f(std::integral_constant<int, 2>{});
-      break;
-    case 3:
-      f(std::integral_constant<int, 3>{});
-      break;
-    case 4:
-      f(std::integral_constant<int, 4>{});
-      break;
-    default:
-      throw std::invalid_argument("grid " + std::to_string(grid) + " is not one of 2, 3, 4");
-  }
-}
 
 // Progress of a long build or annotation as log lines, every 10%, for meshes large enough to wait on.
 std::function<void(std::size_t, std::size_t)> percent_logger(const LogFn& log, std::string what,
@@ -285,73 +258,26 @@ class TreeStore {
         log_(std::move(log)),
         threads_(threads) {}
 
-  template <class BV>
-  std::shared_ptr<const Tree<BV, NoDensity>> plain(const ObjectData& object, const HierarchySpec& h,
-                                                   ModelInfo* info = nullptr) {
-    const std::string key = plain_key<BV>(object, h);
-    if (auto hit = memo_.find(key); hit != memo_.end()) {
-      if (info) *info = infos_.at(key);
-      return std::static_pointer_cast<const Tree<BV, NoDensity>>(hit->second);
-    }
-    const auto start = Clock::now();
-    CachedTreeTimes times;
-    std::optional<Tree<BV, NoDensity>> tree = cache_.load<BV, NoDensity>(key, object.mesh, &times);
-    const bool from_cache = tree.has_value();
-    if (!tree) {
-      log_("building " + std::string(BV::name()) + " tree of " + object.spec->name + " (" +
-           std::to_string(object.mesh.triangle_count()) + " triangles)");
-      BuildOptions options = h.build;
-      options.threads = threads_;
-      options.progress = percent_logger(log_, "building: triangles placed", object.mesh.triangle_count());
-      tree.emplace(Tree<BV, NoDensity>{Bvh<BV>::build(object.mesh, options), {}});
-      ++stats_.trees_built;
-      times.build_seconds = tree->bvh.stats().build_seconds;
-      cache_.store(key, *tree, times);
-    }
-    stats_.preprocess_seconds += seconds_since(start);
-    auto shared = std::make_shared<const Tree<BV, NoDensity>>(std::move(*tree));
-    remember(key, shared, describe(*shared, object, h, "none", times, from_cache), info);
-    return shared;
-  }
-
-  template <class BV, int G>
-  std::shared_ptr<const Tree<BV, AdbDensity<G>>> annotated(const ObjectData& object, const HierarchySpec& h,
-                                                           double tau, ModelInfo* info = nullptr) {
-    const std::string annotation = "adb g=" + std::to_string(G) + " tau=" + g17(tau);
-    const std::string key = plain_key<BV>(object, h) + "|" + annotation;
-    using T = Tree<BV, AdbDensity<G>>;
+  /// The tree of `object` for hierarchy `h` with density D (parameters `density`): from this run's memory,
+  /// else the disk cache, else built (a density starts from the plain tree, itself remembered).
+  template <class BV, class D>
+  std::shared_ptr<const Tree<BV, D>> tree(const ObjectData& object, const HierarchySpec& h,
+                                          const DensitySpec& density, ModelInfo* info = nullptr) {
+    const std::string annotation = density.label();
+    const std::string key = plain_key<BV>(object, h) + (annotation == "none" ? "" : "|" + annotation);
+    using T = Tree<BV, D>;
     if (auto hit = memo_.find(key); hit != memo_.end()) {
       if (info) *info = infos_.at(key);
       return std::static_pointer_cast<const T>(hit->second);
     }
     CachedTreeTimes times;
     auto start = Clock::now();
-    std::optional<T> tree = cache_.load<BV, AdbDensity<G>>(key, object.mesh, &times, tau);
+    std::optional<T> tree = cache_.load<BV, D>(key, object.mesh, &times, annotation);
     stats_.preprocess_seconds += seconds_since(start);
     const bool from_cache = tree.has_value();
     if (!tree) {
-      ModelInfo plain_info;
-      Bvh<BV> bvh = plain<BV>(object, h, &plain_info)->bvh;  // a copy: annotate() takes its tree
-      start = Clock::now();
-      log_("annotating " + std::string(BV::name()) + " tree of " + object.spec->name + " (" + annotation +
-           ")");
-      AnnotateOptions options;
-      options.tau = tau;
-      options.threads = threads_;
-      options.progress =
-          percent_logger(log_, "annotating: triangle-node pairs", object.mesh.triangle_count());
-      AnnotateStats annotate_stats;
-      if constexpr (requires { annotate<G>(std::move(bvh), options, &annotate_stats); })
-        tree.emplace(annotate<G>(std::move(bvh), options, &annotate_stats));
-      else
-        throw std::invalid_argument("the ADB annotation does not support " + std::string(BV::name()) +
-                                    " trees");
-      ++stats_.trees_annotated;
-      stats_.annotation_clip_calls += annotate_stats.clip_calls;
-      times.build_seconds = plain_info.build_seconds;
-      times.annotate_seconds = annotate_stats.seconds;
+      tree.emplace(make_tree<BV, D>(object, h, density, times));
       cache_.store(key, *tree, times);
-      stats_.preprocess_seconds += seconds_since(start);
     }
     auto shared = std::make_shared<const T>(std::move(*tree));
     remember(key, shared, describe(*shared, object, h, annotation, times, from_cache), info);
@@ -405,6 +331,40 @@ class TreeStore {
   }
 
  private:
+  template <class BV, class D>
+  Tree<BV, D> make_tree(const ObjectData& object, const HierarchySpec& h, const DensitySpec& density,
+                        CachedTreeTimes& times) {
+    if constexpr (std::is_same_v<D, NoDensity>) {
+      log_("building " + std::string(BV::name()) + " tree of " + object.spec->name + " (" +
+           std::to_string(object.mesh.triangle_count()) + " triangles)");
+      BuildOptions options = h.build;
+      options.threads = threads_;
+      options.progress = percent_logger(log_, "building: triangles placed", object.mesh.triangle_count());
+      Tree<BV, NoDensity> built{Bvh<BV>::build(object.mesh, options), {}};
+      ++stats_.trees_built;
+      times.build_seconds = built.bvh.stats().build_seconds;
+      return built;
+    } else {
+      ModelInfo plain_info;
+      Bvh<BV> bvh = tree<BV, NoDensity>(object, h, DensitySpec{}, &plain_info)->bvh;  // a copy to annotate
+      const auto start = Clock::now();
+      log_("annotating " + std::string(BV::name()) + " tree of " + object.spec->name + " (" +
+           density.label() + ")");
+      AnnotationContext context;
+      context.threads = threads_;
+      context.progress = percent_logger(log_, "annotating", object.mesh.triangle_count());
+      AnnotateStats annotate_stats;
+      Tree<BV, D> annotated =
+          annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &annotate_stats);
+      ++stats_.trees_annotated;
+      stats_.annotation_clip_calls += annotate_stats.clip_calls;
+      times.build_seconds = plain_info.build_seconds;
+      times.annotate_seconds = annotate_stats.seconds;
+      stats_.preprocess_seconds += seconds_since(start);
+      return annotated;
+    }
+  }
+
   template <class BV>
   static std::string plain_key(const ObjectData& object, const HierarchySpec& h) {
     return "bvhlab-tree v1|" + object.key + "|bv=" + std::string(BV::name()) +
@@ -424,9 +384,9 @@ class TreeStore {
     m.triangles = s.triangles;
     m.nodes = s.nodes;
     m.depth = s.depth;
-    // Nodes and volumes, plus one byte of pc per node when annotated; polygons are not counted (an ADB query
-    // does not need them).
-    m.model_bytes = double(s.nodes * s.bytes_per_node) + (annotation == "none" ? 0.0 : double(s.nodes));
+    // Nodes and volumes, plus what the density adds; polygons are not counted (an ADB query does not need
+    // them).
+    m.model_bytes = double(s.nodes * s.bytes_per_node) + double(T::DensityType::memory_bytes(tree.density));
     m.bytes_per_triangle = s.triangles ? m.model_bytes / double(s.triangles) : 0;
     m.build_seconds = times.build_seconds;
     m.annotate_seconds = times.annotate_seconds;
@@ -452,8 +412,7 @@ class TreeStore {
 };
 
 std::unique_ptr<PreparedHierarchy> prepare(const Scene& scene, const HierarchySpec& h, const ObjectData& a,
-                                           const ObjectData& b, TreeStore& store,
-                                           const std::shared_ptr<const AdbModel>& adb_model) {
+                                           const ObjectData& b, TreeStore& store) {
   std::unique_ptr<PreparedHierarchy> out;
   ModelInfo info;
   if (h.is_fcl()) {
@@ -472,20 +431,20 @@ std::unique_ptr<PreparedHierarchy> prepare(const Scene& scene, const HierarchySp
 #else
     throw std::invalid_argument("hierarchy " + h.name + " needs FCL, which this build lacks");
 #endif
-  } else if (scene.needs_annotation(h)) {
-    // with_volume's value-returning form cannot pass a move-only result out, so assign inside the call.
-    with_volume(h.bv, [&]<class BV>(std::type_identity<BV>) {
-      with_grid(scene.annotation.grid, [&]<int G>(std::integral_constant<int, G>) {
-        auto ta = store.annotated<BV, G>(a, h, scene.annotation.tau, &info);
-        auto tb = &a == &b ? ta : store.annotated<BV, G>(b, h, scene.annotation.tau);
-        out = std::make_unique<BvhlabHierarchy<BV, AdbDensity<G>>>(ta, tb, adb_model);
-      });
-    });
   } else {
+    // Only a hierarchy whose strategies need the density is annotated; exact strategies share its trees.
+    const DensitySpec density = scene.needs_density(h) ? scene.density : DensitySpec{};
     with_volume(h.bv, [&]<class BV>(std::type_identity<BV>) {
-      auto ta = store.plain<BV>(a, h, &info);
-      auto tb = &a == &b ? ta : store.plain<BV>(b, h);
-      out = std::make_unique<BvhlabHierarchy<BV, NoDensity>>(ta, tb, nullptr);
+      with_density(density.name, [&]<class D>(std::type_identity<D>) {
+        if constexpr (DensityFor<D, BV>) {
+          auto ta = store.tree<BV, D>(a, h, density, &info);
+          auto tb = &a == &b ? ta : store.tree<BV, D>(b, h, density);
+          out = std::make_unique<BvhlabHierarchy<BV, D>>(ta, tb);
+        } else {
+          throw std::invalid_argument("density " + std::string(D::name()) + " cannot annotate " +
+                                      std::string(BV::name()) + " trees");
+        }
+      });
     });
   }
   out->model = info;
@@ -648,30 +607,27 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
                        const RigidTransform& pose, const RunOptions& options) {
   QueryOutcome outcome;
   const LogFn log = options.log ? options.log : LogFn([](const std::string& m) { std::cerr << m << '\n'; });
-  Scene scene;  // a one-hierarchy, one-strategy scene, so prepare() decides annotation as a run would
+  Scene scene;  // a one-hierarchy, one-strategy scene, so prepare() decides the density as a run would
   scene.hierarchies = {request.hierarchy};
-  scene.annotation = request.annotation;
+  scene.density = request.density;
   StrategySpec strategy;
-  strategy.kind = request.strategy.kind;
+  strategy.name = request.strategy.strategy;
   scene.strategies = {strategy};
-  if (strategy.needs_annotation() && !request.annotation.adb)
-    throw std::invalid_argument("strategy " + std::string(to_string(strategy.kind)) +
-                                " needs the ADB annotation");
-  if (request.hierarchy.is_fcl() && strategy.kind != StrategyKind::Exact)
-    throw std::invalid_argument("FCL hierarchies answer exact queries only");
+  const StrategyInfo& info = strategy_info(strategy.name);
+  if (info.needs_density && !info.accepts(request.density.name))
+    throw std::invalid_argument("strategy " + strategy.name + " does not run on trees with density '" +
+                                request.density.name + "'");
+  if (request.hierarchy.is_fcl() && strategy.name != ExactStrategy::name())
+    throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only");
   const unsigned threads =
       options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   TreeStore store(options.cache_dir, outcome.stats, log, threads);
-  std::shared_ptr<const AdbModel> adb_model;
-  if (request.annotation.adb)
-    adb_model = std::make_shared<const AdbModel>(request.annotation.grid, request.annotation.tau);
   const ObjectData object_a = load_object(a);
   const ObjectData object_b = &a == &b ? ObjectData{} : load_object(b);
   const ObjectData& ob = &a == &b ? object_a : object_b;
-  auto hierarchy = prepare(scene, request.hierarchy, object_a, ob, store, adb_model);
-  const ContactMode mode = request.all_contacts ? ContactMode::All : ContactMode::First;
+  auto hierarchy = prepare(scene, request.hierarchy, object_a, ob, store);
   const auto start = Clock::now();
-  outcome.result = hierarchy->query(request.strategy, pose, mode);
+  outcome.result = hierarchy->query(request.strategy, pose);
   outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
   const auto models = store.models();
   outcome.model_a = hierarchy->model;
@@ -680,7 +636,7 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
 }
 
 BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hierarchy,
-                             const AnnotationSpec& annotation, const std::filesystem::path& output,
+                             const DensitySpec& density, const std::filesystem::path& output,
                              unsigned threads, std::function<void(const std::string&)> log) {
   if (hierarchy.is_fcl()) throw std::invalid_argument("FCL models cannot be saved as bvhlab trees");
   BuildOutcome outcome;
@@ -690,13 +646,13 @@ BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hie
   const ObjectData data = load_object(object);
   std::vector<std::byte> bytes;
   with_volume(hierarchy.bv, [&]<class BV>(std::type_identity<BV>) {
-    if (annotation.adb) {
-      with_grid(annotation.grid, [&]<int G>(std::integral_constant<int, G>) {
-        bytes = save_tree_to_buffer(*store.annotated<BV, G>(data, hierarchy, annotation.tau, &outcome.model));
-      });
-    } else {
-      bytes = save_tree_to_buffer(*store.plain<BV>(data, hierarchy, &outcome.model));
-    }
+    with_density(density.name, [&]<class D>(std::type_identity<D>) {
+      if constexpr (DensityFor<D, BV>)
+        bytes = save_tree_to_buffer(*store.tree<BV, D>(data, hierarchy, density, &outcome.model));
+      else
+        throw std::invalid_argument("density " + density.name + " cannot annotate " + hierarchy.bv +
+                                    " trees");
+    });
   });
   saved_tree_detail::write_file_atomically(output, bytes);
   outcome.file_bytes = std::filesystem::file_size(output);
@@ -709,73 +665,85 @@ bool is_saved_tree(const std::filesystem::path& file) {
   return in.read(magic, 8) && std::string_view(magic, 8) == "BVHLTREE";
 }
 
-SavedTreeInfo peek_saved_tree(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  unsigned char header[kSavedTreeHeaderSize];
-  if (!in || !in.read(reinterpret_cast<char*>(header), sizeof header) ||
-      std::memcmp(header, "BVHLTREE", 8) != 0)
-    throw std::runtime_error(file.string() + ": not a saved bvhlab tree");
-  auto u64 = [&](std::size_t at) {
-    std::uint64_t v = 0;
-    for (int i = 7; i >= 0; --i) v = (v << 8) | header[at + static_cast<std::size_t>(i)];
-    return v;
+namespace {
+
+/// Calls f(tree) with the saved tree in `file`, typed by the BV and density its header names.
+template <class F>
+void with_saved_tree(const std::filesystem::path& file, F&& f) {
+  const std::vector<std::byte> bytes = saved_tree_detail::read_file(file);
+  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, file.string());
+  auto named = [&](auto&& dispatch) {
+    try {
+      dispatch();
+    } catch (const SavedTreeError&) {
+      throw;
+    } catch (const std::invalid_argument& e) {  // an unknown BV or density name
+      throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
+    }
   };
-  auto u32 = [&](std::size_t at) { return static_cast<std::uint32_t>(u64(at) & 0xffffffffu); };
-  if (u32(8) != kSavedTreeVersion)
-    throw std::runtime_error(file.string() + ": saved-tree format version " + std::to_string(u32(8)) +
-                             ", this build reads " + std::to_string(kSavedTreeVersion));
+  named([&] {
+    with_volume(header.bv_name, [&]<class BV>(std::type_identity<BV>) {
+      with_density(header.density_name, [&]<class D>(std::type_identity<D>) {
+        f(load_tree_from_buffer<BV, D>(bytes, file.string()));
+      });
+    });
+  });
+}
+
+}  // namespace
+
+SavedTreeInfo peek_saved_tree(const std::filesystem::path& file) {
   SavedTreeInfo info;
-  info.bv.assign(reinterpret_cast<const char*>(header + 24),
-                 strnlen(reinterpret_cast<const char*>(header + 24), 32));
-  info.grid = static_cast<int>(u32(64));
-  const std::uint64_t tau_bits = u64(72);
-  std::memcpy(&info.tau, &tau_bits, sizeof info.tau);
-  info.nodes = u64(80);
-  info.triangles = u64(88);
+  with_saved_tree(file, [&]<class BV, class D>(const Tree<BV, D>& tree) {
+    info.bv = BV::name();
+    info.density = D::name();
+    info.annotation = D::describe(tree.density);
+    info.nodes = tree.bvh.nodes().size();
+    const BvhStats stats = tree.bvh.stats();
+    info.triangles = stats.triangles;
+  });
   return info;
 }
 
 QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
                                 const StrategyVariant& strategy, const RigidTransform& pose) {
-  if (strategy.kind == StrategyKind::Exact || strategy.kind == StrategyKind::GuidedExact)
-    throw std::invalid_argument(
-        "saved trees carry no polygons, so they answer adb and time_critical queries only; "
-        "give the meshes for " +
-        std::string(to_string(strategy.kind)));
-  const SavedTreeInfo ia = peek_saved_tree(a), ib = peek_saved_tree(b);
-  if (ia.grid == 0 || ib.grid == 0)
-    throw std::invalid_argument((ia.grid == 0 ? a : b).string() +
-                                ": the tree has no ADB annotation (build it with --adb)");
-  if (ia.bv != ib.bv || ia.grid != ib.grid || ia.tau != ib.tau)
-    throw std::invalid_argument("the two trees differ in BV, grid or tau (" + ia.bv +
-                                " g=" + std::to_string(ia.grid) + " vs " + ib.bv +
-                                " g=" + std::to_string(ib.grid) + ")");
+  const StrategyInfo& info = strategy_info(strategy.strategy);
+  if (info.needs_polygons)
+    throw std::invalid_argument("saved trees carry no polygons, and strategy " + strategy.strategy +
+                                " tests triangles; give the meshes instead");
   QueryOutcome outcome;
-  with_volume(ia.bv, [&]<class BV>(std::type_identity<BV>) {
-    with_grid(ia.grid, [&]<int G>(std::integral_constant<int, G>) {
-      const auto tree_a = load_tree<BV, AdbDensity<G>>(a);
-      const auto tree_b = a == b ? tree_a : load_tree<BV, AdbDensity<G>>(b);
-      const AdbModel model(G, ia.tau);
-      AdbOptions options;
-      options.p_min = strategy.p_min >= 0 ? strategy.p_min : 1.0;
-      options.budget = strategy.budget;
-      options.best_effort_threshold = strategy.best_effort_threshold;
-      options.validate();
-      const auto start = Clock::now();
-      outcome.result = query_adb(tree_a, tree_b, pose, model, options);
-      outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
-      for (auto [info, tree, file] :
-           {std::tuple{&outcome.model_a, &tree_a, &a}, std::tuple{&outcome.model_b, &tree_b, &b}}) {
-        const BvhStats st = tree->bvh.stats();
-        info->object = file->filename().string();
-        info->hierarchy = info->bv = ia.bv;
-        info->annotation = "adb g=" + std::to_string(G) + " tau=" + g17(ia.tau);
-        info->triangles = st.triangles;
-        info->nodes = st.nodes;
-        info->depth = st.depth;
-        info->model_bytes = double(st.nodes * st.bytes_per_node + st.nodes);
-        info->bytes_per_triangle = st.triangles ? info->model_bytes / double(st.triangles) : 0;
-        info->from_cache = true;
+  with_saved_tree(a, [&]<class BV, class D>(const Tree<BV, D>& tree_a) {
+    with_saved_tree(b, [&]<class BV2, class D2>(const Tree<BV2, D2>& tree_b) {
+      if constexpr (!std::is_same_v<BV, BV2> || !std::is_same_v<D, D2>) {
+        throw std::invalid_argument("the two trees differ in BV or density (" + std::string(BV::name()) +
+                                    ", " + D::describe(tree_a.density) + " vs " + std::string(BV2::name()) +
+                                    ", " + D2::describe(tree_b.density) + ")");
+      } else {
+        with_strategy(strategy.strategy, [&]<class S>(std::type_identity<S>) {
+          if constexpr (S::template accepts<D>) {
+            const auto options = strategy_options<S>(strategy.values, strategy.budget);
+            const auto start = Clock::now();
+            outcome.result = S::query(tree_a, tree_b, pose, options);
+            outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+          } else {
+            throw std::invalid_argument("strategy " + strategy.strategy +
+                                        " does not run on trees with density '" + std::string(D::name()) +
+                                        "'");
+          }
+        });
+        for (auto [model, tree, file] :
+             {std::tuple{&outcome.model_a, &tree_a, &a}, std::tuple{&outcome.model_b, &tree_b, &b}}) {
+          const BvhStats st = tree->bvh.stats();
+          model->object = file->filename().string();
+          model->hierarchy = model->bv = BV::name();
+          model->annotation = D::describe(tree->density);
+          model->triangles = st.triangles;
+          model->nodes = st.nodes;
+          model->depth = st.depth;
+          model->model_bytes = double(st.nodes * st.bytes_per_node + D::memory_bytes(tree->density));
+          model->bytes_per_triangle = st.triangles ? model->model_bytes / double(st.triangles) : 0;
+          model->from_cache = true;
+        }
       }
     });
   });
@@ -830,9 +798,6 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
 
   TreeStore store(options.cache_dir, stats, log, threads);
   const TruthCache truth_cache(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "truth");
-  std::shared_ptr<const AdbModel> adb_model;
-  if (scene.annotation.adb)
-    adb_model = std::make_shared<const AdbModel>(scene.annotation.grid, scene.annotation.tau);
   stats.clock_overhead_us = clock_overhead_us();
 
   for (const std::string& note : scene.notes) {
@@ -896,7 +861,7 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
     const std::string label = pair->label();
 
     std::vector<std::unique_ptr<PreparedHierarchy>> prepared;
-    for (const auto& [h, variants] : plan) prepared.push_back(prepare(scene, *h, a, b, store, adb_model));
+    for (const auto& [h, variants] : plan) prepared.push_back(prepare(scene, *h, a, b, store));
 
     // Ground truth from the disk cache, else from the exact traversal on the first bvhlab hierarchy.
     const auto truth_start = Clock::now();
@@ -917,8 +882,8 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
       if (!exact) {  // an FCL-only scene: the truth still comes from bvhlab's exact traversal
         HierarchySpec aabb;
         aabb.bv = aabb.name = "aabb";
-        fallback = std::make_unique<BvhlabHierarchy<Aabb, NoDensity>>(store.plain<Aabb>(a, aabb),
-                                                                      store.plain<Aabb>(b, aabb), nullptr);
+        fallback = std::make_unique<BvhlabHierarchy<Aabb, NoDensity>>(
+            store.tree<Aabb, NoDensity>(a, aabb, {}), store.tree<Aabb, NoDensity>(b, aabb, {}));
         exact = fallback.get();
       }
       log("computing the ground truth of " + label + " (exact traversal)");
@@ -989,10 +954,10 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
           row.hierarchy = h.name;
           row.bv = h.bv;
           row.annotation = hierarchy.model.annotation;
-          row.strategy = std::string(to_string(variant.kind));
-          row.p_min = variant.kind == StrategyKind::Adb || variant.kind == StrategyKind::TimeCritical
-                          ? variant.p_min
-                          : -1;
+          row.strategy = variant.strategy;
+          row.label = variant.label();
+          row.exact_strategy = strategy_info(variant.strategy).exact;
+          row.p_min = variant.value_or("p_min", -1);
           row.budget = variant.budget_label();
           row.distance = group.distance;
           row.queries = records.size();
@@ -1001,8 +966,7 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
           std::size_t fp = 0, fn = 0, truth_yes = 0, answer_yes = 0, inexact = 0, exhausted = 0;
           double sum_us = 0, max_us = 0;
           Counters counters;
-          const bool calibrate =
-              variant.kind == StrategyKind::Adb || variant.kind == StrategyKind::TimeCritical;
+          const bool calibrate = !row.exact_strategy;
           const std::string cal_key = label + "\x1f" + h.name + "\x1f" + variant.label();
           for (std::size_t k = 0; k < records.size(); ++k) {
             const QueryRecord& r = records[k];
@@ -1099,10 +1063,6 @@ std::string csv_p_min(double p) {
   return p < 0 ? "" : csv_number(p);
 }
 
-nlohmann::json json_number(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 std::ofstream open_output(const std::filesystem::path& file) {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   std::ofstream out(file, std::ios::trunc);
@@ -1112,33 +1072,72 @@ std::ofstream open_output(const std::filesystem::path& file) {
 
 }  // namespace
 
+namespace {
+
+using json = nlohmann::json;
+
+json optional_number(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+json optional_p_min(double p) {
+  return p < 0 ? json(nullptr) : json(p);
+}
+
+/// One column of results.csv and one key of the rows in results.json: both writers read this table.
+struct RowField {
+  const char* name;
+  json (*value)(const ResultRow&);
+};
+
+const std::vector<RowField>& row_fields() {
+  static const std::vector<RowField> fields{
+      {"mesh", [](const ResultRow& r) { return json(r.mesh); }},
+      {"hierarchy", [](const ResultRow& r) { return json(r.hierarchy); }},
+      {"bv", [](const ResultRow& r) { return json(r.bv); }},
+      {"annotation", [](const ResultRow& r) { return json(r.annotation); }},
+      {"strategy", [](const ResultRow& r) { return json(r.strategy); }},
+      {"label", [](const ResultRow& r) { return json(r.label); }},
+      {"exact", [](const ResultRow& r) { return json(r.exact_strategy); }},
+      {"p_min", [](const ResultRow& r) { return optional_p_min(r.p_min); }},
+      {"budget", [](const ResultRow& r) { return json(r.budget); }},
+      {"distance", [](const ResultRow& r) { return json(r.distance); }},
+      {"queries", [](const ResultRow& r) { return json(r.queries); }},
+      {"truth_colliding_rate", [](const ResultRow& r) { return json(r.truth_colliding_rate); }},
+      {"answer_colliding_rate", [](const ResultRow& r) { return json(r.answer_colliding_rate); }},
+      {"mean_time_us", [](const ResultRow& r) { return json(r.mean_time_us); }},
+      {"max_time_us", [](const ResultRow& r) { return json(r.max_time_us); }},
+      {"fp_rate", [](const ResultRow& r) { return json(r.fp_rate); }},
+      {"fn_rate", [](const ResultRow& r) { return json(r.fn_rate); }},
+      {"inexact_rate", [](const ResultRow& r) { return json(r.inexact_rate); }},
+      {"budget_exhausted_rate", [](const ResultRow& r) { return json(r.budget_exhausted_rate); }},
+      {"bv_tests_per_query", [](const ResultRow& r) { return optional_number(r.bv_tests_per_query); }},
+      {"triangle_tests_per_query",
+       [](const ResultRow& r) { return optional_number(r.triangle_tests_per_query); }},
+      {"nodes_visited_per_query",
+       [](const ResultRow& r) { return optional_number(r.nodes_visited_per_query); }},
+      {"model_bytes", [](const ResultRow& r) { return json(r.model_bytes); }},
+      {"bytes_per_triangle", [](const ResultRow& r) { return json(r.bytes_per_triangle); }},
+  };
+  return fields;
+}
+
+std::string csv_value(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_string()) return csv_field(v.get<std::string>());
+  if (v.is_boolean()) return v.get<bool>() ? "1" : "0";
+  if (v.is_number_integer() || v.is_number_unsigned()) return v.dump();
+  return csv_number(v.get<double>());
+}
+
+}  // namespace
+
 const std::vector<std::string>& results_csv_columns() {
-  static const std::vector<std::string> columns{"mesh",
-                                                "hierarchy",
-                                                "bv",
-                                                "annotation",
-                                                "strategy",
-                                                "p_min",
-                                                "budget",
-                                                "distance",
-                                                "queries",
-                                                "truth_colliding_rate",
-                                                "answer_colliding_rate",
-                                                "mean_time_us",
-                                                "max_time_us",
-                                                "fp_rate",
-                                                "fn_rate",
-                                                "inexact_rate",
-                                                "budget_exhausted_rate",
-                                                "bv_tests_per_query",
-                                                "triangle_tests_per_query",
-                                                "nodes_visited_per_query",
-                                                "model_bytes",
-                                                "bytes_per_triangle",
-                                                "machine",
-                                                "compiler",
-                                                "build_type",
-                                                "git_commit"};
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> out;
+    for (const RowField& f : row_fields()) out.emplace_back(f.name);
+    for (const char* env : {"machine", "compiler", "build_type", "git_commit"}) out.emplace_back(env);
+    return out;
+  }();
   return columns;
 }
 
@@ -1149,34 +1148,9 @@ void write_results_csv(const RunOutput& run, const std::filesystem::path& file) 
   out << '\n';
   const Environment& env = run.environment;
   for (const ResultRow& r : run.rows) {
-    const std::vector<std::string> fields{csv_field(r.mesh),
-                                          csv_field(r.hierarchy),
-                                          csv_field(r.bv),
-                                          csv_field(r.annotation),
-                                          r.strategy,
-                                          csv_p_min(r.p_min),
-                                          csv_field(r.budget),
-                                          csv_number(r.distance),
-                                          std::to_string(r.queries),
-                                          csv_number(r.truth_colliding_rate),
-                                          csv_number(r.answer_colliding_rate),
-                                          csv_number(r.mean_time_us),
-                                          csv_number(r.max_time_us),
-                                          csv_number(r.fp_rate),
-                                          csv_number(r.fn_rate),
-                                          csv_number(r.inexact_rate),
-                                          csv_number(r.budget_exhausted_rate),
-                                          csv_number(r.bv_tests_per_query),
-                                          csv_number(r.triangle_tests_per_query),
-                                          csv_number(r.nodes_visited_per_query),
-                                          csv_number(r.model_bytes),
-                                          csv_number(r.bytes_per_triangle),
-                                          csv_field(env.machine),
-                                          csv_field(env.compiler),
-                                          csv_field(env.build_type),
-                                          csv_field(env.git_commit)};
-    for (std::size_t i = 0; i < fields.size(); ++i) out << (i ? "," : "") << fields[i];
-    out << '\n';
+    for (const RowField& f : row_fields()) out << csv_value(f.value(r)) << ',';
+    out << csv_field(env.machine) << ',' << csv_field(env.compiler) << ',' << csv_field(env.build_type) << ','
+        << csv_field(env.git_commit) << '\n';
   }
   if (!out) throw std::runtime_error(file.string() + ": write error");
 }
@@ -1193,7 +1167,6 @@ void write_calibration_csv(const RunOutput& run, const std::filesystem::path& fi
 }
 
 void write_results_json(const RunOutput& run, const std::filesystem::path& file) {
-  using nlohmann::json;
   const Environment& env = run.environment;
   const RunStats& s = run.stats;
   json doc;
@@ -1244,29 +1217,11 @@ void write_results_json(const RunOutput& run, const std::filesystem::path& file)
         {{"mesh", t.mesh}, {"distance", t.distance}, {"poses", t.poses}, {"colliding", t.colliding}});
   doc["ground_truth"] = truth;
   json rows = json::array();
-  for (const ResultRow& r : run.rows)
-    rows.push_back({{"mesh", r.mesh},
-                    {"hierarchy", r.hierarchy},
-                    {"bv", r.bv},
-                    {"annotation", r.annotation},
-                    {"strategy", r.strategy},
-                    {"p_min", r.p_min < 0 ? json(nullptr) : json(r.p_min)},
-                    {"budget", r.budget},
-                    {"distance", r.distance},
-                    {"queries", r.queries},
-                    {"truth_colliding_rate", r.truth_colliding_rate},
-                    {"answer_colliding_rate", r.answer_colliding_rate},
-                    {"mean_time_us", r.mean_time_us},
-                    {"max_time_us", r.max_time_us},
-                    {"fp_rate", r.fp_rate},
-                    {"fn_rate", r.fn_rate},
-                    {"inexact_rate", r.inexact_rate},
-                    {"budget_exhausted_rate", r.budget_exhausted_rate},
-                    {"bv_tests_per_query", json_number(r.bv_tests_per_query)},
-                    {"triangle_tests_per_query", json_number(r.triangle_tests_per_query)},
-                    {"nodes_visited_per_query", json_number(r.nodes_visited_per_query)},
-                    {"model_bytes", r.model_bytes},
-                    {"bytes_per_triangle", r.bytes_per_triangle}});
+  for (const ResultRow& r : run.rows) {
+    json row = json::object();
+    for (const RowField& f : row_fields()) row[f.name] = f.value(r);
+    rows.push_back(std::move(row));
+  }
   doc["rows"] = rows;
   json cal = json::array();
   for (const CalibrationBin& c : run.calibration)
@@ -1278,9 +1233,10 @@ void write_results_json(const RunOutput& run, const std::filesystem::path& file)
                    {"bin_low", c.bin_low},
                    {"bin_high", c.bin_high},
                    {"count", c.count},
-                   {"mean_probability", json_number(c.mean_probability)},
-                   {"collision_frequency", json_number(c.collision_frequency)}});
+                   {"mean_probability", optional_number(c.mean_probability)},
+                   {"collision_frequency", optional_number(c.collision_frequency)}});
   doc["calibration"] = cal;
+  doc["policies"] = policies_json();
   std::ofstream out = open_output(file);
   out << doc.dump(1) << '\n';
   if (!out) throw std::runtime_error(file.string() + ": write error");

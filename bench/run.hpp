@@ -50,10 +50,12 @@ struct RunStats {
 /// One row of results.csv.
 struct ResultRow {
   std::string mesh;                       ///< the pair's label: "jeep1", or "a|b" for two different objects
-  std::string hierarchy, bv, annotation;  ///< annotation: "none" or "adb g=2 tau=0.5"
-  std::string strategy;                   ///< exact, guided_exact, adb, time_critical
-  double p_min = -1;                      ///< < 0: not applicable (written as an empty field)
-  std::string budget;                     ///< "" or "bv_tests=200" / "deadline_us=20"
+  std::string hierarchy, bv, annotation;  ///< annotation: the density's label, "none" or "adb grid=2 tau=0.5"
+  std::string strategy;                   ///< a registered strategy's name
+  std::string label;           ///< the series: "adb p_min=0.9", "time_critical p_min=0.9 bv_tests=50"
+  bool exact_strategy = true;  ///< the strategy is exact (from the strategy table)
+  double p_min = -1;           ///< the variant's p_min; < 0: it has none (an empty field)
+  std::string budget;          ///< "" or "bv_tests=200" / "deadline_us=20"
   double distance = 0;
   std::size_t queries = 0;
   double truth_colliding_rate = 0, answer_colliding_rate = 0;
@@ -119,9 +121,8 @@ Mesh load_scene_object(const SceneObject& object);
 /// cache).
 struct QueryRequest {
   HierarchySpec hierarchy;
-  AnnotationSpec annotation;  ///< must be adb for every strategy but exact
+  DensitySpec density;  ///< what the trees carry; a strategy that needs a density must accept it
   StrategyVariant strategy;
-  bool all_contacts = false;  ///< exact strategy: list every intersecting triangle pair
 };
 struct QueryOutcome {
   Result result;
@@ -135,29 +136,29 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
 /// What a saved-tree file's header says about its tree.
 struct SavedTreeInfo {
   std::string bv;
-  int grid = 0;  ///< 0: no annotation
-  double tau = 0;
+  std::string density;     ///< the density's name
+  std::string annotation;  ///< its description: "none", "adb grid=2 tau=0.25"
   std::uint64_t nodes = 0, triangles = 0;
 };
-/// Reads the header of a saved tree (adb/saved_tree.hpp, format version 1). Throws std::runtime_error naming
-/// the file for anything that is not one.
+/// Reads a saved tree (adb/saved_tree.hpp) and describes it. Throws SavedTreeError naming the file for
+/// anything that is not one, or names a BV or density this build does not know.
 SavedTreeInfo peek_saved_tree(const std::filesystem::path& file);
 /// Whether `file` starts like a saved tree (so the CLI can take trees and meshes alike).
 bool is_saved_tree(const std::filesystem::path& file);
 
-/// One ADB or time-critical query between two saved, annotated trees (no polygons needed). Both must have the
-/// same BV, grid and tau. Throws std::invalid_argument for exact strategies (saved trees carry no polygons).
+/// One query between two saved trees (no polygons). Both must have the same BV and density, and the strategy
+/// must run on it without polygons. Throws std::invalid_argument otherwise.
 QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
                                 const StrategyVariant& strategy, const RigidTransform& pose);
 
-/// Builds (and, if asked, annotates) one object's tree and saves it, without polygons, in the saved-tree
-/// format.
+/// Builds (and annotates with the density, if any) one object's tree and saves it, without polygons, in the
+/// saved-tree format.
 struct BuildOutcome {
   ModelInfo model;
   std::uintmax_t file_bytes = 0;
 };
 BuildOutcome build_tree_file(
-    const SceneObject& object, const HierarchySpec& hierarchy, const AnnotationSpec& annotation,
+    const SceneObject& object, const HierarchySpec& hierarchy, const DensitySpec& density,
     const std::filesystem::path& output, unsigned threads = 0,
     std::function<void(const std::string&)> log = [](const std::string&) {});
 

@@ -10,19 +10,10 @@
 //     (centre R c + t, half-extents |R| h), and the same with the roles swapped; the smaller bound is used.
 //     It still over-estimates the true overlap of a rotated pair, which errs toward "collision" (false
 //     positives rather than false negatives).
-//   * Cells: each node's grid lies on its bounding box, so its cells are boxes of extent / g. Differently
-//     sized BVs are mapped onto the coarser cells (the larger cell volume): s = Vol(A ∩ B) / c_coarse, and
-//     the finer side's expected count is scaled by F_fine / F_coarse, the ratio of the cells' mean face
-//     areas. Possible collision cells hold surface, and a surface crosses about area / F cells; for cubic
-//     cells this is the square of the side ratio, and for equal sizes it is 1: the paper's case. The
-//     same mean face area defines the annotation's threshold tau, and the ratio needs no roots.
-//   * Rounding: s is rounded up (at least 1 when the volumes overlap, at most g^3); the fractional s_A, s_B
-//     are interpolated bilinearly between the table's integer entries, so a query still does no
-//     transcendental math and a small expected count is not rounded away to a probability of 0.
+//   * The estimate itself comes from the trees' density (adb/concept.hpp, ProbabilityDensity): for ADB,
+//     adb/model.hpp.
 #pragma once
 
-#include "adb/lb_table.hpp"
-#include "adb/probability.hpp"
 #include "adb/tree.hpp"
 #include "bvh/triangle_intersection.hpp"
 #include "traversal/result.hpp"
@@ -71,60 +62,6 @@ struct AdbOptions {
       throw std::invalid_argument("adb: best_effort_threshold must lie in [0, 1]");
     if (!(budget.deadline_us >= 0)) throw std::invalid_argument("adb: deadline must be >= 0 microseconds");
   }
-};
-
-/// The probability model for one (grid, tau): the lookup table over (s, s_A, s_B). Built once, shared
-/// read-only by any number of queries and threads.
-class AdbModel {
- public:
-  AdbModel(int grid, double tau) : grid_(grid), tau_(tau), table_(grid * grid * grid, lb_for_tau(tau)) {}
-
-  [[nodiscard]] int grid() const { return grid_; }
-  [[nodiscard]] double tau() const { return tau_; }
-  [[nodiscard]] const ProbabilityTable& table() const { return table_; }
-
-  /// The estimate for a BV pair from the nodes' own-frame bounding boxes, the overlap volume and the pc
-  /// counts. Only arithmetic and four table loads: no transcendental math on the query path.
-  [[nodiscard]] double estimate(const Box& box_a, const Box& box_b, double overlap, int pc_a,
-                                int pc_b) const {
-    if (!(overlap > 0) || pc_a == 0 || pc_b == 0) return 0;
-    const Vec3 ea = box_a.extent(), eb = box_b.extent();
-    const double volume_a = ea.prod(), volume_b = eb.prod();
-    // Mean face area of a cell, times 3 g^2 (the common factor cancels in the ratio).
-    const double face_a = ea.x() * ea.y() + ea.y() * ea.z() + ea.z() * ea.x();
-    const double face_b = eb.x() * eb.y() + eb.y() * eb.z() + eb.z() * eb.x();
-    const int cells = grid_ * grid_ * grid_;
-    const bool a_coarse = volume_a >= volume_b;
-    const double coarse_cell = (a_coarse ? volume_a : volume_b) / cells;
-    // Expected possible-collision cells in the overlap, in each node's own cells...
-    double s_a = volume_a > 0 ? pc_a * std::min(1.0, overlap / volume_a) : pc_a;
-    double s_b = volume_b > 0 ? pc_b * std::min(1.0, overlap / volume_b) : pc_b;
-    // ...with the finer side mapped onto the coarser cells by the ratio of cell face areas.
-    if (a_coarse && face_a > 0)
-      s_b *= std::min(1.0, face_b / face_a);
-    else if (!a_coarse && face_b > 0)
-      s_a *= std::min(1.0, face_a / face_b);
-    const double s_real = coarse_cell > 0 ? overlap / coarse_cell : cells;
-    const int s =
-        !(s_real < cells) ? cells : std::clamp(static_cast<int>(std::ceil(s_real - 1e-9)), 1, cells);
-    s_a = std::min(s_a, double(s));
-    s_b = std::min(s_b, double(s));
-    return interpolate(s, s_a, s_b);
-  }
-
- private:
-  [[nodiscard]] double interpolate(int s, double s_a, double s_b) const {
-    const int a0 = static_cast<int>(s_a), b0 = static_cast<int>(s_b);
-    const int a1 = std::min(a0 + 1, s), b1 = std::min(b0 + 1, s);
-    const double fa = s_a - a0, fb = s_b - b0;
-    const double p00 = table_.lookup(s, a0, b0), p10 = table_.lookup(s, a1, b0);
-    const double p01 = table_.lookup(s, a0, b1), p11 = table_.lookup(s, a1, b1);
-    return (1 - fa) * ((1 - fb) * p00 + fb * p01) + fa * ((1 - fb) * p10 + fb * p11);
-  }
-
-  int grid_;
-  double tau_;
-  ProbabilityTable table_;
 };
 
 namespace detail {
@@ -182,16 +119,15 @@ Result& finish_adb(Result& result, const Queue& queue, const AdbOptions& options
   return result;
 }
 
-/// ADB query on two annotated trees. `b_to_a` maps B's frame into A's.
+/// ADB query on two trees annotated with a ProbabilityDensity (adb/concept.hpp). `b_to_a` maps B's frame
+/// into A's. The probability model comes from the trees' own annotation.
 /// Const and thread-safe: the model is read-only and all traversal state is local.
-template <TreeVolume BV, int G>
-Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>& b,
-                 const RigidTransform& b_to_a, const AdbModel& model, const AdbOptions& options) {
+template <TreeVolume BV, ProbabilityDensity D>
+Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
+                 const AdbOptions& options) {
   options.validate();
   b_to_a.validate();
-  if (model.grid() != G) throw std::invalid_argument("adb: the model's grid differs from the trees'");
-  if (a.density.tau != model.tau() || b.density.tau != model.tau())
-    throw std::invalid_argument("adb: the trees were annotated with another tau than the model's");
+  const auto estimate = D::estimator(a.density, b.density);  // throws for incompatible annotations
   if (options.exact_leaves && (!a.bvh.has_polygons() || !b.bvh.has_polygons()))
     throw std::invalid_argument("adb: guided exact needs trees with polygons");
 
@@ -203,8 +139,6 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
   using Pair = detail::QueuedPair<typename Walker::Working>;
   const typename Walker::Context context = Walker::make_context(b_to_a);
   const Mat3 abs_rotation = b_to_a.rotation.cwiseAbs();
-  const auto& pc_a = a.density.possible_collision_cells;
-  const auto& pc_b = b.density.possible_collision_cells;
   const Budget& budget = options.budget;
 
   bool budget_hit = false;
@@ -219,7 +153,7 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
     ++counters.probability_evaluations;
     const Box box_a = Walker::box(a.bvh, e.a, e.wa), box_b = Walker::box(b.bvh, e.b, e.wb);
     const double overlap = detail::overlap_volume(box_a, box_b, b_to_a, abs_rotation);
-    return model.estimate(box_a, box_b, overlap, pc_a[e.a], pc_b[e.b]);
+    return estimate(e.a, box_a, e.b, box_b, overlap);
   };
 
   std::priority_queue<Pair> queue;
@@ -346,18 +280,5 @@ Result query_adb(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>
   }
   return finish_adb(result, queue, options, budget_hit, dropped_possible_contact, best_dropped);
 }
-
-/// Strategy object: ADB with p_min, optionally under a budget, or guided exact. Holds the shared model.
-template <int G>
-struct AdbStrategy {
-  std::shared_ptr<const AdbModel> model;
-  AdbOptions options;
-
-  template <TreeVolume BV>
-  Result query(const Tree<BV, AdbDensity<G>>& a, const Tree<BV, AdbDensity<G>>& b,
-               const RigidTransform& b_to_a) const {
-    return query_adb(a, b, b_to_a, *model, options);
-  }
-};
 
 }  // namespace bvhlab

@@ -89,14 +89,4 @@ Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_t
   return result;
 }
 
-/// Strategy object: exact first contact or all contacts, over any tree that carries a Bvh.
-struct ExactStrategy {
-  ContactMode mode = ContactMode::First;
-
-  template <class TreeA, class TreeB>
-  Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a) const {
-    return query_exact(bvh_of(a), bvh_of(b), b_to_a, mode);
-  }
-};
-
 }  // namespace bvhlab

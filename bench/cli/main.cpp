@@ -1,6 +1,7 @@
 // bvhlab: the command-line front end. Subcommands: info, build, query, run, report, demo.
 #include "bench/core/content_hash.hpp"
 #include "bench/core/mesh_catalog.hpp"
+#include "bench/core/policies.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
 #include "bench/core/scene.hpp"
@@ -11,11 +12,13 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 namespace bvhlab {
@@ -95,11 +98,94 @@ RigidTransform parse_pose(const std::string& pose, const std::string& protocol) 
   return out;
 }
 
-StrategyKind strategy_from(const std::string& name) {
-  if (name == "exact") return StrategyKind::Exact;
-  if (name == "guided_exact") return StrategyKind::GuidedExact;
-  if (name == "adb") return StrategyKind::Adb;
-  return StrategyKind::TimeCritical;
+/// Command-line options for the parameters of the registered densities or strategies, one per parameter
+/// name ("p_min" becomes --p-min), with help, range and default from the policies' tables. A value given
+/// for a policy that does not take it is refused, not ignored.
+class ParameterOptions {
+ public:
+  void add(CLI::App* app, const std::vector<ParamSpec>& specs, const std::string& owner) {
+    for (const ParamSpec& p : specs) {
+      const std::string name(p.name);
+      if (options_.count(name)) {
+        owners_[name] += ", " + owner;
+        continue;
+      }
+      std::string flag = "--" + name;
+      std::replace(flag.begin(), flag.end(), '_', '-');
+      std::string help = std::string(p.description) + "; " + p.range_text();
+      if (!p.required()) help += ", default " + parameter_text(p.default_value);
+      owners_[name] = owner;
+      options_[name] = app->add_option(flag, values_[name], help);
+    }
+  }
+  void finish_help() {
+    for (auto& [name, option] : options_)
+      option->description(option->get_description() + " (" + owners_[name] + ")");
+  }
+  /// The values given on the command line for the parameters in `specs`.
+  [[nodiscard]] ParamValues pick(const std::vector<ParamSpec>& specs) const {
+    ParamValues out;
+    for (const ParamSpec& p : specs)
+      if (const auto it = options_.find(std::string(p.name)); it != options_.end() && it->second->count())
+        out[std::string(p.name)] = values_.at(std::string(p.name));
+    return out;
+  }
+  /// Throws CLI::ValidationError for a value given that none of `specs` takes: `what` says what is in use.
+  void refuse_others(const std::vector<const std::vector<ParamSpec>*>& specs, const std::string& what) const {
+    for (const auto& [name, option] : options_) {
+      if (option->count() == 0) continue;
+      const bool taken = std::any_of(specs.begin(), specs.end(), [&, n = name](const auto* list) {
+        return std::any_of(list->begin(), list->end(), [&](const ParamSpec& p) { return p.name == n; });
+      });
+      if (!taken) throw CLI::ValidationError(option->get_name(), "does not apply to " + what);
+    }
+  }
+
+ private:
+  std::map<std::string, double> values_;
+  std::map<std::string, CLI::Option*> options_;
+  std::map<std::string, std::string> owners_;
+};
+
+/// The density `name` with the parameters given on the command line, checked.
+DensitySpec density_from(const std::string& name, const ParameterOptions& options) {
+  const DensityInfo& info = density_info(name);
+  DensitySpec density;
+  density.name = name;
+  const ParamValues given = options.pick(info.parameters);
+  density.values = with_density(name, [&]<class D>(std::type_identity<D>) {
+    (void)density_params<D>(given);
+    return resolve_parameters(D::parameters(), given, D::name());
+  });
+  return density;
+}
+
+void print_policies(bool json) {
+  if (json) {
+    std::cout << policies_json().dump(2) << '\n';
+    return;
+  }
+  auto print_parameters = [](const std::vector<ParamSpec>& specs) {
+    for (const ParamSpec& p : specs)
+      std::printf("      %-22s %s; %s%s\n", std::string(p.name).c_str(), std::string(p.description).c_str(),
+                  p.range_text().c_str(),
+                  p.required() ? "" : (", default " + parameter_text(p.default_value)).c_str());
+  };
+  std::printf("densities\n");
+  for (const DensityInfo& d : density_table()) {
+    std::printf("  %s (data version %u)\n", d.name.c_str(), d.version);
+    print_parameters(d.parameters);
+  }
+  std::printf("strategies\n");
+  for (const StrategyInfo& s : strategy_table()) {
+    std::printf("  %-14s %s; %s, budget %s, densities: %s%s\n", s.name.c_str(), s.description.c_str(),
+                s.exact ? "exact" : "inexact",
+                s.budget == BudgetUse::None       ? "none"
+                : s.budget == BudgetUse::Required ? "required"
+                                                  : "optional",
+                join(s.densities).c_str(), s.needs_polygons ? "; needs polygons" : "");
+    print_parameters(s.parameters);
+  }
 }
 
 void print_model(const ModelInfo& m) {
@@ -185,13 +271,12 @@ int main(int argc, char** argv) {
   info->footer("Example: bvhlab info meshes/pinion.off");
 
   // build
-  std::string build_mesh, build_out, build_bv = "aabb", build_split = "sah";
+  std::string build_mesh, build_out, build_bv = "aabb", build_split = "sah", build_density = "none";
   unsigned build_leaf = 1, build_threads = 0;
   bool build_adb = false, build_raw = false;
-  int build_grid = 2;
-  double build_tau = kDefaultAdbTau;
+  ParameterOptions build_parameters;
   auto* build =
-      app.add_subcommand("build", "Build (and optionally ADB-annotate) a tree and save it without polygons");
+      app.add_subcommand("build", "Build (and optionally annotate) a tree and save it without polygons");
   build->add_option("MESH", build_mesh, "Mesh file or catalog name")->required();
   build->add_option("--bv", build_bv, "Bounding volume")
       ->check(CLI::IsMember(volume_names()))
@@ -202,12 +287,13 @@ int main(int argc, char** argv) {
   build->add_option("--leaf", build_leaf, "Triangles per leaf at most")
       ->check(CLI::Range(1, 255))
       ->capture_default_str();
-  build->add_flag("--adb", build_adb, "Compute the ADB annotation (CGAL clipping)");
-  build->add_option("--grid", build_grid, "ADB cells per axis")
-      ->check(CLI::Range(2, 4))
-      ->capture_default_str();
-  build->add_option("--tau", build_tau, "ADB area threshold (fraction of the cell face area)")
-      ->capture_default_str();
+  auto* density_option =
+      build->add_option("--density", build_density, "Density annotation (`bvhlab policies`)")
+          ->check(CLI::IsMember(density_names()))
+          ->capture_default_str();
+  build->add_flag("--adb", build_adb, "Short for --density adb (CGAL clipping)")->excludes(density_option);
+  for (const DensityInfo& d : density_table()) build_parameters.add(build, d.parameters, "density " + d.name);
+  build_parameters.finish_help();
   build->add_flag("--no-normalize", build_raw,
                   "Keep the mesh's coordinates (default: the protocol normalisation)");
   build->add_option("--threads", build_threads, "Threads (0: all)");
@@ -216,14 +302,14 @@ int main(int argc, char** argv) {
 
   // query
   std::string query_a, query_b, query_pose, query_protocol, query_bv = "aabb", query_strategy = "exact",
-                                                            query_cache;
-  double query_p_min = 0.9, query_tau = kDefaultAdbTau, query_deadline = 0, query_threshold = 0.5;
-  int query_grid = 2;
+                                                            query_cache, query_density;
+  double query_deadline = 0;
   std::uint64_t query_bv_tests = 0;
   bool query_all = false, query_json = false, query_raw = false, query_no_cache = false;
+  ParameterOptions query_parameters;
   auto* query = app.add_subcommand("query", "One query between two meshes; prints the full result");
-  query->add_option("A", query_a, "Mesh A (stays at the origin), or a saved annotated tree")->required();
-  query->add_option("B", query_b, "Mesh B (moved by the pose), or a saved annotated tree")->required();
+  query->add_option("A", query_a, "Mesh A (stays at the origin), or a saved tree")->required();
+  query->add_option("B", query_b, "Mesh B (moved by the pose), or a saved tree")->required();
   auto* pose_option =
       query->add_option("--pose", query_pose, "B's pose: TX,TY,TZ or TX,TY,TZ,AX,AY,AZ,DEGREES");
   query->add_option("--protocol", query_protocol, "B's pose from the protocol: DISTANCE,STEP,STEPS")
@@ -231,22 +317,26 @@ int main(int argc, char** argv) {
   query->add_option("--bv", query_bv, "Hierarchy: a bvhlab BV, or fcl_obb / fcl_obbrss")
       ->check(CLI::IsMember(hierarchy_bv_names()))
       ->capture_default_str();
-  query->add_option("--strategy", query_strategy, "Strategy")
-      ->check(CLI::IsMember({"exact", "guided_exact", "adb", "time_critical"}))
+  query->add_option("--strategy", query_strategy, "Strategy (`bvhlab policies`)")
+      ->check(CLI::IsMember(strategy_names()))
       ->capture_default_str();
-  query->add_option("--p-min", query_p_min, "ADB: answer 'collision' above this probability")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  query->add_option("--grid", query_grid, "ADB cells per axis")
-      ->check(CLI::Range(2, 4))
-      ->capture_default_str();
-  query->add_option("--tau", query_tau, "ADB area threshold")->capture_default_str();
-  query->add_option("--bv-tests", query_bv_tests, "Time-critical: budget of BV tests");
-  query->add_option("--deadline-us", query_deadline, "Time-critical: deadline in microseconds")
-      ->check(CLI::PositiveNumber);
-  query->add_option("--best-effort-threshold", query_threshold, "Time-critical: 'collision' at or above this")
-      ->check(CLI::Range(0.0, 1.0));
-  query->add_flag("--all-contacts", query_all, "Exact: list every intersecting triangle pair");
+  query
+      ->add_option(
+          "--density", query_density,
+          "Density of the trees built from meshes (default: none, or the first one the strategy needs)")
+      ->check(CLI::IsMember(density_names()));
+  for (const StrategyInfo& st : strategy_table())
+    query_parameters.add(query, st.parameters, "strategy " + st.name);
+  for (const DensityInfo& d : density_table()) query_parameters.add(query, d.parameters, "density " + d.name);
+  query_parameters.finish_help();
+  auto* bv_tests_option =
+      query->add_option("--bv-tests", query_bv_tests, "Budget of BV tests (strategies with a budget)");
+  auto* deadline_option =
+      query
+          ->add_option("--deadline-us", query_deadline, "Deadline in microseconds (strategies with a budget)")
+          ->check(CLI::PositiveNumber);
+  query->add_flag("--all-contacts", query_all,
+                  "Short for --strategy all_contacts: every intersecting triangle pair");
   query->add_flag("--no-normalize", query_raw, "Keep the meshes' coordinates");
   query->add_flag("--json", query_json, "Print JSON");
   query->add_option("--cache", query_cache, "Tree cache directory (default: <build>/cache)");
@@ -256,6 +346,12 @@ int main(int argc, char** argv) {
       "  bvhlab query jeep1.ms3d jeep1.ms3d --pose 1.5,0,0,0,0,1,30\n"
       "  bvhlab query injector_pipes.stl injector_pipes.stl --protocol 1.6,42,5000 --strategy time_critical "
       "--bv-tests 200");
+
+  // policies
+  bool policies_json_flag = false;
+  auto* policies =
+      app.add_subcommand("policies", "The registered densities and strategies, with their parameters");
+  policies->add_flag("--json", policies_json_flag, "Print JSON");
 
   // run / report
   std::string scene_file, out_dir, cache_dir, snippet_file;
@@ -301,12 +397,16 @@ int main(int argc, char** argv) {
     if (*info) {
       if (fs::is_regular_file(info_mesh) && is_saved_tree(info_mesh)) {
         const SavedTreeInfo t = peek_saved_tree(info_mesh);
-        std::printf("%s (saved tree)\n  bv              %s\n  nodes           %ju\n  triangles       %ju\n",
-                    info_mesh.c_str(), t.bv.c_str(), std::uintmax_t(t.nodes), std::uintmax_t(t.triangles));
-        if (t.grid)
-          std::printf("  annotation      adb g=%d tau=%g\n", t.grid, t.tau);
-        else
-          std::printf("  annotation      none\n");
+        if (info_json) {
+          nlohmann::json j = {{"file", info_mesh},       {"saved_tree", true},         {"bv", t.bv},
+                              {"density", t.density},    {"annotation", t.annotation}, {"nodes", t.nodes},
+                              {"triangles", t.triangles}};
+          std::cout << j.dump(2) << '\n';
+        } else {
+          std::printf("%s (saved tree)\n  bv              %s\n  nodes           %ju\n  triangles       %ju\n",
+                      info_mesh.c_str(), t.bv.c_str(), std::uintmax_t(t.nodes), std::uintmax_t(t.triangles));
+          std::printf("  annotation      %s\n", t.annotation.c_str());
+        }
         return 0;
       }
       const fs::path path = resolve_mesh_argument(info_mesh);
@@ -344,15 +444,22 @@ int main(int argc, char** argv) {
       return 0;
     }
 
+    if (*policies) {
+      print_policies(policies_json_flag);
+      return 0;
+    }
+
     if (*build) {
+      const std::string density_name = build_adb ? "adb" : build_density;
+      build_parameters.refuse_others({&density_info(density_name).parameters}, "density " + density_name);
+      const DensitySpec density = density_from(density_name, build_parameters);
       const SceneObject object = object_for(build_mesh, !build_raw);
       HierarchySpec h;
       h.bv = h.name = build_bv;
       h.build.split = split_method_from_string(build_split);
       h.build.max_leaf_triangles = build_leaf;
-      AnnotationSpec annotation{build_adb, build_grid, build_tau};
       const BuildOutcome outcome =
-          build_tree_file(object, h, annotation, build_out, build_threads,
+          build_tree_file(object, h, density, build_out, build_threads,
                           [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); });
       std::printf("%s -> %s (%ju bytes)\n", object.path.c_str(), build_out.c_str(), outcome.file_bytes);
       print_model(outcome.model);
@@ -366,18 +473,42 @@ int main(int argc, char** argv) {
       const bool tree_b = fs::is_regular_file(query_b) && is_saved_tree(query_b);
       if (tree_a != tree_b)
         throw CLI::ValidationError("query", "give two meshes or two saved trees, not one of each");
+      if (query_all) {
+        if (query_strategy != ExactStrategy::name() && query_strategy != AllContactsStrategy::name())
+          throw CLI::ValidationError("--all-contacts",
+                                     "lists exact contacts; it does not apply to strategy " + query_strategy);
+        query_strategy = AllContactsStrategy::name();
+      }
+      const StrategyInfo& strategy = strategy_info(query_strategy);
+      const std::string query_density_given = query_density;
+      if (query_density.empty())  // the first density the strategy runs on: none when it needs none
+        query_density =
+            strategy.densities.empty() ? std::string(NoDensity::name()) : strategy.densities.front();
+      if (!strategy.accepts(query_density))
+        throw CLI::ValidationError(
+            "--density", "strategy " + query_strategy + " does not run on density " + query_density);
+      if (tree_a && !query_density_given.empty())
+        throw CLI::ValidationError("--density", "saved trees carry their own density; it does not apply");
+      const auto& density_parameters = density_info(query_density).parameters;
+      if (tree_a)
+        query_parameters.refuse_others({&strategy.parameters},
+                                       "strategy " + query_strategy + " on saved trees");
+      else
+        query_parameters.refuse_others({&strategy.parameters, &density_parameters},
+                                       "strategy " + query_strategy + " with density " + query_density);
       QueryRequest request;
       request.hierarchy.bv = request.hierarchy.name = query_bv;
-      request.strategy.kind = strategy_from(query_strategy);
-      request.annotation = {request.strategy.kind != StrategyKind::Exact, query_grid, query_tau};
-      if (request.strategy.kind == StrategyKind::Adb || request.strategy.kind == StrategyKind::TimeCritical)
-        request.strategy.p_min = query_p_min;
+      request.strategy.strategy = query_strategy;
+      request.strategy.values =
+          resolve_parameters(strategy.parameters, query_parameters.pick(strategy.parameters), query_strategy);
+      if (!tree_a) request.density = density_from(query_density, query_parameters);
       request.strategy.budget.max_bv_tests = query_bv_tests;
       request.strategy.budget.deadline_us = query_deadline;
-      request.strategy.best_effort_threshold = query_threshold;
-      if (request.strategy.kind == StrategyKind::TimeCritical && request.strategy.budget.unlimited())
-        throw CLI::ValidationError("--strategy time_critical", "needs --bv-tests and/or --deadline-us");
-      request.all_contacts = query_all;
+      if (strategy.budget == BudgetUse::None && (bv_tests_option->count() || deadline_option->count()))
+        throw CLI::ValidationError("--bv-tests/--deadline-us",
+                                   "strategy " + query_strategy + " takes no budget");
+      if (strategy.budget == BudgetUse::Required && request.strategy.budget.unlimited())
+        throw CLI::ValidationError("--strategy " + query_strategy, "needs --bv-tests and/or --deadline-us");
       const RigidTransform pose = parse_pose(query_pose, query_protocol);
       QueryOutcome outcome;
       std::string name_a, name_b;

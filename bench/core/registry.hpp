@@ -1,7 +1,11 @@
-// The one place where run-time names meet compile-time BV policies. A new bounding volume is named
-// here (one line) and nowhere else outside its own header; tools instantiate only what they are asked for.
+// The one place where run-time names meet compile-time policies: bounding volumes, densities and traversal
+// strategies. A new policy is named here (one line in its list) and nowhere else outside its own header;
+// tools instantiate only what they are asked for.
 #pragma once
 
+#include "adb/adb_density.hpp"
+#include "adb/tree.hpp"
+#include "traversal/strategies.hpp"
 #include "volumes/aabb.hpp"
 #include "volumes/dop24.hpp"
 #include "volumes/kdop.hpp"
@@ -13,7 +17,14 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <tuple>
+#include <type_traits>
 #include <vector>
+
+#ifdef BVHLAB_TEST_POLICIES
+// The test-only policies (tests/support/test_policies.hpp): built into the test variant of the CLI only.
+#include "tests/support/test_policies.hpp"
+#endif
 
 namespace bvhlab {
 
@@ -23,42 +34,100 @@ struct TypeList {};
 using RegisteredVolumes =
     TypeList<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop24, Dop<26>, Obb, Sphere, RestrictedBox>;
 
-/// Calls f(std::type_identity<BV>{}) for the BV whose name() is `name`; throws naming the choices.
-template <class F, class... BVs>
-auto with_volume_impl(std::string_view name, F&& f, TypeList<BVs...>) {
-  using R = decltype(f(std::type_identity<Aabb>{}));
+using RegisteredDensities = TypeList<NoDensity, AdbDensity
+#ifdef BVHLAB_TEST_POLICIES
+                                     ,
+                                     testing::TriangleCountDensity
+#endif
+                                     >;
+
+using RegisteredStrategies =
+    TypeList<ExactStrategy, AllContactsStrategy, GuidedExactStrategy, AdbStrategy, TimeCriticalStrategy
+#ifdef BVHLAB_TEST_POLICIES
+             ,
+             testing::RootOverlapStrategy
+#endif
+             >;
+
+namespace registry_detail {
+
+template <class... Ts>
+std::vector<std::string> names(TypeList<Ts...>) {
+  return {std::string(Ts::name())...};
+}
+
+inline std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+/// Calls f(std::type_identity<T>{}) for the T of the list whose name() is `name`; throws naming the choices.
+template <class F, class... Ts>
+auto with_named(std::string_view kind, std::string_view name, F&& f, TypeList<Ts...> list) {
+  auto unknown = [&] {
+    return std::invalid_argument("unknown " + std::string(kind) + " '" + std::string(name) +
+                                 "' (known: " + joined(names(list)) + ")");
+  };
+  using First = std::tuple_element_t<0, std::tuple<Ts...>>;
+  using R = decltype(f(std::type_identity<First>{}));
   if constexpr (std::is_void_v<R>) {
     bool found = false;
-    ((found = found || (BVs::name() == name ? (f(std::type_identity<BVs>{}), true) : false)), ...);
-    if (!found) throw std::invalid_argument("unknown bounding volume '" + std::string(name) + "'");
+    ((found = found || (Ts::name() == name ? (f(std::type_identity<Ts>{}), true) : false)), ...);
+    if (!found) throw unknown();
   } else {
     std::optional<R> out;
-    ((out || BVs::name() != name ? void() : void(out.emplace(f(std::type_identity<BVs>{})))), ...);
-    if (!out) throw std::invalid_argument("unknown bounding volume '" + std::string(name) + "'");
+    ((out || Ts::name() != name ? void() : void(out.emplace(f(std::type_identity<Ts>{})))), ...);
+    if (!out) throw unknown();
     return *out;
   }
 }
+
+template <class F, class... Ts>
+void for_each(F&& f, TypeList<Ts...>) {
+  (f(std::type_identity<Ts>{}), ...);
+}
+
+}  // namespace registry_detail
+
+/// Calls f(std::type_identity<BV>{}) for the BV whose name() is `name`; throws naming the choices.
 template <class F>
 auto with_volume(std::string_view name, F&& f) {
-  return with_volume_impl(name, std::forward<F>(f), RegisteredVolumes{});
+  return registry_detail::with_named("bounding volume", name, std::forward<F>(f), RegisteredVolumes{});
 }
-
 /// Calls f(std::type_identity<BV>{}) for every registered BV, in registration order.
-template <class F, class... BVs>
-void with_each_volume_impl(F&& f, TypeList<BVs...>) {
-  (f(std::type_identity<BVs>{}), ...);
-}
 template <class F>
 void with_each_volume(F&& f) {
-  with_each_volume_impl(std::forward<F>(f), RegisteredVolumes{});
-}
-
-template <class... BVs>
-std::vector<std::string> volume_names_impl(TypeList<BVs...>) {
-  return {std::string(BVs::name())...};
+  registry_detail::for_each(std::forward<F>(f), RegisteredVolumes{});
 }
 inline std::vector<std::string> volume_names() {
-  return volume_names_impl(RegisteredVolumes{});
+  return registry_detail::names(RegisteredVolumes{});
+}
+
+/// Calls f(std::type_identity<D>{}) for the density whose name() is `name`; throws naming the choices.
+template <class F>
+auto with_density(std::string_view name, F&& f) {
+  return registry_detail::with_named("density", name, std::forward<F>(f), RegisteredDensities{});
+}
+template <class F>
+void with_each_density(F&& f) {
+  registry_detail::for_each(std::forward<F>(f), RegisteredDensities{});
+}
+inline std::vector<std::string> density_names() {
+  return registry_detail::names(RegisteredDensities{});
+}
+
+/// Calls f(std::type_identity<S>{}) for the strategy whose name() is `name`; throws naming the choices.
+template <class F>
+auto with_strategy(std::string_view name, F&& f) {
+  return registry_detail::with_named("strategy", name, std::forward<F>(f), RegisteredStrategies{});
+}
+template <class F>
+void with_each_strategy(F&& f) {
+  registry_detail::for_each(std::forward<F>(f), RegisteredStrategies{});
+}
+inline std::vector<std::string> strategy_names() {
+  return registry_detail::names(RegisteredStrategies{});
 }
 
 }  // namespace bvhlab

@@ -1,9 +1,8 @@
 #include "bench/core/scene.hpp"
 
-#include "adb/annotate.hpp"
-#include "adb/lb_table.hpp"
 #include "bench/core/content_hash.hpp"
 #include "bench/core/mesh_catalog.hpp"
+#include "bench/core/policies.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
 
@@ -13,26 +12,13 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 
 namespace bvhlab {
 
 using json = nlohmann::json;
-
-std::string_view to_string(StrategyKind kind) {
-  switch (kind) {
-    case StrategyKind::Exact:
-      return "exact";
-    case StrategyKind::GuidedExact:
-      return "guided_exact";
-    case StrategyKind::Adb:
-      return "adb";
-    case StrategyKind::TimeCritical:
-      return "time_critical";
-  }
-  return "?";
-}
 
 namespace {
 
@@ -227,6 +213,182 @@ std::vector<PoseGroup> parse_poses(const json& document, const std::string& sour
   return groups;
 }
 
+/// Runs f; a std::invalid_argument it throws becomes a SceneError at `node`.
+template <class F>
+auto checked(const Node& node, F&& f) {
+  try {
+    return f();
+  } catch (const std::invalid_argument& e) {
+    node.fail(e.what());
+  }
+}
+
+/// One value of parameter p, checked against its range.
+double read_parameter(const Node& node, const ParamSpec& p) {
+  const double v = node.number();
+  if (const std::string problem = p.problem(v); !problem.empty())
+    node.fail(std::string(p.name) + " " + problem);
+  return v;
+}
+
+/// A sweep parameter takes a number or a non-empty list of numbers; any other takes one number.
+std::vector<double> read_values(const Node& node, const ParamSpec& p) {
+  if (!p.sweep || !node.value().is_array()) return {read_parameter(node, p)};
+  std::vector<double> out;
+  for (std::size_t k = 0, m = node.array_size(); k < m; ++k) out.push_back(read_parameter(node.child(k), p));
+  return out;
+}
+
+std::vector<Budget> parse_budgets(const Node& budgets) {
+  std::vector<Budget> out;
+  for (std::size_t k = 0, m = budgets.array_size(); k < m; ++k) {
+    const Node b = budgets.child(k);
+    b.expect_object({"bv_tests", "deadline_us"});
+    Budget budget;
+    if (b.has("bv_tests"))
+      budget.max_bv_tests = static_cast<std::uint64_t>(b.child("bv_tests").integer(1, 1LL << 40));
+    if (b.has("deadline_us")) {
+      budget.deadline_us = b.child("deadline_us").number(0, 1e9);
+      if (!(budget.deadline_us > 0))
+        b.child("deadline_us").fail("expected a positive number of microseconds");
+    }
+    if (budget.unlimited()) b.fail("expected \"bv_tests\" and/or \"deadline_us\"");
+    out.push_back(budget);
+  }
+  return out;
+}
+
+/// The hierarchies a strategy entry names; false when every one of them was optional and left out.
+template <class Skipped>
+bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec& spec, Skipped&& skipped) {
+  if (!s.has("hierarchies")) return true;
+  const Node hs = s.child("hierarchies");
+  std::vector<std::string> names;
+  for (const auto& h : scene.hierarchies) names.push_back(h.name);
+  for (std::size_t k = 0, m = hs.array_size(); k < m; ++k) {
+    if (skipped(hs.child(k).string())) continue;
+    const std::string name = hs.child(k).choice(names);
+    if (scene.hierarchy(name)->is_fcl() && spec.name != ExactStrategy::name())
+      hs.child(k).fail("\"" + spec.name + "\" needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only");
+    spec.hierarchies.push_back(name);
+  }
+  return !spec.hierarchies.empty();
+}
+
+/// One entry of "strategies", checked against the strategy table; nullopt when it has nowhere to run.
+template <class Skipped>
+std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Skipped&& skipped) {
+  StrategySpec spec;
+  spec.name = s.child("type").choice(strategy_names());
+  const StrategyInfo& info = strategy_info(spec.name);
+  std::vector<std::string> fields{"type", "hierarchies"};
+  for (const ParamSpec& p : info.parameters) fields.emplace_back(p.name);
+  if (info.budget != BudgetUse::None) fields.emplace_back("budgets");
+  s.expect_object(fields);
+  for (const ParamSpec& p : info.parameters)
+    if (s.has(std::string(p.name)))
+      spec.values[std::string(p.name)] = read_values(s.child(std::string(p.name)), p);
+  if (info.budget == BudgetUse::Required || s.has("budgets"))
+    spec.budgets = parse_budgets(s.child("budgets"));
+  if (!parse_strategy_hierarchies(s, scene, spec, skipped)) return std::nullopt;
+  if (info.needs_density && !info.accepts(scene.density.name)) {
+    std::string usable;
+    for (const std::string& d : info.densities) usable += (usable.empty() ? "\"" : ", \"") + d + "\"";
+    s.child("type").fail("\"" + spec.name + "\" needs a density it can estimate from (" + usable +
+                         "), the scene's is \"" + scene.density.name +
+                         "\"; add \"annotation\": {\"type\": \"adb\", \"grid\": 2, \"tau\": 0.25}");
+  }
+  if (std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
+                   [&](const HierarchySpec& h) { return scene.applies(spec, h); }))
+    s.fail("\"" + spec.name + "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\" only)");
+  checked(s, [&] {
+    for (const StrategyVariant& v : expand(spec))
+      with_strategy(v.strategy,
+                    [&]<class S>(std::type_identity<S>) { (void)strategy_options<S>(v.values, v.budget); });
+    return 0;
+  });
+  return spec;
+}
+
+/// "report": what the summary singles out, checked against what the scene runs.
+template <class Skipped>
+void parse_report(const Node& root, Scene& scene, Skipped&& skipped) {
+  ReportSpec& report = scene.report;
+  std::vector<std::string> hierarchy_names;
+  for (const auto& h : scene.hierarchies) hierarchy_names.push_back(h.name);
+  // The operating point: an inexact strategy swept over p_min (the ADB trade-off curve).
+  std::vector<double> operating_p_min;
+  for (const auto& s : scene.strategies) {
+    const StrategyInfo& info = strategy_info(s.name);
+    const ParamSpec* p_min = info.parameter("p_min");
+    if (info.exact || !p_min || !p_min->sweep) continue;
+    if (report.operating_strategy.empty()) report.operating_strategy = s.name;
+    if (s.name != report.operating_strategy) continue;
+    for (const StrategyVariant& v : expand(s)) operating_p_min.push_back(v.value_or("p_min", -1));
+  }
+  std::vector<std::string> operated;
+  for (const auto& h : scene.hierarchies)
+    for (const auto& s : scene.strategies)
+      if (s.name == report.operating_strategy && scene.applies(s, h) &&
+          std::find(operated.begin(), operated.end(), h.name) == operated.end())
+        operated.push_back(h.name);
+  if (root.has("report")) {
+    const Node r = root.child("report");
+    r.expect_object({"quality_distances", "cgal_sample", "operating_point", "baseline"});
+    if (r.has("quality_distances")) {
+      const auto q = r.child("quality_distances").numbers(2, 0, 1e6);
+      if (q[0] > q[1]) r.child("quality_distances").fail("expected [min, max] with min <= max");
+      report.quality_min = q[0];
+      report.quality_max = q[1];
+    }
+    if (r.has("cgal_sample"))
+      report.cgal_sample = static_cast<int>(r.child("cgal_sample").integer(0, 1'000'000));
+    if (r.has("operating_point")) {
+      const Node op = r.child("operating_point");
+      op.expect_object({"hierarchy", "p_min"});
+      if (operated.empty())
+        op.fail(
+            "an operating point needs an inexact strategy swept over p_min (such as \"adb\") on some "
+            "hierarchy");
+      if (op.has("hierarchy") && !skipped(op.child("hierarchy").string()))
+        report.operating_hierarchy = op.child("hierarchy").choice(operated);
+      if (op.has("p_min")) {
+        report.operating_p_min = op.child("p_min").number(0, 1);
+        if (std::find(operating_p_min.begin(), operating_p_min.end(), report.operating_p_min) ==
+            operating_p_min.end())
+          op.child("p_min").fail("no \"" + report.operating_strategy + "\" strategy runs this p_min");
+      }
+    }
+    if (r.has("baseline")) {
+      const Node b = r.child("baseline");
+      b.expect_object({"hierarchy", "strategy"});
+      if (b.has("hierarchy") && !skipped(b.child("hierarchy").string()))
+        report.baseline_hierarchy = b.child("hierarchy").choice(hierarchy_names);
+      if (b.has("strategy")) {
+        std::vector<std::string> exact;
+        for (const StrategyInfo& info : strategy_table())
+          if (info.exact) exact.push_back(info.name);
+        report.baseline_strategy = b.child("strategy").choice(exact);
+      }
+    }
+  }
+  if (report.operating_hierarchy.empty() && !operated.empty()) report.operating_hierarchy = operated.front();
+  if (report.operating_p_min < 0 && !operating_p_min.empty()) {
+    std::sort(operating_p_min.begin(), operating_p_min.end());
+    report.operating_p_min = operating_p_min.back();
+    for (double p : operating_p_min)
+      if (p <= 0.9) report.operating_p_min = p;
+  }
+  if (report.baseline_hierarchy.empty()) {
+    report.baseline_hierarchy = scene.hierarchies.front().name;
+    for (const auto& h : scene.hierarchies)
+      if (h.bv == "dop24") {
+        report.baseline_hierarchy = h.name;
+        break;
+      }
+  }
+}
+
 std::filesystem::path resolve_mesh(const std::string& mesh, const std::filesystem::path& base_dir) {
   const std::filesystem::path written(mesh);
   const std::filesystem::path relative = written.is_absolute() ? written : base_dir / written;
@@ -246,16 +408,6 @@ bool fcl_available() {
 
 }  // namespace
 
-bool volume_supports_annotation(std::string_view bv) {
-  bool supported = false;
-  with_volume(bv, [&]<class BV>(std::type_identity<BV>) {
-    supported = requires(Bvh<BV> bvh, const AnnotateOptions& options) {
-      annotate<2>(std::move(bvh), options);
-    };
-  });
-  return supported;
-}
-
 std::vector<std::string> hierarchy_bv_names() {
   std::vector<std::string> names = volume_names();
   names.emplace_back("fcl_obb");
@@ -263,37 +415,44 @@ std::vector<std::string> hierarchy_bv_names() {
   return names;
 }
 
+std::string DensitySpec::label() const {
+  return density_label(name, values);
+}
+
 std::string StrategyVariant::budget_label() const {
-  std::string out;
-  if (budget.max_bv_tests) out += "bv_tests=" + std::to_string(budget.max_bv_tests);
-  if (budget.deadline_us > 0)
-    out += (out.empty() ? "" : ";") + std::string("deadline_us=") + number_text(budget.deadline_us);
-  return out;
+  return bvhlab::budget_label(budget);
 }
 
 std::string StrategyVariant::label() const {
-  std::string out(to_string(kind));
-  if (p_min >= 0) out += " p_min=" + number_text(p_min);
-  if (!budget.unlimited()) out += " " + budget_label();
-  return out;
+  return strategy_label(strategy, values, budget);
+}
+
+double StrategyVariant::value_or(std::string_view name, double fallback) const {
+  const auto it = values.find(name);
+  return it == values.end() ? fallback : it->second;
 }
 
 std::vector<StrategyVariant> expand(const StrategySpec& spec) {
-  std::vector<StrategyVariant> out;
-  switch (spec.kind) {
-    case StrategyKind::Exact:
-    case StrategyKind::GuidedExact:
-      out.push_back({spec.kind, -1, {}, 0.5});
-      break;
-    case StrategyKind::Adb:
-      for (double p : spec.p_min) out.push_back({spec.kind, p, {}, 0.5});
-      break;
-    case StrategyKind::TimeCritical:
-      for (const Budget& b : spec.budgets)
-        out.push_back(
-            {spec.kind, spec.p_min.empty() ? 0.9 : spec.p_min.front(), b, spec.best_effort_threshold});
-      break;
+  const StrategyInfo& info = strategy_info(spec.name);
+  // Cross product of the given values (a sweep may hold several), in the order of the parameter table.
+  std::vector<ParamValues> combos{{}};
+  for (const ParamSpec& p : info.parameters) {
+    const auto given = spec.values.find(p.name);
+    if (given == spec.values.end()) continue;
+    std::vector<ParamValues> next;
+    for (const ParamValues& combo : combos)
+      for (double v : given->second) {
+        ParamValues c = combo;
+        c[std::string(p.name)] = v;
+        next.push_back(std::move(c));
+      }
+    combos = std::move(next);
   }
+  const std::vector<Budget> budgets = spec.budgets.empty() ? std::vector<Budget>{Budget{}} : spec.budgets;
+  std::vector<StrategyVariant> out;
+  for (const ParamValues& combo : combos)
+    for (const Budget& budget : budgets)
+      out.push_back({spec.name, resolve_parameters(info.parameters, combo, spec.name), budget});
   return out;
 }
 
@@ -313,12 +472,13 @@ bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
   if (!s.hierarchies.empty() &&
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
-  return !h.is_fcl() || s.kind == StrategyKind::Exact;
+  return !h.is_fcl() || s.name == ExactStrategy::name();
 }
 
-bool Scene::needs_annotation(const HierarchySpec& h) const {
-  return std::any_of(strategies.begin(), strategies.end(),
-                     [&](const StrategySpec& s) { return s.needs_annotation() && applies(s, h); });
+bool Scene::needs_density(const HierarchySpec& h) const {
+  return std::any_of(strategies.begin(), strategies.end(), [&](const StrategySpec& s) {
+    return strategy_info(s.name).needs_density && applies(s, h);
+  });
 }
 
 std::vector<PoseGroup> load_pose_file(const std::filesystem::path& file) {
@@ -426,23 +586,25 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   }
   if (scene.hierarchies.empty()) hierarchies.fail("no hierarchy is available in this build");
 
-  // Annotation.
+  // Density ("annotation"): a registered density and its parameters.
   if (root.has("annotation")) {
     const Node a = root.child("annotation");
-    a.expect_object({"type", "grid", "tau"});
-    scene.annotation.adb = a.child("type").choice({"none", "adb"}) == "adb";
-    if (!scene.annotation.adb && (a.has("grid") || a.has("tau")))
-      (a.has("grid") ? a.child("grid") : a.child("tau")).fail("only an \"adb\" annotation takes this field");
-    if (a.has("grid")) scene.annotation.grid = static_cast<int>(a.child("grid").integer(2, 4));
-    if (a.has("tau")) {
-      const Node t = a.child("tau");
-      scene.annotation.tau = t.number(0, 1e6);
-      try {
-        (void)lb_for_tau(scene.annotation.tau);
-      } catch (const std::invalid_argument& e) {
-        t.fail(std::string("no LB value for this tau (") + e.what() + ")");
-      }
-    }
+    if (!a.value().is_object()) a.fail("expected an object; " + a.got());
+    scene.density.name = a.child("type").choice(density_names());
+    const DensityInfo& info = density_info(scene.density.name);
+    std::vector<std::string> fields{"type"};
+    for (const ParamSpec& p : info.parameters) fields.emplace_back(p.name);
+    a.expect_object(fields);
+    ParamValues given;
+    for (const ParamSpec& p : info.parameters)
+      if (a.has(std::string(p.name)))
+        given[std::string(p.name)] = read_parameter(a.child(std::string(p.name)), p);
+    scene.density.values = checked(a, [&] {
+      return with_density(scene.density.name, [&]<class D>(std::type_identity<D>) {
+        (void)density_params<D>(given);  // the density's own checks, beyond each parameter's range
+        return resolve_parameters(D::parameters(), given, D::name());
+      });
+    });
   }
 
   // A name of a hierarchy left out above may still be referred to: it is skipped there too.
@@ -457,82 +619,19 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   for (std::size_t i = 0, n = strategies.array_size(); i < n; ++i) {
     const Node s = strategies.child(i);
     if (!s.value().is_object()) s.fail("expected an object; " + s.got());
-    const std::string type = s.child("type").choice({"exact", "guided_exact", "adb", "time_critical"});
-    StrategySpec spec;
-    if (type == "exact") {
-      s.expect_object({"type", "hierarchies"});
-      spec.kind = StrategyKind::Exact;
-    } else if (type == "guided_exact") {
-      s.expect_object({"type", "hierarchies"});
-      spec.kind = StrategyKind::GuidedExact;
-    } else if (type == "adb") {
-      s.expect_object({"type", "p_min", "hierarchies"});
-      spec.kind = StrategyKind::Adb;
-      const Node p = s.child("p_min");
-      spec.p_min = p.value().is_array() ? p.numbers(0, 0, 1) : std::vector<double>{p.number(0, 1)};
-      if (spec.p_min.empty()) p.fail("expected at least one p_min");
-    } else {
-      s.expect_object({"type", "p_min", "budgets", "best_effort_threshold", "hierarchies"});
-      spec.kind = StrategyKind::TimeCritical;
-      spec.p_min = {s.has("p_min") ? s.child("p_min").number(0, 1) : 0.9};
-      if (s.has("best_effort_threshold"))
-        spec.best_effort_threshold = s.child("best_effort_threshold").number(0, 1);
-      const Node budgets = s.child("budgets");
-      for (std::size_t k = 0, m = budgets.array_size(); k < m; ++k) {
-        const Node b = budgets.child(k);
-        b.expect_object({"bv_tests", "deadline_us"});
-        Budget budget;
-        if (b.has("bv_tests"))
-          budget.max_bv_tests = static_cast<std::uint64_t>(b.child("bv_tests").integer(1, 1LL << 40));
-        if (b.has("deadline_us")) {
-          budget.deadline_us = b.child("deadline_us").number(0, 1e9);
-          if (!(budget.deadline_us > 0))
-            b.child("deadline_us").fail("expected a positive number of microseconds");
-        }
-        if (budget.unlimited()) b.fail("expected \"bv_tests\" and/or \"deadline_us\"");
-        spec.budgets.push_back(budget);
-      }
+    std::optional<StrategySpec> spec = parse_strategy(s, scene, skipped_hierarchy);
+    if (!spec) {  // every hierarchy it names was optional and left out
+      scene.notes.push_back("strategy /strategies/" + std::to_string(i) + " (" + s.child("type").string() +
+                            ") skipped: none of its hierarchies is available");
+      continue;
     }
-    if (s.has("hierarchies")) {
-      const Node hs = s.child("hierarchies");
-      for (std::size_t k = 0, m = hs.array_size(); k < m; ++k) {
-        std::vector<std::string> names;
-        for (const auto& h : scene.hierarchies) names.push_back(h.name);
-        const std::string written = hs.child(k).string();
-        if (skipped_hierarchy(written)) continue;
-        const std::string name = hs.child(k).choice(names);
-        if (scene.hierarchy(name)->is_fcl() && spec.kind != StrategyKind::Exact)
-          hs.child(k).fail("\"" + type + "\" needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only");
-        spec.hierarchies.push_back(name);
-      }
-      if (spec.hierarchies.empty()) {  // every hierarchy it names was optional and left out
-        scene.notes.push_back("strategy /strategies/" + std::to_string(i) + " (" + type +
-                              ") skipped: none of its hierarchies is available");
-        continue;
-      }
-    }
-    if (spec.needs_annotation() && !scene.annotation.adb)
-      s.child("type").fail(
-          "\"" + type +
-          "\" needs the ADB annotation; add \"annotation\": {\"type\": \"adb\", \"grid\": 2, "
-          "\"tau\": 0.5}");
-    if (spec.needs_annotation())
-      for (const auto& h : scene.hierarchies)
-        if (scene.applies(spec, h) && !volume_supports_annotation(h.bv))
-          s.fail("\"" + type + "\" needs ADB-annotated trees, and the annotation does not support \"" + h.bv +
-                 "\" (hierarchy \"" + h.name +
-                 "\"); list the hierarchies it should run on in \"hierarchies\"");
-    const bool applies_somewhere =
-        std::any_of(scene.hierarchies.begin(), scene.hierarchies.end(),
-                    [&](const HierarchySpec& h) { return scene.applies(spec, h); });
-    if (!applies_somewhere)
-      s.fail("\"" + type + "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\" only)");
-    scene.strategies.push_back(std::move(spec));
+    scene.strategies.push_back(std::move(*spec));
   }
-  if (scene.annotation.adb && std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
-                                           [&](const HierarchySpec& h) { return scene.needs_annotation(h); }))
+  if (scene.density.name != NoDensity::name() &&
+      std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
+                   [&](const HierarchySpec& h) { return scene.needs_density(h); }))
     root.child("annotation")
-        .fail("an ADB annotation is set but no strategy uses it (it would cost time for nothing)");
+        .fail("a density is set but no strategy needs it (annotating would cost time for nothing)");
 
   // Workload.
   if (root.has("workload")) {
@@ -574,68 +673,7 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
     scene.workload.identity = identity;
   }
 
-  // Report.
-  ReportSpec& report = scene.report;
-  if (root.has("report")) {
-    const Node r = root.child("report");
-    r.expect_object({"quality_distances", "cgal_sample", "operating_point", "baseline"});
-    if (r.has("quality_distances")) {
-      const auto q = r.child("quality_distances").numbers(2, 0, 1e6);
-      if (q[0] > q[1]) r.child("quality_distances").fail("expected [min, max] with min <= max");
-      report.quality_min = q[0];
-      report.quality_max = q[1];
-    }
-    if (r.has("cgal_sample"))
-      report.cgal_sample = static_cast<int>(r.child("cgal_sample").integer(0, 1'000'000));
-    if (r.has("operating_point")) {
-      const Node op = r.child("operating_point");
-      op.expect_object({"hierarchy", "p_min"});
-      std::vector<std::string> annotated;
-      for (const auto& h : scene.hierarchies)
-        if (scene.needs_annotation(h)) annotated.push_back(h.name);
-      if (annotated.empty()) op.fail("an operating point needs an \"adb\" strategy on some hierarchy");
-      if (op.has("hierarchy") && !skipped_hierarchy(op.child("hierarchy").string()))
-        report.operating_hierarchy = op.child("hierarchy").choice(annotated);
-      if (op.has("p_min")) report.operating_p_min = op.child("p_min").number(0, 1);
-    }
-    if (r.has("baseline")) {
-      const Node b = r.child("baseline");
-      b.expect_object({"hierarchy", "strategy"});
-      std::vector<std::string> names;
-      for (const auto& h : scene.hierarchies) names.push_back(h.name);
-      if (b.has("hierarchy") && !skipped_hierarchy(b.child("hierarchy").string()))
-        report.baseline_hierarchy = b.child("hierarchy").choice(names);
-      if (b.has("strategy"))
-        report.baseline_strategy = b.child("strategy").choice({"exact", "guided_exact"}) == "exact"
-                                       ? StrategyKind::Exact
-                                       : StrategyKind::GuidedExact;
-    }
-  }
-  // Defaults and cross-checks of the report's choices against what the scene runs.
-  std::vector<double> adb_p_min;
-  for (const auto& s : scene.strategies)
-    if (s.kind == StrategyKind::Adb) adb_p_min.insert(adb_p_min.end(), s.p_min.begin(), s.p_min.end());
-  if (report.operating_hierarchy.empty())
-    for (const auto& h : scene.hierarchies)
-      if (report.operating_hierarchy.empty() && scene.needs_annotation(h))
-        report.operating_hierarchy = h.name;
-  if (report.operating_p_min < 0 && !adb_p_min.empty()) {
-    std::sort(adb_p_min.begin(), adb_p_min.end());
-    report.operating_p_min = adb_p_min.back();
-    for (double p : adb_p_min)
-      if (p <= 0.9) report.operating_p_min = p;
-  } else if (report.operating_p_min >= 0 &&
-             std::find(adb_p_min.begin(), adb_p_min.end(), report.operating_p_min) == adb_p_min.end()) {
-    root.child("report").child("operating_point").child("p_min").fail("no \"adb\" strategy runs this p_min");
-  }
-  if (report.baseline_hierarchy.empty()) {
-    report.baseline_hierarchy = scene.hierarchies.front().name;
-    for (const auto& h : scene.hierarchies)
-      if (h.bv == "dop24") {
-        report.baseline_hierarchy = h.name;
-        break;
-      }
-  }
+  parse_report(root, scene, skipped_hierarchy);
   return scene;
 }
 

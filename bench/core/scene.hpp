@@ -28,12 +28,13 @@
 // the length of the translation) is the value the report files the pose under in its "distance" column.
 #pragma once
 
-#include "adb/annotate.hpp"
+#include "adb/parameters.hpp"
 #include "bvh/topology.hpp"
 #include "traversal/adb.hpp"
 #include "volumes/geometry.hpp"
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -72,34 +73,34 @@ struct HierarchySpec {
   [[nodiscard]] bool is_fcl() const { return bv.rfind("fcl_", 0) == 0; }
 };
 
-struct AnnotationSpec {
-  bool adb = false;
-  int grid = 2;                 ///< cells per axis, 2..4
-  double tau = kDefaultAdbTau;  ///< area threshold, fraction of the cell face area
+/// The density the scene's trees carry ("annotation" in the file): a registered density and its parameters.
+struct DensitySpec {
+  std::string name = "none";                ///< a registered density (bench/core/registry.hpp)
+  ParamValues values;                       ///< resolved: every parameter, defaults filled in
+  [[nodiscard]] std::string label() const;  ///< "none", "adb grid=2 tau=0.25"
 };
 
-enum class StrategyKind { Exact, GuidedExact, Adb, TimeCritical };
-std::string_view to_string(StrategyKind kind);
-
-/// One entry of "strategies"; expands into one run per p_min (adb) or per budget (time_critical).
+/// One entry of "strategies": a registered strategy with its given parameters; a sweep parameter may hold
+/// several values, and each budget is a variant too.
 struct StrategySpec {
-  StrategyKind kind = StrategyKind::Exact;
-  std::vector<double> p_min;             ///< adb: the list; time_critical: exactly one value
-  std::vector<Budget> budgets;           ///< time_critical only
-  double best_effort_threshold = 0.5;    ///< time_critical only
+  std::string name = "exact";
+  std::map<std::string, std::vector<double>, std::less<>> values;  ///< as given; defaults come in expand()
+  std::vector<Budget> budgets;                                     ///< strategies that take a budget
   std::vector<std::string> hierarchies;  ///< restricts the strategy to these; empty: all it applies to
-  [[nodiscard]] bool needs_annotation() const { return kind != StrategyKind::Exact; }
 };
 
 /// One concrete way to answer a query: the unit of a results row.
 struct StrategyVariant {
-  StrategyKind kind = StrategyKind::Exact;
-  double p_min = -1;  ///< < 0: not applicable
+  std::string strategy = "exact";
+  ParamValues values;  ///< resolved
   Budget budget;
-  double best_effort_threshold = 0.5;
   [[nodiscard]] std::string budget_label() const;  ///< "" or "bv_tests=200" or "deadline_us=20"
   [[nodiscard]] std::string label() const;         ///< e.g. "adb p_min=0.9"
+  /// The value of parameter `name`, or `fallback` when the strategy has none.
+  [[nodiscard]] double value_or(std::string_view name, double fallback) const;
 };
+/// Every variant of a spec: the cross product of its sweep values and its budgets, defaults filled in.
+/// Throws std::invalid_argument for values the strategy refuses.
 std::vector<StrategyVariant> expand(const StrategySpec& spec);
 
 /// Poses filed under one value of the report's "distance" column.
@@ -121,10 +122,11 @@ struct WorkloadSpec {
 struct ReportSpec {
   double quality_min = 1.2, quality_max = 2.0;  ///< distances the time-versus-quality summary uses
   int cgal_sample = 64;                         ///< poses per object pair cross-checked against CGAL
-  std::string operating_hierarchy;              ///< default: the first annotated hierarchy
-  double operating_p_min = -1;                  ///< default: the largest p_min <= 0.9, else the largest
-  std::string baseline_hierarchy;               ///< default: dop24 if present, else the first hierarchy
-  StrategyKind baseline_strategy = StrategyKind::Exact;
+  std::string operating_hierarchy;          ///< default: the first hierarchy the operating strategy runs on
+  double operating_p_min = -1;              ///< default: the largest p_min <= 0.9, else the largest
+  std::string operating_strategy;           ///< default: the first inexact strategy with a p_min
+  std::string baseline_hierarchy;           ///< default: dop24 if present, else the first hierarchy
+  std::string baseline_strategy = "exact";  ///< an exact strategy
 };
 
 struct Scene {
@@ -133,7 +135,7 @@ struct Scene {
   std::vector<SceneObject> objects;
   std::vector<ScenePair> pairs;
   std::vector<HierarchySpec> hierarchies;
-  AnnotationSpec annotation;
+  DensitySpec density;
   std::vector<StrategySpec> strategies;
   WorkloadSpec workload;
   ReportSpec report;
@@ -144,16 +146,12 @@ struct Scene {
   [[nodiscard]] const HierarchySpec* hierarchy(std::string_view name) const;
   /// Whether strategy `s` runs on hierarchy `h` (an FCL hierarchy only takes exact).
   [[nodiscard]] bool applies(const StrategySpec& s, const HierarchySpec& h) const;
-  /// Whether any strategy on `h` needs the ADB annotation: only then is `h` annotated.
-  [[nodiscard]] bool needs_annotation(const HierarchySpec& h) const;
+  /// Whether any strategy on `h` needs a density: only then are `h`'s trees annotated.
+  [[nodiscard]] bool needs_density(const HierarchySpec& h) const;
 };
 
 /// Names a scene may use for "bv": the registered volumes, then fcl_obb and fcl_obbrss.
 std::vector<std::string> hierarchy_bv_names();
-
-/// Whether the ADB annotation (adb/annotate.hpp) accepts trees of this registered BV; throws for unknown
-/// names.
-bool volume_supports_annotation(std::string_view bv);
 
 /// Parses and checks a scene. Relative paths resolve against `base_dir`. Throws SceneError.
 Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_dir,

@@ -34,7 +34,7 @@ namespace tree_cache_detail {
 
 /// Checks a decoded tree against its mesh and re-attaches the polygons (saved trees carry none).
 /// Throws std::runtime_error naming the first defect.
-template <class BV, DensityPolicy D>
+template <class BV, Density D>
 Tree<BV, D> attach_polygons(const Tree<BV, D>& saved, const Mesh& mesh) {
   const Bvh<BV>& bvh = saved.bvh;
   const std::size_t n = mesh.triangles.size();
@@ -56,8 +56,7 @@ Tree<BV, D> attach_polygons(const Tree<BV, D>& saved, const Mesh& mesh) {
   triangles.reserve(n);
   for (std::uint32_t id : ids) triangles.push_back(mesh.triangle(id));
   // Volumes stored relative to their parent (hierarchical BVs) are checked through their decoded boxes.
-  std::vector<Box> boxes;
-  if constexpr (requires { bvh.node_boxes(); }) boxes = bvh.node_boxes();
+  const std::vector<Box> boxes = bvh.node_boxes();
   for (std::size_t i = 0; i < bvh.nodes().size(); ++i) {
     const auto node = static_cast<std::uint32_t>(i);
     if (!bvh.node(node).is_leaf()) continue;
@@ -78,14 +77,8 @@ Tree<BV, D> attach_polygons(const Tree<BV, D>& saved, const Mesh& mesh) {
     else
       return Bvh<BV>::from_parts(bvh.nodes(), bvh.volumes(), ids, std::move(triangles));
   }();
-  Tree<BV, D> out{std::move(with_polygons), saved.density};
-  if constexpr (D::annotated) {
-    const auto& pc = saved.density.possible_collision_cells;
-    if (pc.size() != bvh.nodes().size()) throw std::runtime_error("annotation and node counts differ");
-    if (std::any_of(pc.begin(), pc.end(), [](std::uint8_t c) { return c > D::cells; }))
-      throw std::runtime_error("a possible-collision-cell count exceeds the grid's cells");
-  }
-  return out;
+  // The density's data was validated when the saved tree was decoded (D::decode).
+  return Tree<BV, D>{std::move(with_polygons), saved.density};
 }
 
 std::vector<std::byte> read_file_bytes(const std::filesystem::path& file);
@@ -108,11 +101,11 @@ class TreeCache {
   [[nodiscard]] const Counts& counts() const { return counts_; }
 
   /// The tree stored under `key`, checked and with `mesh`'s polygons re-attached; nullopt on a miss or when
-  /// the entry is stale or corrupt (then it is logged and counted as rejected). An annotated tree must carry
-  /// `expected_tau`.
-  template <class BV, DensityPolicy D>
+  /// the entry is stale or corrupt (then it is logged and counted as rejected). Its density must describe
+  /// itself as `expected_density` (D::describe).
+  template <class BV, Density D>
   std::optional<Tree<BV, D>> load(const std::string& key, const Mesh& mesh, CachedTreeTimes* times = nullptr,
-                                  double expected_tau = 0) {
+                                  std::string_view expected_density = "none") {
     if (!enabled()) return std::nullopt;
     const auto file = tree_file(key, BV::name());
     if (!std::filesystem::exists(file) && !std::filesystem::exists(meta_file(file))) {
@@ -122,10 +115,9 @@ class TreeCache {
     try {
       const std::vector<std::byte> payload = read_checked_payload(key, file, times);
       const Tree<BV, D> saved = load_tree_from_buffer<BV, D>(payload);
-      if constexpr (D::annotated)
-        if (saved.density.tau != expected_tau)
-          throw std::runtime_error("annotated with tau " + std::to_string(saved.density.tau) + ", expected " +
-                                   std::to_string(expected_tau));
+      if (const std::string found = D::describe(saved.density); found != expected_density)
+        throw std::runtime_error("annotated as '" + found + "', expected '" + std::string(expected_density) +
+                                 "'");
       Tree<BV, D> tree = tree_cache_detail::attach_polygons(saved, mesh);
       ++counts_.hits;
       return tree;
@@ -137,7 +129,7 @@ class TreeCache {
   }
 
   /// Saves `tree` (without polygons) under `key`. A failure to write is logged, never fatal.
-  template <class BV, DensityPolicy D>
+  template <class BV, Density D>
   void store(const std::string& key, const Tree<BV, D>& tree, const CachedTreeTimes& times) {
     if (!enabled()) return;
     const auto file = tree_file(key, BV::name());

@@ -1,6 +1,6 @@
 // ADB density annotation: clipped areas against closed forms and an independent clipper, the closed-cell
 // rule, degenerate input, exact ties, and pc counts against an exact rational reference.
-#include "adb/annotate.hpp"
+#include "adb/adb_density.hpp"
 #include "support/generated_meshes.hpp"
 #include "volumes/aabb.hpp"
 
@@ -237,12 +237,14 @@ TEST(Annotate, CountsAreAtMostGCubedAndMonotoneInTau) {
   const Mesh mesh = testing::make_torus(1.0, 0.35, 24, 12);
   const auto bvh = Bvh<Aabb>::build(mesh);
   std::vector<std::uint8_t> previous;
-  for (const double tau : {1.5, 1.0, 0.75, 0.5, 0.25, 0.1}) {
+  // The density takes tau where the LB table has values; the counting alone (annotate_counts) takes any.
+  EXPECT_THROW(annotate_adb(bvh, 3, 1.5), std::invalid_argument);
+  for (const double tau : {1.0, 0.75, 0.5, 0.25, 0.1}) {
     AnnotateOptions options;
     options.tau = tau;
-    const auto tree3 = annotate<3>(bvh, options);
+    const auto tree3 = annotate_adb(bvh, 3, options);
     ASSERT_EQ(tree3.density.possible_collision_cells.size(), bvh.nodes().size());
-    EXPECT_EQ(tree3.density.tau, tau);
+    EXPECT_EQ(tree3.density.params.tau, tau);
     const auto& counts = tree3.density.possible_collision_cells;
     for (const auto c : counts) ASSERT_LE(c, 27);
     if (!previous.empty()) {
@@ -261,8 +263,8 @@ TEST(Annotate, ThreadCountDoesNotChangeTheCounts) {
   one.threads = 1;
   two.threads = 2;
   AnnotateStats stats;
-  const auto a = annotate<2>(bvh, one, &stats);
-  const auto b = annotate<2>(bvh, two);
+  const auto a = annotate_adb(bvh, 2, one, &stats);
+  const auto b = annotate_adb(bvh, 2, two);
   EXPECT_EQ(a.density.possible_collision_cells, b.density.possible_collision_cells);
   EXPECT_EQ(stats.nodes, bvh.nodes().size());
   EXPECT_GT(stats.fast_path_triangles, 0u);
@@ -297,7 +299,7 @@ TEST(Annotate, MatchesAnExactRationalReference) {
     const double tau = 0.5;
     AnnotateOptions options;
     options.tau = tau;
-    const auto tree = annotate<2>(bvh, options);
+    const auto tree = annotate_adb(bvh, 2, options);
     const auto boxes = node_boxes(bvh);
     const auto ranges = node_triangle_ranges(bvh.nodes());
     int compared = 0;
@@ -336,7 +338,7 @@ TEST(Annotate, ReportsProgressUpToTheTotal) {
   AnnotateOptions options;
   options.progress = [&](std::size_t done, std::size_t total) { calls.emplace_back(done, total); };
   AnnotateStats stats;
-  annotate<2>(bvh, options, &stats);
+  annotate_adb(bvh, 2, options, &stats);
   ASSERT_FALSE(calls.empty());
   EXPECT_EQ(calls.back().first, stats.triangle_node_pairs);
   EXPECT_EQ(calls.back().second, stats.triangle_node_pairs);
@@ -371,7 +373,7 @@ TEST(Annotate, RejectsBadInputWithAClearMessage) {
 
   auto bvh = Bvh<Aabb>::build(testing::make_torus(1.0, 0.3, 8, 4));
   auto stripped = Bvh<Aabb>::from_parts(bvh.nodes(), bvh.volumes(), bvh.triangle_ids());
-  expect_error([&] { annotate<2>(stripped); }, "no polygons");
+  expect_error([&] { annotate_adb(stripped, 2); }, "no polygons");
 }
 
 }  // namespace

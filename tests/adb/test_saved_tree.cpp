@@ -2,7 +2,7 @@
 // refuse (with a message naming it) instead of crashing or returning a wrong tree.
 #include "adb/saved_tree.hpp"
 
-#include "adb/annotate.hpp"
+#include "adb/adb_density.hpp"
 #include "support/generated_meshes.hpp"
 #include "volumes/aabb.hpp"
 #include "volumes/dop24.hpp"
@@ -28,14 +28,13 @@
 namespace bvhlab {
 namespace {
 
-using Adb2 = AdbDensity<2>;
 using Bytes = std::vector<std::byte>;
 
-const Tree<Aabb, Adb2>& annotated_torus() {
-  static const Tree<Aabb, Adb2> tree = [] {
+const Tree<Aabb, AdbDensity>& annotated_torus() {
+  static const Tree<Aabb, AdbDensity> tree = [] {
     AnnotateOptions options;
     options.threads = 1;
-    return annotate<2>(Bvh<Aabb>::build(testing::make_torus(1.0, 0.3, 12, 6)), options);
+    return annotate_adb(Bvh<Aabb>::build(testing::make_torus(1.0, 0.3, 12, 6)), 2, options);
   }();
   return tree;
 }
@@ -60,8 +59,8 @@ void expect_rejected(F&& load, const std::string& fragment) {
   }
 }
 
-Tree<Aabb, Adb2> load_adb(const Bytes& bytes) {
-  return load_tree_from_buffer<Aabb, Adb2>(bytes, "test.tree");
+Tree<Aabb, AdbDensity> load_adb(const Bytes& bytes) {
+  return load_tree_from_buffer<Aabb, AdbDensity>(bytes, "test.tree");
 }
 
 // Header fields, to craft bad files (offsets from the format table in adb/saved_tree.hpp).
@@ -88,7 +87,8 @@ TEST(SavedTree, AnnotatedAabbTreeRoundTrips) {
   EXPECT_TRUE(same_volume_bytes(loaded.bvh.volumes(), tree.bvh.volumes()));
   EXPECT_EQ(loaded.bvh.triangle_ids(), tree.bvh.triangle_ids());
   EXPECT_EQ(loaded.density.possible_collision_cells, tree.density.possible_collision_cells);
-  EXPECT_EQ(loaded.density.tau, tree.density.tau);
+  EXPECT_EQ(loaded.density.params, tree.density.params);
+  EXPECT_EQ(loaded.density.model, tree.density.model);  // one shared model per (grid, tau)
   EXPECT_FALSE(loaded.bvh.has_polygons());
   EXPECT_EQ(loaded.bvh.stats().leaves, tree.bvh.stats().leaves);
   EXPECT_EQ(loaded.bvh.stats().depth, tree.bvh.stats().depth);
@@ -117,8 +117,8 @@ TEST(SavedTree, PlainAndHierarchicalTreesRoundTrip) {
   }
   {
     // Stored relative to the parent: the root volume travels in the file, and decoding gives the same boxes.
-    const Tree<RestrictedBox, Adb2> tree = annotate<2>(Bvh<RestrictedBox>::build(mesh));
-    const auto loaded = load_tree_from_buffer<RestrictedBox, Adb2>(save_tree_to_buffer(tree));
+    const Tree<RestrictedBox, AdbDensity> tree = annotate_adb(Bvh<RestrictedBox>::build(mesh), 2);
+    const auto loaded = load_tree_from_buffer<RestrictedBox, AdbDensity>(save_tree_to_buffer(tree));
     EXPECT_TRUE(same_volume_bytes(loaded.bvh.volumes(), tree.bvh.volumes()));
     const auto a = loaded.bvh.node_boxes(), b = tree.bvh.node_boxes();
     ASSERT_EQ(a.size(), b.size());
@@ -151,7 +151,7 @@ TEST_F(SavedTreeFiles, FileRoundTripLeavesNoTemporaryFiles) {
   const auto file = dir_ / "torus.tree";
   save_tree(tree, file);
   EXPECT_EQ(files_in_dir(), 1u);
-  const auto loaded = load_tree<Aabb, Adb2>(file);
+  const auto loaded = load_tree<Aabb, AdbDensity>(file);
   EXPECT_EQ(loaded.density.possible_collision_cells, tree.density.possible_collision_cells);
   EXPECT_TRUE(same_volume_bytes(loaded.bvh.volumes(), tree.bvh.volumes()));
   save_tree(tree, file);  // overwrite in place
@@ -160,7 +160,7 @@ TEST_F(SavedTreeFiles, FileRoundTripLeavesNoTemporaryFiles) {
 
 TEST_F(SavedTreeFiles, MissingFileIsNamed) {
   const auto file = dir_ / "absent.tree";
-  expect_rejected([&] { load_tree<Aabb, Adb2>(file); }, file.string());
+  expect_rejected([&] { load_tree<Aabb, AdbDensity>(file); }, file.string());
 }
 
 TEST_F(SavedTreeFiles, FailedWriteLeavesNothingBehind) {
@@ -207,41 +207,56 @@ TEST(SavedTree, RejectsForeignFilesAndTypes) {
   bad[0] = std::byte{'X'};
   expect_rejected([&] { load_adb(bad); }, "magic");
   bad = bytes;
-  put_u32(bad, 8, 2);
-  expect_rejected([&] { load_adb(bad); }, "version 2");
-  // Another BV type, another volume size, another grid, no grid.
-  expect_rejected([&] { load_tree_from_buffer<Obb, Adb2>(bytes); }, "'aabb' volumes, expected 'obb'");
+  put_u32(bad, 8, 1);
+  expect_rejected([&] { load_adb(bad); }, "format version 1, this build reads version 2");
+  // Another BV type, another volume size, another density, another density version.
+  expect_rejected([&] { load_tree_from_buffer<Obb, AdbDensity>(bytes); }, "'aabb' volumes, expected 'obb'");
   bad = bytes;
   put_u32(bad, 56, sizeof(Aabb) + 8);
   expect_rejected([&] { load_adb(bad); }, "bytes");
-  expect_rejected([&] { load_tree_from_buffer<Aabb, AdbDensity<3>>(bytes); }, "grid of 2");
-  expect_rejected([&] { load_tree_from_buffer<Aabb, NoDensity>(bytes); }, "expected no density");
+  expect_rejected([&] { load_tree_from_buffer<Aabb, NoDensity>(bytes); }, "density 'adb', expected 'none'");
   const Bytes plain = save_tree_to_buffer(Tree<Aabb>{annotated_torus().bvh, {}});
-  expect_rejected([&] { load_adb(plain); }, "with no density");
-  // A tree without density stores tau as zero bits: -0.0 (found by fuzz_saved_tree: it compared equal to 0
-  // and was accepted, then saved back as +0.0) and any other value are corrupt headers.
-  for (const double tau : {-0.0, 0.25}) {
-    Bytes odd = plain;
-    put_u64(odd, 72, std::bit_cast<std::uint64_t>(tau));
-    reseal(odd);
-    expect_rejected([&] { load_tree_from_buffer<Aabb, NoDensity>(odd); }, "corrupted header (tau");
-  }
+  expect_rejected([&] { load_adb(plain); }, "density 'none', expected 'adb'");
+  bad = bytes;
+  put_u32(bad, 80, 7);
+  reseal(bad);
+  expect_rejected([&] { load_adb(bad); }, "density 'adb' data of version 7, this build reads version 1");
+  bad = bytes;
+  std::memcpy(bad.data() + 64, "foo\0", 4);
+  reseal(bad);
+  expect_rejected([&] { load_adb(bad); }, "density 'foo', expected 'adb'");
+  bad = bytes;
+  std::memcpy(bad.data() + 64, "adbadbadbadbadba", 16);  // no terminating NUL in the field
+  reseal(bad);
+  expect_rejected([&] { load_adb(bad); }, "bad density name field");
   // The error names the source.
-  expect_rejected([&] { load_tree_from_buffer<Obb, Adb2>(bytes, "somewhere/model.tree"); },
+  expect_rejected([&] { load_tree_from_buffer<Obb, AdbDensity>(bytes, "somewhere/model.tree"); },
                   "somewhere/model.tree");
 }
 
 TEST(SavedTree, AbsurdCountsAreRejectedBeforeAllocating) {
   const Bytes bytes = save_tree_to_buffer(annotated_torus());
   Bytes bad = bytes;
-  put_u64(bad, 80, std::uint64_t{1} << 60);  // node count
+  put_u64(bad, 88, std::uint64_t{1} << 60);  // node count
   expect_rejected([&] { load_adb(bad); }, "absurd");
   bad = bytes;
-  put_u64(bad, 80, 100'000'000);  // plausible count, but the file is far too short for it
-  put_u64(bad, 96, 100'000'000ull * (8 + sizeof(Aabb) + 1) + 4 * annotated_torus().bvh.triangle_ids().size());
+  put_u64(bad, 104, std::uint64_t{1} << 63);  // density block size, beyond what the payload could hold
+  expect_rejected([&] { load_adb(bad); }, "does not match");
+  bad = bytes;  // a density block of 1 TB, the payload size agreeing: the file is far too short for it
+  const std::uint64_t density_bytes = 12 + annotated_torus().bvh.nodes().size();
+  std::uint64_t payload = 0;
+  for (int i = 7; i >= 0; --i) payload = (payload << 8) | std::to_integer<std::uint64_t>(bytes[112 + i]);
+  put_u64(bad, 104, std::uint64_t{1} << 40);
+  put_u64(bad, 112, payload - density_bytes + (std::uint64_t{1} << 40));
   expect_rejected([&] { load_adb(bad); }, "truncated");
   bad = bytes;
-  put_u64(bad, 96, 12345);  // payload size disagreeing with the counts
+  put_u64(bad, 88, 100'000'000);  // plausible count, but the file is far too short for it
+  put_u64(bad, 112,
+          100'000'000ull * (8 + sizeof(Aabb)) + 4 * annotated_torus().bvh.triangle_ids().size() +
+              (12 + annotated_torus().bvh.nodes().size()));
+  expect_rejected([&] { load_adb(bad); }, "truncated");
+  bad = bytes;
+  put_u64(bad, 112, 12345);  // payload size disagreeing with the counts
   expect_rejected([&] { load_adb(bad); }, "payload size");
 }
 
@@ -278,11 +293,23 @@ TEST(SavedTree, RejectsBadStructureEvenWithAValidChecksum) {
         load_adb(with_node(nodes[parent].left(), TreeNode{left.first, left.count + 1}));
       },
       "adjacent");
-  // pc above g^3.
+  // The density's own block: pc above g^3, a grid or tau outside the parameters' ranges.
   Bytes bad = bytes;
   bad[bad.size() - 1] = std::byte{9};
   reseal(bad);
-  expect_rejected([&] { load_adb(bad); }, "more than the grid's 8 cells");
+  expect_rejected([&] { load_adb(bad); }, "exceeds the grid's 8 cells");
+  const std::size_t density_at = bytes.size() - nodes.size() - 12;
+  bad = bytes;
+  put_u32(bad, density_at, 9);
+  reseal(bad);
+  expect_rejected([&] { load_adb(bad); },
+                  "bad 'adb' density data: adb: grid must be an integer in [2, 4], got 9");
+  for (const double tau : {1.5, 0.0, -0.0, std::numeric_limits<double>::quiet_NaN()}) {
+    bad = bytes;
+    put_u64(bad, density_at + 4, std::bit_cast<std::uint64_t>(tau));
+    reseal(bad);
+    expect_rejected([&] { load_adb(bad); }, "adb: tau must be a number in (0, 1]");
+  }
   // Triangle ids that are not a permutation.
   bad = bytes;
   const std::size_t ids_at = nodes_offset() + nodes.size() * (sizeof(TreeNode) + sizeof(Aabb));
@@ -380,10 +407,10 @@ TEST(SavedTree, RandomGarbageNeverCrashes) {
 }
 
 TEST(SavedTree, RefusesToSaveInconsistentTrees) {
-  Tree<Aabb, Adb2> tree = annotated_torus();
+  Tree<Aabb, AdbDensity> tree = annotated_torus();
   tree.density.possible_collision_cells.pop_back();
-  expect_rejected([&] { save_tree_to_buffer(tree); }, "pc counts");
-  Tree<Aabb, Adb2> empty;
+  expect_rejected([&] { save_tree_to_buffer(tree); }, "bytes of annotation for");
+  Tree<Aabb, AdbDensity> empty;
   expect_rejected([&] { save_tree_to_buffer(empty); }, "no nodes");
 }
 

@@ -102,7 +102,9 @@ TEST_F(RunTest, AnnotationRunsOnlyWhereAStrategyNeedsIt) {
   EXPECT_GT(run.stats.annotation_clip_calls, 0u);
   EXPECT_EQ(run.stats.trees_built, 2u);
   for (const auto& m : run.models) {
-    if (m.hierarchy == "dop24") EXPECT_EQ(m.annotation, "none");
+    if (m.hierarchy == "dop24") {
+      EXPECT_EQ(m.annotation, "none");
+    }
   }
   EXPECT_EQ(run.stats.fcl_models_built, 0u);
 }
@@ -224,6 +226,8 @@ TEST_F(RunTest, CsvSchemaAndRates) {
                                         "bv",
                                         "annotation",
                                         "strategy",
+                                        "label",
+                                        "exact",
                                         "p_min",
                                         "budget",
                                         "distance",
@@ -267,7 +271,11 @@ TEST_F(RunTest, CsvSchemaAndRates) {
     EXPECT_GE(std::stod(row[column("max_time_us")]), std::stod(row[column("mean_time_us")]));
     const std::string strategy = row[column("strategy")];
     ++per_strategy[strategy];
+    // The label and exactness come from the strategy table.
+    EXPECT_EQ(row[column("exact")], strategy == "exact" ? "1" : "0");
+    EXPECT_EQ(row[column("label")].rfind(strategy, 0), 0u) << row[column("label")];
     if (strategy == "exact") {
+      EXPECT_EQ(row[column("label")], "exact");
       EXPECT_EQ(row[column("p_min")], "");
       EXPECT_EQ(std::stod(row[column("fp_rate")]), 0.0);
       EXPECT_EQ(std::stod(row[column("fn_rate")]), 0.0);
@@ -276,6 +284,7 @@ TEST_F(RunTest, CsvSchemaAndRates) {
     }
     if (strategy == "time_critical") {
       EXPECT_EQ(row[column("budget")], "bv_tests=8");
+      EXPECT_EQ(row[column("label")], "time_critical p_min=0.9 bv_tests=8");
       EXPECT_LE(std::stod(row[column("bv_tests_per_query")]), 8.0);
     }
     EXPECT_EQ(row[column("build_type")], run.environment.build_type);
@@ -365,22 +374,22 @@ TEST_F(RunTest, SavedTreesAnswerLikeTheMeshesTheyWereBuiltFrom) {
   torus.path = dir / "torus.obj";
   HierarchySpec aabb;
   aabb.bv = aabb.name = "aabb";
-  const AnnotationSpec annotation{true, 2, 0.5};
+  const DensitySpec annotation{"adb", {{"grid", 2}, {"tau", 0.5}}};
   const BuildOutcome built = build_tree_file(torus, aabb, annotation, dir / "torus.tree", 2);
   EXPECT_EQ(built.file_bytes, std::filesystem::file_size(dir / "torus.tree"));
   EXPECT_GT(built.model.annotate_seconds, 0.0);
   const SavedTreeInfo info = peek_saved_tree(dir / "torus.tree");
   EXPECT_EQ(info.bv, "aabb");
-  EXPECT_EQ(info.grid, 2);
-  EXPECT_EQ(info.tau, 0.5);
+  EXPECT_EQ(info.density, "adb");
+  EXPECT_EQ(info.annotation, "adb grid=2 tau=0.5");
   EXPECT_EQ(info.triangles, built.model.triangles);
   EXPECT_FALSE(is_saved_tree(dir / "torus.obj"));
 
   QueryRequest request;
   request.hierarchy = aabb;
-  request.annotation = annotation;
-  request.strategy.kind = StrategyKind::Adb;
-  request.strategy.p_min = 0.9;
+  request.density = annotation;
+  request.strategy.strategy = "adb";
+  request.strategy.values = {{"p_min", 0.9}};
   options.cache_dir.clear();
   for (int step = 0; step < 40; step += 7) {
     const RigidTransform pose = protocol_pose(1.3, step, 40);

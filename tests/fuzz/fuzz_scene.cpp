@@ -4,8 +4,10 @@
 // A SceneError naming the source is the expected way to refuse. Anything else -- another exception, a crash,
 // a sanitizer report, or an accepted scene that breaks the parser's promises (every transform rigid and
 // finite, every name resolvable) -- is a finding.
+#include "bench/core/policies.hpp"
 #include "bench/core/scene.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -43,11 +45,14 @@ void check_scene(const bvhlab::Scene& scene) {
   for (const auto& p : scene.pairs)
     if (!scene.object(p.a) || !scene.object(p.b)) broken_promise("pair names an unknown object");
   for (const auto& s : scene.strategies) {
-    for (double p : s.p_min)
-      if (!(p >= 0 && p <= 1)) broken_promise("p_min outside [0, 1]");
     for (const auto& name : s.hierarchies)
       if (!scene.hierarchy(name)) broken_promise("strategy names an unknown hierarchy");
-    for (const auto& v : expand(s)) (void)v.label();
+    const StrategyInfo& info = strategy_info(s.name);
+    for (const auto& v : expand(s)) {  // every accepted value lies in its parameter's range
+      (void)v.label();
+      for (const ParamSpec& p : info.parameters)
+        if (!p.problem(v.value_or(p.name, std::nan(""))).empty()) broken_promise("parameter out of range");
+    }
   }
   for (const auto& g : scene.workload.groups)
     for (const auto& pose : g.poses) check_rigid(pose, "pose");

@@ -1,7 +1,7 @@
 // Shared pieces of the robustness suite: small exact meshes, frame changes, annotation, and every strategy.
 #pragma once
 
-#include "adb/annotate.hpp"
+#include "adb/adb_density.hpp"
 #include "adb/tree.hpp"
 #include "bvh/bvh.hpp"
 #include "traversal/adb.hpp"
@@ -50,8 +50,17 @@ inline Mesh moved(Mesh m, const RigidTransform& pose) {
 }
 
 constexpr int kGrid = 2;
+
+/// pc = min(g^3, triangles below the node): a stand-in annotation for tests whose point is not the counts.
 template <class BV>
-using Annotated = Tree<BV, AdbDensity<kGrid>>;
+Tree<BV, AdbDensity> with_stand_in_annotation(Bvh<BV> bvh) {
+  std::vector<std::uint8_t> counts;
+  for (const auto& [begin, end] : node_triangle_ranges(bvh.nodes()))
+    counts.push_back(static_cast<std::uint8_t>(std::min<std::uint32_t>(kGrid * kGrid * kGrid, end - begin)));
+  return {std::move(bvh), AdbDensity::make_storage({kGrid, kDefaultAdbTau}, std::move(counts))};
+}
+template <class BV>
+using Annotated = Tree<BV, AdbDensity>;
 
 /// The real ADB annotation (adb/annotate.hpp), single-threaded so the tests stay deterministic in cost.
 /// Where annotate does not (yet) accept a volume model, a crude stand-in keeps the traversal tests running:
@@ -61,22 +70,16 @@ template <class BV>
 Annotated<BV> annotated(const Mesh& mesh, const BuildOptions& build = {}) {
   AnnotateOptions options;
   options.threads = 1;
-  if constexpr (requires { annotate<kGrid>(Bvh<BV>::build(mesh, build), options); }) {
-    return annotate<kGrid>(Bvh<BV>::build(mesh, build), options);
+  if constexpr (requires { annotate_adb(Bvh<BV>::build(mesh, build), kGrid, options); }) {
+    return annotate_adb(Bvh<BV>::build(mesh, build), kGrid, options);
   } else {
-    Annotated<BV> tree{Bvh<BV>::build(mesh, build), {}};
-    for (const auto& [begin, end] : node_triangle_ranges(tree.bvh.nodes()))
-      tree.density.possible_collision_cells.push_back(
-          static_cast<std::uint8_t>(std::min<std::uint32_t>(AdbDensity<kGrid>::cells, end - begin)));
-    tree.density.tau = kDefaultAdbTau;
-    return tree;
+    return with_stand_in_annotation(Bvh<BV>::build(mesh, build));
   }
 }
 
-/// One model for the whole suite: grid 2, the default tau.
+/// The model every annotated tree of the suite shares: grid 2, the default tau.
 inline const AdbModel& shared_model() {
-  static const AdbModel model(kGrid, kDefaultAdbTau);
-  return model;
+  return *shared_adb_model(kGrid, kDefaultAdbTau);
 }
 
 /// Every strategy the library offers, by name, so a test can run all of them on one pose.
@@ -115,13 +118,13 @@ Result run(Strategy s, const Annotated<BV>& a, const Annotated<BV>& b, const Rig
     case Strategy::ExactAll:
       return query_exact(a.bvh, b.bvh, pose, ContactMode::All);
     case Strategy::AdbPmin:
-      return query_adb(a, b, pose, shared_model(), options);
+      return query_adb(a, b, pose, options);
     case Strategy::AdbBudget:
       options.budget.max_bv_tests = max_bv_tests;
-      return query_adb(a, b, pose, shared_model(), options);
+      return query_adb(a, b, pose, options);
     case Strategy::GuidedExact:
       options.exact_leaves = true;
-      return query_adb(a, b, pose, shared_model(), options);
+      return query_adb(a, b, pose, options);
   }
   throw std::logic_error("unknown strategy");
 }

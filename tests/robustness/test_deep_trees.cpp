@@ -34,16 +34,8 @@ Mesh line_mesh(const std::function<double(std::size_t)>& x, double h) {
   return m;
 }
 
-// pc = min(g^3, triangles below the node): the real annotation clips every triangle once per tree level,
-// which on these trees is the annotation's own cost, not what this test is about.
-Annotated<Aabb> with_stand_in_annotation(Bvh<Aabb> bvh) {
-  Annotated<Aabb> tree{std::move(bvh), {}};
-  for (const auto& [begin, end] : node_triangle_ranges(tree.bvh.nodes()))
-    tree.density.possible_collision_cells.push_back(
-        static_cast<std::uint8_t>(std::min<std::uint32_t>(AdbDensity<kGrid>::cells, end - begin)));
-  tree.density.tau = kDefaultAdbTau;
-  return tree;
-}
+// with_stand_in_annotation (robust_support.hpp): the real annotation clips every triangle once per tree
+// level, which on these trees is the annotation's own cost, not what this test is about.
 
 // One small triangle standing across the line at x = at: it touches exactly the line's triangles around at.
 Mesh probe_at(double at) {

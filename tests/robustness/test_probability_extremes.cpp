@@ -202,11 +202,11 @@ TEST(ProbabilityExtremes, PMinOneDrainsAndPMinZeroDecidesOnAnyEvidence) {
     const bool expected = truth.collides(pose);
     AdbOptions never;
     never.p_min = 1.0;
-    const Result drained = query_adb(tree, tree, pose, shared_model(), never);
+    const Result drained = query_adb(tree, tree, pose, never);
     EXPECT_TRUE(honest(drained, expected)) << "d " << d;
     AdbOptions eager;
     eager.p_min = 0.0;
-    const Result decided = query_adb(tree, tree, pose, shared_model(), eager);
+    const Result decided = query_adb(tree, tree, pose, eager);
     EXPECT_TRUE(honest(decided, expected)) << "d " << d;
     if (decided.collides) {
       EXPECT_GT(decided.probability, 0.0);

@@ -153,7 +153,7 @@ TEST(Threads, ConcurrentBuildsAndAnnotationsAreIdentical) {
     options.threads = 2;
     BuildOptions build;
     build.threads = 2;
-    return annotate<kGrid>(Bvh<Aabb>::build(teapot, build), options);
+    return annotate_adb(Bvh<Aabb>::build(teapot, build), kGrid, options);
   };
   const auto reference = make();
   std::vector<Annotated<Aabb>> got(kThreads);

@@ -1,5 +1,5 @@
 // ADB strategies: guided exact equals exact; budgets are honoured; p_min behaves at its ends.
-#include "adb/tree.hpp"
+#include "adb/adb_density.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/adb.hpp"
 #include "traversal/exact.hpp"
@@ -15,22 +15,18 @@ namespace {
 
 // A crude stand-in annotation, independent of adb/annotate: pc = min(g^3, triangles below the node).
 template <int G, class BV = Aabb>
-Tree<BV, AdbDensity<G>> crude_annotation(Bvh<BV> bvh, double tau) {
-  Tree<BV, AdbDensity<G>> tree{std::move(bvh), {}};
-  const auto ranges = node_triangle_ranges(tree.bvh.nodes());
-  for (const auto& [begin, end] : ranges)
-    tree.density.possible_collision_cells.push_back(
-        static_cast<std::uint8_t>(std::min<std::uint32_t>(AdbDensity<G>::cells, end - begin)));
-  tree.density.tau = tau;
-  return tree;
+Tree<BV, AdbDensity> crude_annotation(Bvh<BV> bvh, double tau) {
+  std::vector<std::uint8_t> counts;
+  for (const auto& [begin, end] : node_triangle_ranges(bvh.nodes()))
+    counts.push_back(static_cast<std::uint8_t>(std::min<std::uint32_t>(G * G * G, end - begin)));
+  return {std::move(bvh), AdbDensity::make_storage({G, tau}, std::move(counts))};
 }
 
 struct Scene {
   Mesh a = testing::make_torus(0.7, 0.25, 40, 20);
   Mesh b = testing::make_random_soup(500, 0.1, 3);
-  Tree<Aabb, AdbDensity<2>> tree_a = crude_annotation<2>(Bvh<Aabb>::build(a), 0.5);
-  Tree<Aabb, AdbDensity<2>> tree_b = crude_annotation<2>(Bvh<Aabb>::build(b), 0.5);
-  AdbModel model{2, 0.5};
+  Tree<Aabb, AdbDensity> tree_a = crude_annotation<2>(Bvh<Aabb>::build(a), 0.5);
+  Tree<Aabb, AdbDensity> tree_b = crude_annotation<2>(Bvh<Aabb>::build(b), 0.5);
 };
 
 TEST(AdbTraversal, GuidedExactEqualsExactTraversal) {
@@ -41,7 +37,7 @@ TEST(AdbTraversal, GuidedExactEqualsExactTraversal) {
   int colliding = 0;
   for (int k = 0; k < 300; ++k) {
     const RigidTransform pose = testing::random_pose(rng, 1.5);
-    const Result guided = query_adb(scene.tree_a, scene.tree_b, pose, scene.model, options);
+    const Result guided = query_adb(scene.tree_a, scene.tree_b, pose, options);
     const Result exact = query_exact(scene.tree_a.bvh, scene.tree_b.bvh, pose);
     ASSERT_EQ(guided.collides, exact.collides) << "pose " << k;
     ASSERT_TRUE(guided.exact);
@@ -60,7 +56,7 @@ TEST(AdbTraversal, GuidedExactOnTheRestrictedBoxtree) {
   std::mt19937_64 rng(31);
   for (int k = 0; k < 200; ++k) {
     const RigidTransform pose = testing::random_pose(rng, 1.5);
-    const Result r = query_adb(tree_a, tree_b, pose, scene.model, guided);
+    const Result r = query_adb(tree_a, tree_b, pose, guided);
     ASSERT_EQ(r.collides, query_exact(scene.tree_a.bvh, scene.tree_b.bvh, pose).collides) << "pose " << k;
   }
 }
@@ -73,8 +69,7 @@ TEST(AdbTraversal, BvTestBudgetIsNeverExceeded) {
     options.p_min = 1.0;  // never decisive: the traversal runs until the budget stops it
     options.budget.max_bv_tests = budget;
     for (int k = 0; k < 50; ++k) {
-      const Result r =
-          query_adb(scene.tree_a, scene.tree_b, testing::random_pose(rng, 0.5), scene.model, options);
+      const Result r = query_adb(scene.tree_a, scene.tree_b, testing::random_pose(rng, 0.5), options);
       EXPECT_LE(r.counters.bv_tests, budget);
       if (r.budget_exhausted) {
         EXPECT_FALSE(r.exact);
@@ -91,14 +86,14 @@ TEST(AdbTraversal, PMinEnds) {
   const RigidTransform overlapping = RigidTransform::identity();
   AdbOptions eager;
   eager.p_min = 0.0;  // any positive estimate decides
-  const Result r0 = query_adb(scene.tree_a, scene.tree_a, overlapping, scene.model, eager);
+  const Result r0 = query_adb(scene.tree_a, scene.tree_a, overlapping, eager);
   EXPECT_TRUE(r0.collides);
   EXPECT_FALSE(r0.exact);
   EXPECT_GT(r0.probability, 0.0);
 
   AdbOptions never;
   never.p_min = 1.0;  // no estimate exceeds 1: the queue drains, leaves are dropped, the answer is inexact
-  const Result r1 = query_adb(scene.tree_a, scene.tree_a, overlapping, scene.model, never);
+  const Result r1 = query_adb(scene.tree_a, scene.tree_a, overlapping, never);
   EXPECT_FALSE(r1.collides);
   EXPECT_FALSE(r1.exact);
 }
@@ -115,10 +110,12 @@ TEST(AdbTraversal, CombiningLeafEvidenceOnlyAddsCollisionsAndNeverCostsMore) {
       literal.combine_leaf_evidence = false;
       AdbOptions combined = literal;
       combined.combine_leaf_evidence = true;
-      const Result a = query_adb(scene.tree_a, scene.tree_b, pose, scene.model, literal);
-      const Result b = query_adb(scene.tree_a, scene.tree_b, pose, scene.model, combined);
+      const Result a = query_adb(scene.tree_a, scene.tree_b, pose, literal);
+      const Result b = query_adb(scene.tree_a, scene.tree_b, pose, combined);
       // Same traversal order until the combined evidence decides, so a literal "collision" is found too.
-      if (a.collides) EXPECT_TRUE(b.collides) << "pose " << k;
+      if (a.collides) {
+        EXPECT_TRUE(b.collides) << "pose " << k;
+      }
       EXPECT_LE(b.counters.bv_tests, a.counters.bv_tests);
       EXPECT_TRUE(b.probability >= 0 && b.probability <= 1);
       changed += a.collides != b.collides;
@@ -131,20 +128,17 @@ TEST(AdbTraversal, ConfirmationNeverDecidesOnASingleCoarsePair) {
   AdbOptions confirm;
   confirm.p_min = 0.0;  // every overlapping pair exceeds p_min: without confirmation the root decides
   confirm.confirm_with_children = true;
-  const Result r = query_adb(scene.tree_a, scene.tree_a, RigidTransform::identity(), scene.model, confirm);
+  const Result r = query_adb(scene.tree_a, scene.tree_a, RigidTransform::identity(), confirm);
   EXPECT_TRUE(r.collides);
   EXPECT_GT(r.counters.bv_tests, 1u);  // the root's children were consulted
   AdbOptions literal = confirm;
   literal.confirm_with_children = false;
-  EXPECT_EQ(query_adb(scene.tree_a, scene.tree_a, RigidTransform::identity(), scene.model, literal)
-                .counters.bv_tests,
-            1u);
+  EXPECT_EQ(query_adb(scene.tree_a, scene.tree_a, RigidTransform::identity(), literal).counters.bv_tests, 1u);
 }
 
 TEST(AdbTraversal, DisjointIsAnExactNo) {
   const Scene scene;
-  const Result r =
-      query_adb(scene.tree_a, scene.tree_b, RigidTransform::translate(Vec3(10, 0, 0)), scene.model, {});
+  const Result r = query_adb(scene.tree_a, scene.tree_b, RigidTransform::translate(Vec3(10, 0, 0)), {});
   EXPECT_FALSE(r.collides);
   EXPECT_TRUE(r.exact);
   EXPECT_EQ(r.counters.bv_tests, 1u);
@@ -154,11 +148,14 @@ TEST(AdbTraversal, NonsenseOptionsAndMismatchedTauAreRejected) {
   const Scene scene;
   AdbOptions bad;
   bad.p_min = std::nan("");
-  EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, scene.model, bad), std::invalid_argument);
+  EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, bad), std::invalid_argument);
   bad.p_min = 1.5;
-  EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, scene.model, bad), std::invalid_argument);
-  const AdbModel other_tau(2, 0.25);
-  EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, other_tau, {}), std::invalid_argument);
+  EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, bad), std::invalid_argument);
+  // Trees annotated with another tau (or grid) cannot share one model: refused, not mixed.
+  const auto other_tau = crude_annotation<2>(Bvh<Aabb>::build(scene.b), 0.25);
+  EXPECT_THROW(query_adb(scene.tree_a, other_tau, {}, AdbOptions{}), std::invalid_argument);
+  const auto other_grid = crude_annotation<3>(Bvh<Aabb>::build(scene.b), 0.5);
+  EXPECT_THROW(query_adb(scene.tree_a, other_grid, {}, AdbOptions{}), std::invalid_argument);
 }
 
 Box cube(double side) {

@@ -1,6 +1,6 @@
 // The benchmark protocol on real meshes: every registered BV gives exactly CGAL's answer on every pose,
 // and the colliding fractions match the reference table measured with FCL (shared/meshes/README.md).
-#include "adb/annotate.hpp"
+#include "adb/adb_density.hpp"
 #include "bench/core/ground_truth.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
@@ -62,15 +62,14 @@ void check_mesh(const Reference& ref) {
   });
 
   // Guided exact (ADB order, exact leaves) on the real annotation: the same answer on every pose.
-  const auto annotated = annotate<2>(Bvh<Aabb>::build(mesh));
-  const AdbModel model(2, annotated.density.tau);
+  const auto annotated = annotate_adb(Bvh<Aabb>::build(mesh), 2);
   AdbOptions guided;
   guided.exact_leaves = true;
   std::size_t guided_mismatches = 0;
   for (std::size_t d = 0; d < protocol.distances.size(); ++d)
     for (int k = 0; k < kSteps; ++k) {
       const Result r =
-          query_adb(annotated, annotated, protocol_pose(protocol.distances[d], k, kSteps), model, guided);
+          query_adb(annotated, annotated, protocol_pose(protocol.distances[d], k, kSteps), guided);
       guided_mismatches += r.collides != static_cast<bool>(expected[d][k]) || !r.exact;
     }
   EXPECT_EQ(guided_mismatches, 0u) << ref.file << " guided exact";

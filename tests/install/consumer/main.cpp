@@ -1,7 +1,6 @@
 // Builds two trees over a generated mesh and runs an exact and an ADB query through the installed headers.
-#include <adb/annotate.hpp>
-#include <traversal/adb.hpp>
-#include <traversal/exact.hpp>
+#include <adb/adb_density.hpp>
+#include <traversal/strategies.hpp>
 #include <volumes/aabb.hpp>
 
 #include <cstdio>
@@ -20,9 +19,10 @@ int main() {
   const auto tree = Bvh<Aabb>::build(mesh);
   const Result touching = query_exact(tree, tree, RigidTransform::translate(Vec3(0.05, 0, 0)));
   const Result apart = query_exact(tree, tree, RigidTransform::translate(Vec3(0, 5, 0)));
-  const auto annotated = annotate<2>(Bvh<Aabb>::build(mesh));
-  const AdbModel model(2, annotated.density.tau);
-  const Result adb = query_adb(annotated, annotated, RigidTransform::identity(), model, AdbOptions{});
+  // The ADB strategy through its policy: parameters checked against its table, the model from the trees.
+  const auto annotated = annotate_adb(Bvh<Aabb>::build(mesh));
+  const auto options = strategy_options<AdbStrategy>({{"p_min", 0.9}});
+  const Result adb = AdbStrategy::query(annotated, annotated, RigidTransform::identity(), options);
   std::printf("exact: %d %d, adb: %d (p = %.3f)\n", touching.collides, apart.collides, adb.collides,
               adb.probability);
   return touching.collides && !apart.collides && adb.collides ? 0 : 1;

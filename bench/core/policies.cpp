@@ -1,0 +1,141 @@
+#include "bench/core/policies.hpp"
+
+#include "bench/core/registry.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace bvhlab {
+
+namespace {
+
+template <class D>
+DensityInfo density_row() {
+  const auto specs = D::parameters();
+  return {std::string(D::name()), D::version(), {specs.begin(), specs.end()}};
+}
+
+template <class S>
+StrategyInfo strategy_row() {
+  StrategyInfo info;
+  info.name = S::name();
+  info.description = S::description();
+  info.exact = S::exact;
+  info.budget = S::budget;
+  info.needs_polygons = S::needs_polygons;
+  info.needs_density = !S::template accepts<NoDensity>;
+  with_each_density([&]<class D>(std::type_identity<D>) {
+    if constexpr (S::template accepts<D>) info.densities.emplace_back(D::name());
+  });
+  const auto specs = S::parameters();
+  info.parameters.assign(specs.begin(), specs.end());
+  return info;
+}
+
+template <class Row>
+const Row& find_named(const std::vector<Row>& table, std::string_view name, std::string_view kind) {
+  for (const Row& row : table)
+    if (row.name == name) return row;
+  std::string known;
+  for (const Row& row : table) known += (known.empty() ? "" : ", ") + row.name;
+  throw std::invalid_argument("unknown " + std::string(kind) + " '" + std::string(name) +
+                              "' (known: " + known + ")");
+}
+
+nlohmann::json parameters_json(const std::vector<ParamSpec>& specs) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ParamSpec& p : specs) {
+    nlohmann::json row = {{"name", p.name},       {"description", p.description},
+                          {"min", p.min},         {"max", p.max},
+                          {"integer", p.integer}, {"exclusive_min", p.exclusive_min},
+                          {"sweep", p.sweep},     {"in_label", p.in_label}};
+    row["default"] = p.required() ? nlohmann::json(nullptr) : nlohmann::json(p.default_value);
+    out.push_back(std::move(row));
+  }
+  return out;
+}
+
+std::string_view budget_text(BudgetUse use) {
+  switch (use) {
+    case BudgetUse::None:
+      return "none";
+    case BudgetUse::Optional:
+      return "optional";
+    case BudgetUse::Required:
+      return "required";
+  }
+  return "none";
+}
+
+}  // namespace
+
+bool StrategyInfo::accepts(std::string_view density) const {
+  return std::find(densities.begin(), densities.end(), density) != densities.end();
+}
+
+const ParamSpec* StrategyInfo::parameter(std::string_view name) const {
+  for (const ParamSpec& p : parameters)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+const std::vector<DensityInfo>& density_table() {
+  static const std::vector<DensityInfo> table = [] {
+    std::vector<DensityInfo> rows;
+    with_each_density([&]<class D>(std::type_identity<D>) { rows.push_back(density_row<D>()); });
+    return rows;
+  }();
+  return table;
+}
+
+const std::vector<StrategyInfo>& strategy_table() {
+  static const std::vector<StrategyInfo> table = [] {
+    std::vector<StrategyInfo> rows;
+    with_each_strategy([&]<class S>(std::type_identity<S>) { rows.push_back(strategy_row<S>()); });
+    return rows;
+  }();
+  return table;
+}
+
+const DensityInfo& density_info(std::string_view name) {
+  return find_named(density_table(), name, "density");
+}
+
+const StrategyInfo& strategy_info(std::string_view name) {
+  return find_named(strategy_table(), name, "strategy");
+}
+
+std::string density_label(std::string_view density, const ParamValues& values) {
+  const std::string params =
+      describe_parameters(density_info(density).parameters, values, [](const ParamSpec&) { return true; });
+  return std::string(density) + (params.empty() ? "" : " " + params);
+}
+
+std::string strategy_label(std::string_view strategy, const ParamValues& values, const Budget& budget) {
+  const std::string params = describe_parameters(strategy_info(strategy).parameters, values,
+                                                 [](const ParamSpec& p) { return p.in_label; });
+  const std::string budget_text = budget_label(budget);
+  return std::string(strategy) + (params.empty() ? "" : " " + params) +
+         (budget_text.empty() ? "" : " " + budget_text);
+}
+
+nlohmann::json policies_json() {
+  nlohmann::json densities = nlohmann::json::array(), strategies = nlohmann::json::array();
+  for (const DensityInfo& d : density_table())
+    densities.push_back(
+        {{"name", d.name}, {"version", d.version}, {"parameters", parameters_json(d.parameters)}});
+  for (const StrategyInfo& s : strategy_table())
+    strategies.push_back({{"name", s.name},
+                          {"description", s.description},
+                          {"exact", s.exact},
+                          {"budget", budget_text(s.budget)},
+                          {"needs_polygons", s.needs_polygons},
+                          {"needs_density", s.needs_density},
+                          {"densities", s.densities},
+                          {"parameters", parameters_json(s.parameters)}});
+  return {{"densities", densities}, {"strategies", strategies}};
+}
+
+}  // namespace bvhlab

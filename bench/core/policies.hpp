@@ -1,0 +1,51 @@
+// The registered densities and strategies (bench/core/registry.hpp) as run-time tables: what the scene
+// parser, the CLI, the runner, the report and the plot script read to name, check and label them. Nothing
+// outside a policy's header and its registry line says which strategies exist or what they take.
+#pragma once
+
+#include "adb/parameters.hpp"
+#include "traversal/strategy.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bvhlab {
+
+struct DensityInfo {
+  std::string name;
+  std::uint32_t version = 0;
+  std::vector<ParamSpec> parameters;
+};
+
+struct StrategyInfo {
+  std::string name, description;
+  bool exact = false;  ///< answers agree with the exact ground truth
+  BudgetUse budget = BudgetUse::None;
+  bool needs_polygons = false;         ///< cannot run on trees saved without polygons
+  bool needs_density = false;          ///< does not run on trees without a density
+  std::vector<std::string> densities;  ///< the registered densities it runs on
+  std::vector<ParamSpec> parameters;
+  [[nodiscard]] bool accepts(std::string_view density) const;
+  [[nodiscard]] const ParamSpec* parameter(std::string_view name) const;
+};
+
+/// In registration order.
+const std::vector<DensityInfo>& density_table();
+const std::vector<StrategyInfo>& strategy_table();
+/// Throw std::invalid_argument naming the choices for an unknown name.
+const DensityInfo& density_info(std::string_view name);
+const StrategyInfo& strategy_info(std::string_view name);
+
+/// "none", or "adb grid=2 tau=0.25": the density's name and every parameter, as reports label trees.
+std::string density_label(std::string_view density, const ParamValues& values);
+/// "adb p_min=0.9", "time_critical p_min=0.9 bv_tests=50": the name, its labelled parameters, the budget.
+std::string strategy_label(std::string_view strategy, const ParamValues& values, const Budget& budget);
+
+/// Both tables as JSON ({"densities": [...], "strategies": [...]}) for results.json and `bvhlab policies`.
+nlohmann::json policies_json();
+
+}  // namespace bvhlab

@@ -1,0 +1,127 @@
+// The shipped traversal strategies (concept: traversal/strategy.hpp). Each is a thin configuration of the
+// traversal loops in traversal/exact.hpp and traversal/adb.hpp.
+#pragma once
+
+#include "adb/parameters.hpp"
+#include "traversal/adb.hpp"
+#include "traversal/exact.hpp"
+#include "traversal/strategy.hpp"
+
+#include <span>
+
+namespace bvhlab {
+
+namespace strategy_detail {
+
+inline constexpr ParamSpec kPMinSweep{.name = "p_min",
+                                      .description = "answer \"collision\" once a pair's estimate exceeds it",
+                                      .min = 0,
+                                      .max = 1,
+                                      .default_value = 0.9,
+                                      .sweep = true,
+                                      .in_label = true};
+inline constexpr ParamSpec kTimeCritical[] = {
+    {.name = "p_min",
+     .description = "answer \"collision\" once a pair's estimate exceeds it",
+     .min = 0,
+     .max = 1,
+     .default_value = 0.9,
+     .in_label = true},
+    {.name = "best_effort_threshold",
+     .description = "on an exhausted budget, \"collision\" iff the best estimate left is at least this",
+     .min = 0,
+     .max = 1,
+     .default_value = 0.5},
+};
+
+}  // namespace strategy_detail
+
+/// Exact first contact: depth-first simultaneous descent, exact triangle tests at the leaves.
+struct ExactStrategy {
+  using Options = ContactMode;
+  static constexpr std::string_view name() { return "exact"; }
+  static constexpr std::string_view description() { return "exact first contact, depth first"; }
+  static constexpr bool exact = true;
+  static constexpr BudgetUse budget = BudgetUse::None;
+  static constexpr bool needs_polygons = true;
+  template <class D>
+  static constexpr bool accepts = true;
+  static std::span<const ParamSpec> parameters() { return {}; }
+  static Options configure(const ParamValues&, const Budget&) { return ContactMode::First; }
+  template <class TreeA, class TreeB>
+  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options mode) {
+    return query_exact(a.bvh, b.bvh, b_to_a, mode);
+  }
+};
+
+/// Every intersecting triangle pair (Result::contacts), exactly.
+struct AllContactsStrategy : ExactStrategy {
+  static constexpr std::string_view name() { return "all_contacts"; }
+  static constexpr std::string_view description() { return "every intersecting triangle pair, exactly"; }
+  static Options configure(const ParamValues&, const Budget&) { return ContactMode::All; }
+};
+
+/// The ADB order (best first by estimated probability) with exact leaf tests and no pruning: exact.
+struct GuidedExactStrategy {
+  using Options = AdbOptions;
+  static constexpr std::string_view name() { return "guided_exact"; }
+  static constexpr std::string_view description() {
+    return "exact, visiting pairs best first by estimated probability";
+  }
+  static constexpr bool exact = true;
+  static constexpr BudgetUse budget = BudgetUse::None;
+  static constexpr bool needs_polygons = true;
+  template <class D>
+  static constexpr bool accepts = ProbabilityDensity<D>;
+  static std::span<const ParamSpec> parameters() { return {}; }
+  static Options configure(const ParamValues&, const Budget&) {
+    Options options;
+    options.p_min = 1;
+    options.exact_leaves = true;
+    return options;
+  }
+  template <class TreeA, class TreeB>
+  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options) {
+    return query_adb(a, b, b_to_a, options);
+  }
+};
+
+/// ADB with p_min: "collision" once a pair's estimated probability exceeds p_min (adb/README.md, section 3).
+struct AdbStrategy : GuidedExactStrategy {
+  static constexpr std::string_view name() { return "adb"; }
+  static constexpr std::string_view description() {
+    return "average-case: collision once a pair's estimated probability exceeds p_min";
+  }
+  static constexpr bool exact = false;
+  static constexpr bool needs_polygons = false;
+  static std::span<const ParamSpec> parameters() { return {&strategy_detail::kPMinSweep, 1}; }
+  static Options configure(const ParamValues& values, const Budget&) {
+    Options options;
+    options.p_min = parameter(values, "p_min");
+    options.validate();
+    return options;
+  }
+};
+
+/// ADB under a budget of BV tests and/or a deadline; on exhaustion, a best-effort answer.
+struct TimeCriticalStrategy : AdbStrategy {
+  static constexpr std::string_view name() { return "time_critical"; }
+  static constexpr std::string_view description() {
+    return "ADB under a budget of BV tests and/or microseconds, best effort on exhaustion";
+  }
+  static constexpr BudgetUse budget = BudgetUse::Required;
+  static std::span<const ParamSpec> parameters() { return strategy_detail::kTimeCritical; }
+  static Options configure(const ParamValues& values, const Budget& budget) {
+    Options options;
+    options.p_min = parameter(values, "p_min");
+    options.best_effort_threshold = parameter(values, "best_effort_threshold");
+    options.budget = budget;
+    options.validate();
+    return options;
+  }
+};
+
+static_assert(Strategy<ExactStrategy> && Strategy<AllContactsStrategy> && Strategy<GuidedExactStrategy> &&
+              Strategy<AdbStrategy> && Strategy<TimeCriticalStrategy>);
+
+}  // namespace bvhlab

@@ -1,0 +1,73 @@
+// The Strategy concept: what a traversal strategy must provide so that scenes, the CLI, the runner, the
+// report and the plot script can name it, configure it and run it. The shipped strategies are
+// traversal/strategies.hpp; the registry that names them at run time is bench/core/registry.hpp.
+//
+// Concept `Strategy<S>` (in the manner of a CGAL concept page)
+// ------------------------------------------------------------
+// Constants and types
+//   S::name()              Stable identifier ("exact", "adb"): scene "type", CLI --strategy, result rows.
+//   S::description()       One line for help texts and reports.
+//   S::exact               constexpr bool: every answer agrees with the exact ground truth (such a
+//                          strategy may serve as a report's baseline; an inexact one reports its errors).
+//   S::budget              constexpr BudgetUse: whether a Budget (BV tests and/or a deadline) is
+//                          refused, optional or required.
+//   S::needs_polygons      constexpr bool: the query tests triangles, so trees saved without polygons
+//                          cannot serve it.
+//   S::accepts<D>          constexpr bool (a variable template): it runs on trees with density D, e.g.
+//                          only ProbabilityDensity models for the ADB strategies.
+//   S::Options             What one configured query needs.
+// Operations
+//   S::parameters()                 std::span<const ParamSpec>: its parameters (adb/parameters.hpp). A
+//                                   `sweep` parameter may be given as a list: one variant per value.
+//   S::configure(values, budget)    Options from resolved values and a budget (unlimited when S::budget is
+//                                   None); throws std::invalid_argument for a bad combination.
+//   S::query(a, b, b_to_a, options) Result for two Tree<BV, D> with accepts<D>; const and thread-safe.
+#pragma once
+
+#include "adb/parameters.hpp"
+#include "traversal/adb.hpp"
+#include "traversal/result.hpp"
+
+#include <concepts>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace bvhlab {
+
+enum class BudgetUse { None, Optional, Required };
+
+template <class S>
+concept Strategy = requires(const ParamValues& values, const Budget& budget) {
+  { S::name() } -> std::convertible_to<std::string_view>;
+  { S::description() } -> std::convertible_to<std::string_view>;
+  { S::exact } -> std::convertible_to<bool>;
+  { S::budget } -> std::convertible_to<BudgetUse>;
+  { S::needs_polygons } -> std::convertible_to<bool>;
+  { S::template accepts<NoDensity> } -> std::convertible_to<bool>;
+  { S::parameters() } -> std::same_as<std::span<const ParamSpec>>;
+  { S::configure(values, budget) } -> std::same_as<typename S::Options>;
+};
+
+/// "bv_tests=200", "deadline_us=20", "bv_tests=200;deadline_us=20", or "" when unlimited.
+inline std::string budget_label(const Budget& budget) {
+  std::string out;
+  if (budget.max_bv_tests) out += "bv_tests=" + std::to_string(budget.max_bv_tests);
+  if (budget.deadline_us > 0)
+    out += (out.empty() ? "" : ";") + std::string("deadline_us=") + parameter_text(budget.deadline_us);
+  return out;
+}
+
+/// The options of S from name/value pairs and a budget: values checked against S::parameters() (defaults
+/// filled in), the budget against S::budget. Throws std::invalid_argument naming the strategy and problem.
+template <Strategy S>
+typename S::Options strategy_options(const ParamValues& given = {}, const Budget& budget = {}) {
+  const std::string owner(S::name());
+  if (S::budget == BudgetUse::None && !budget.unlimited())
+    throw std::invalid_argument(owner + ": takes no budget (" + budget_label(budget) + " given)");
+  if (S::budget == BudgetUse::Required && budget.unlimited())
+    throw std::invalid_argument(owner + ": needs a budget (BV tests and/or a deadline)");
+  return S::configure(resolve_parameters(S::parameters(), given, owner), budget);
+}
+
+}  // namespace bvhlab
