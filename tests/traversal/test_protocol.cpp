@@ -1,5 +1,5 @@
 // The benchmark protocol on real meshes: every registered BV gives exactly CGAL's answer on every pose,
-// and the colliding fractions match the reference table measured with FCL (shared/meshes/README.md).
+// and the colliding fractions match the reference table measured with FCL (adb/README.md, section 4).
 #include "adb/adb_density.hpp"
 #include "bench/core/ground_truth.hpp"
 #include "bench/core/protocol.hpp"
@@ -22,7 +22,7 @@ constexpr int kSteps = 500;  // every 10th pose of the 5000-step protocol
 struct Reference {
   std::string file;
   bool bundled;
-  std::array<double, 9> colliding_percent;  // d = 0.4 .. 2.0, from shared/meshes/README.md (5000 steps)
+  std::array<double, 9> colliding_percent;  // d = 0.4 .. 2.0, adb/README.md, section 4 (5000 steps)
 };
 
 void check_mesh(const Reference& ref) {
