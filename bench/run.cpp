@@ -5,6 +5,7 @@
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
 #include "bench/core/tree_cache.hpp"
+#include "bench/plan.hpp"
 #include "bvh/mesh_io.hpp"
 #include "traversal/strategies.hpp"
 
@@ -411,8 +412,10 @@ class TreeStore {
   std::vector<std::string> order_;
 };
 
-std::unique_ptr<PreparedHierarchy> prepare(const Scene& scene, const HierarchySpec& h, const ObjectData& a,
+/// The planned hierarchy's trees (or FCL models) for objects a and b, ready to time.
+std::unique_ptr<PreparedHierarchy> prepare(const PlannedHierarchy& planned, const ObjectData& a,
                                            const ObjectData& b, TreeStore& store) {
+  const HierarchySpec& h = *planned.hierarchy;
   std::unique_ptr<PreparedHierarchy> out;
   ModelInfo info;
   if (h.is_fcl()) {
@@ -432,8 +435,7 @@ std::unique_ptr<PreparedHierarchy> prepare(const Scene& scene, const HierarchySp
     throw std::invalid_argument("hierarchy " + h.name + " needs FCL, which this build lacks");
 #endif
   } else {
-    // Only a hierarchy whose strategies need the density is annotated; exact strategies share its trees.
-    const DensitySpec density = scene.needs_density(h) ? scene.density : DensitySpec{};
+    const DensitySpec& density = planned.density;  // the plan decided whether the trees are annotated
     with_volume(h.bv, [&]<class BV>(std::type_identity<BV>) {
       with_density(density.name, [&]<class D>(std::type_identity<D>) {
         if constexpr (DensityFor<D, BV>) {
@@ -607,7 +609,7 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
                        const RigidTransform& pose, const RunOptions& options) {
   QueryOutcome outcome;
   const LogFn log = options.log ? options.log : LogFn([](const std::string& m) { std::cerr << m << '\n'; });
-  Scene scene;  // a one-hierarchy, one-strategy scene, so prepare() decides the density as a run would
+  Scene scene;  // a one-hierarchy, one-strategy scene, so the plan decides the density as for a run
   scene.hierarchies = {request.hierarchy};
   scene.density = request.density;
   StrategySpec strategy;
@@ -625,7 +627,11 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
   const ObjectData object_a = load_object(a);
   const ObjectData object_b = &a == &b ? ObjectData{} : load_object(b);
   const ObjectData& ob = &a == &b ? object_a : object_b;
-  auto hierarchy = prepare(scene, request.hierarchy, object_a, ob, store);
+  const PlannedHierarchy planned{
+      &scene.hierarchies.front(),
+      scene.needs_density(scene.hierarchies.front()) ? scene.density : DensitySpec{},
+      {request.strategy}};
+  auto hierarchy = prepare(planned, object_a, ob, store);
   const auto start = Clock::now();
   outcome.result = hierarchy->query(request.strategy, pose);
   outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
@@ -804,26 +810,14 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
     stats.skipped.push_back(note);
     log(note);
   }
-  // Objects: loaded on first use; an optional object without a mesh is skipped with its pairs.
-  std::map<std::string, ObjectData> objects;
-  std::vector<const ScenePair*> pairs;
-  for (const ScenePair& pair : scene.pairs) {
-    bool usable = true;
-    for (const std::string& name : {pair.a, pair.b}) {
-      const SceneObject& spec = *scene.object(name);
-      if (spec.path.empty()) {
-        usable = false;
-        const std::string why =
-            "object " + spec.name + " skipped: mesh \"" + spec.mesh +
-            "\" not found (bundled meshes/ or the mesh cache; fetch it with meshes/fetch.sh)";
-        if (std::find(stats.skipped.begin(), stats.skipped.end(), why) == stats.skipped.end()) {
-          stats.skipped.push_back(why);
-          log(why);
-        }
-      }
-    }
-    if (usable) pairs.push_back(&pair);
+  // What runs where, and on which trees: decided by the plan.
+  const RunPlan plan = plan_run(scene);
+  for (const std::string& why : plan.skipped) {
+    stats.skipped.push_back(why);
+    log(why);
   }
+  // Objects: loaded on first use.
+  std::map<std::string, ObjectData> objects;
   auto object = [&](const std::string& name) -> const ObjectData& {
     auto it = objects.find(name);
     if (it == objects.end()) {
@@ -835,33 +829,19 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
     return it->second;
   };
 
-  // What runs where: (hierarchy, variants) in scene order.
-  std::vector<std::pair<const HierarchySpec*, std::vector<StrategyVariant>>> plan;
-  for (const HierarchySpec& h : scene.hierarchies) {
-    std::vector<StrategyVariant> variants;
-    for (const StrategySpec& s : scene.strategies)
-      if (scene.applies(s, h))
-        for (const StrategyVariant& v : expand(s)) variants.push_back(v);
-    if (!variants.empty()) plan.emplace_back(&h, std::move(variants));
-  }
-  std::size_t total_queries = 0;
-  for (const auto& [h, variants] : plan)
-    for (const auto& group : scene.workload.groups) total_queries += variants.size() * group.poses.size();
-  total_queries *= pairs.size();
-
-  Progress progress(options.progress, total_queries);
+  Progress progress(options.progress, plan.total_queries);
   std::map<std::string, CalibrationAccumulator> calibration;
   std::map<std::string, CalibrationBin> calibration_keys;
   std::vector<std::string> calibration_order;
   std::vector<QueryRecord> block_records;
 
-  for (const ScenePair* pair : pairs) {
+  for (const ScenePair* pair : plan.pairs) {
     const ObjectData& a = object(pair->a);
     const ObjectData& b = object(pair->b);
     const std::string label = pair->label();
 
     std::vector<std::unique_ptr<PreparedHierarchy>> prepared;
-    for (const auto& [h, variants] : plan) prepared.push_back(prepare(scene, *h, a, b, store));
+    for (const PlannedHierarchy& h : plan.hierarchies) prepared.push_back(prepare(h, a, b, store));
 
     // Ground truth from the disk cache, else from the exact traversal on the first bvhlab hierarchy.
     const auto truth_start = Clock::now();
@@ -876,8 +856,8 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
         log("truth cache: rejected " + why + "; recomputing");
       }
       const PreparedHierarchy* exact = nullptr;
-      for (std::size_t i = 0; i < plan.size() && !exact; ++i)
-        if (!plan[i].first->is_fcl()) exact = prepared[i].get();
+      for (std::size_t i = 0; i < plan.hierarchies.size() && !exact; ++i)
+        if (!plan.hierarchies[i].hierarchy->is_fcl()) exact = prepared[i].get();
       std::unique_ptr<PreparedHierarchy> fallback;
       if (!exact) {  // an FCL-only scene: the truth still comes from bvhlab's exact traversal
         HierarchySpec aabb;
@@ -927,27 +907,28 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
     for (std::size_t g = 0; g < scene.workload.groups.size(); ++g) {
       const PoseGroup& group = scene.workload.groups[g];
       const auto& expected = (*truth)[g];
-      std::vector<std::vector<std::vector<QueryRecord>>> series(plan.size());
-      for (std::size_t i = 0; i < plan.size(); ++i) series[i].resize(plan[i].second.size());
+      const auto& planned = plan.hierarchies;
+      std::vector<std::vector<std::vector<QueryRecord>>> series(planned.size());
+      for (std::size_t i = 0; i < planned.size(); ++i) series[i].resize(planned[i].variants.size());
       const std::span<const RigidTransform> poses(group.poses);
       for (std::size_t begin = 0; begin < poses.size(); begin += kPoseBlock) {
         const auto block = poses.subspan(begin, std::min(kPoseBlock, poses.size() - begin));
-        for (std::size_t i = 0; i < plan.size(); ++i)
-          for (std::size_t v = 0; v < plan[i].second.size(); ++v) {
-            prepared[i]->run(plan[i].second[v], block, options.warmup_queries, block_records);
+        for (std::size_t i = 0; i < planned.size(); ++i)
+          for (std::size_t v = 0; v < planned[i].variants.size(); ++v) {
+            prepared[i]->run(planned[i].variants[v], block, options.warmup_queries, block_records);
             series[i][v].insert(series[i][v].end(), block_records.begin(), block_records.end());
           }
         char distance[16];
         std::snprintf(distance, sizeof distance, "%g", group.distance);
         std::size_t done = 0;
-        for (const auto& [h, variants] : plan) done += variants.size() * block.size();
+        for (const auto& h : planned) done += h.variants.size() * block.size();
         progress.advance(done, label + " d=" + distance);
       }
-      for (std::size_t i = 0; i < plan.size(); ++i) {
-        const HierarchySpec& h = *plan[i].first;
+      for (std::size_t i = 0; i < planned.size(); ++i) {
+        const HierarchySpec& h = *planned[i].hierarchy;
         const PreparedHierarchy& hierarchy = *prepared[i];
-        for (std::size_t v = 0; v < plan[i].second.size(); ++v) {
-          const StrategyVariant& variant = plan[i].second[v];
+        for (std::size_t v = 0; v < planned[i].variants.size(); ++v) {
+          const StrategyVariant& variant = planned[i].variants[v];
           const std::vector<QueryRecord>& records = series[i][v];
           ResultRow row;
           row.mesh = label;
