@@ -1,4 +1,5 @@
 #include "bench/report.hpp"
+#include "bench/write.hpp"
 
 #include <algorithm>
 #include <cmath>

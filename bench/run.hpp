@@ -162,10 +162,5 @@ BuildOutcome build_tree_file(
     const std::filesystem::path& output, unsigned threads = 0,
     std::function<void(const std::string&)> log = [](const std::string&) {});
 
-/// The CSV header of results.csv, in order. The schema test holds the writer to it.
-const std::vector<std::string>& results_csv_columns();
-void write_results_csv(const RunOutput& run, const std::filesystem::path& file);
-void write_calibration_csv(const RunOutput& run, const std::filesystem::path& file);
-void write_results_json(const RunOutput& run, const std::filesystem::path& file);
 
 }  // namespace bvhlab

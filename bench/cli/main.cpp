@@ -7,6 +7,7 @@
 #include "bench/core/scene.hpp"
 #include "bench/report.hpp"
 #include "bench/run.hpp"
+#include "bench/write.hpp"
 #include "bvh/mesh_io.hpp"
 
 #include <CLI/CLI.hpp>

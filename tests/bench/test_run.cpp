@@ -4,6 +4,7 @@
 #include "bench/core/tree_cache.hpp"
 #include "bench/report.hpp"
 #include "bench/run.hpp"
+#include "bench/write.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 #include "volumes/aabb.hpp"

@@ -1,0 +1,214 @@
+// The write stage of the bench pipeline: results.csv, calibration.csv and results.json from a run. The CSV
+// columns and the JSON rows come from one field table, so the two cannot drift apart.
+#include "bench/write.hpp"
+
+#include "bench/core/policies.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace bvhlab {
+
+namespace {
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+std::string csv_number(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+std::string csv_p_min(double p) {
+  return p < 0 ? "" : csv_number(p);
+}
+
+std::ofstream open_output(const std::filesystem::path& file) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream out(file, std::ios::trunc);
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  return out;
+}
+
+}  // namespace
+
+namespace {
+
+using json = nlohmann::json;
+
+json optional_number(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+json optional_p_min(double p) {
+  return p < 0 ? json(nullptr) : json(p);
+}
+
+/// One column of results.csv and one key of the rows in results.json: both writers read this table.
+struct RowField {
+  const char* name;
+  json (*value)(const ResultRow&);
+};
+
+const std::vector<RowField>& row_fields() {
+  static const std::vector<RowField> fields{
+      {"mesh", [](const ResultRow& r) { return json(r.mesh); }},
+      {"hierarchy", [](const ResultRow& r) { return json(r.hierarchy); }},
+      {"bv", [](const ResultRow& r) { return json(r.bv); }},
+      {"annotation", [](const ResultRow& r) { return json(r.annotation); }},
+      {"strategy", [](const ResultRow& r) { return json(r.strategy); }},
+      {"label", [](const ResultRow& r) { return json(r.label); }},
+      {"exact", [](const ResultRow& r) { return json(r.exact_strategy); }},
+      {"p_min", [](const ResultRow& r) { return optional_p_min(r.p_min); }},
+      {"budget", [](const ResultRow& r) { return json(r.budget); }},
+      {"distance", [](const ResultRow& r) { return json(r.distance); }},
+      {"queries", [](const ResultRow& r) { return json(r.queries); }},
+      {"truth_colliding_rate", [](const ResultRow& r) { return json(r.truth_colliding_rate); }},
+      {"answer_colliding_rate", [](const ResultRow& r) { return json(r.answer_colliding_rate); }},
+      {"mean_time_us", [](const ResultRow& r) { return json(r.mean_time_us); }},
+      {"max_time_us", [](const ResultRow& r) { return json(r.max_time_us); }},
+      {"fp_rate", [](const ResultRow& r) { return json(r.fp_rate); }},
+      {"fn_rate", [](const ResultRow& r) { return json(r.fn_rate); }},
+      {"inexact_rate", [](const ResultRow& r) { return json(r.inexact_rate); }},
+      {"budget_exhausted_rate", [](const ResultRow& r) { return json(r.budget_exhausted_rate); }},
+      {"bv_tests_per_query", [](const ResultRow& r) { return optional_number(r.bv_tests_per_query); }},
+      {"triangle_tests_per_query",
+       [](const ResultRow& r) { return optional_number(r.triangle_tests_per_query); }},
+      {"nodes_visited_per_query",
+       [](const ResultRow& r) { return optional_number(r.nodes_visited_per_query); }},
+      {"model_bytes", [](const ResultRow& r) { return json(r.model_bytes); }},
+      {"bytes_per_triangle", [](const ResultRow& r) { return json(r.bytes_per_triangle); }},
+  };
+  return fields;
+}
+
+std::string csv_value(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_string()) return csv_field(v.get<std::string>());
+  if (v.is_boolean()) return v.get<bool>() ? "1" : "0";
+  if (v.is_number_integer() || v.is_number_unsigned()) return v.dump();
+  return csv_number(v.get<double>());
+}
+
+}  // namespace
+
+const std::vector<std::string>& results_csv_columns() {
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> out;
+    for (const RowField& f : row_fields()) out.emplace_back(f.name);
+    for (const char* env : {"machine", "compiler", "build_type", "git_commit"}) out.emplace_back(env);
+    return out;
+  }();
+  return columns;
+}
+
+void write_results_csv(const RunOutput& run, const std::filesystem::path& file) {
+  std::ofstream out = open_output(file);
+  const auto& columns = results_csv_columns();
+  for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
+  out << '\n';
+  const Environment& env = run.environment;
+  for (const ResultRow& r : run.rows) {
+    for (const RowField& f : row_fields()) out << csv_value(f.value(r)) << ',';
+    out << csv_field(env.machine) << ',' << csv_field(env.compiler) << ',' << csv_field(env.build_type) << ','
+        << csv_field(env.git_commit) << '\n';
+  }
+  if (!out) throw std::runtime_error(file.string() + ": write error");
+}
+
+void write_calibration_csv(const RunOutput& run, const std::filesystem::path& file) {
+  std::ofstream out = open_output(file);
+  out << "mesh,hierarchy,strategy,p_min,budget,bin_low,bin_high,count,mean_probability,collision_frequency\n";
+  for (const CalibrationBin& c : run.calibration)
+    out << csv_field(c.mesh) << ',' << csv_field(c.hierarchy) << ',' << c.strategy << ','
+        << csv_p_min(c.p_min) << ',' << csv_field(c.budget) << ',' << csv_number(c.bin_low) << ','
+        << csv_number(c.bin_high) << ',' << c.count << ',' << csv_number(c.mean_probability) << ','
+        << csv_number(c.collision_frequency) << '\n';
+  if (!out) throw std::runtime_error(file.string() + ": write error");
+}
+
+void write_results_json(const RunOutput& run, const std::filesystem::path& file) {
+  const Environment& env = run.environment;
+  const RunStats& s = run.stats;
+  json doc;
+  doc["scene"] = {{"name", run.scene_name}, {"file", run.scene_file.string()}};
+  doc["environment"] = {{"machine", env.machine},
+                        {"compiler", env.compiler},
+                        {"build_type", env.build_type},
+                        {"git_commit", env.git_commit},
+                        {"timestamp", env.timestamp}};
+  doc["stats"] = {{"meshes_loaded", s.meshes_loaded},
+                  {"trees_built", s.trees_built},
+                  {"trees_annotated", s.trees_annotated},
+                  {"annotation_clip_calls", s.annotation_clip_calls},
+                  {"tree_cache_hits", s.tree_cache_hits},
+                  {"tree_cache_rejected", s.tree_cache_rejected},
+                  {"tree_cache_stored", s.tree_cache_stored},
+                  {"fcl_models_built", s.fcl_models_built},
+                  {"truth_computed", s.truth_computed},
+                  {"truth_cache_hits", s.truth_cache_hits},
+                  {"truth_cache_rejected", s.truth_cache_rejected},
+                  {"cgal_checked", s.cgal_checked},
+                  {"cgal_mismatches", s.cgal_mismatches},
+                  {"queries", s.queries},
+                  {"preprocess_seconds", s.preprocess_seconds},
+                  {"truth_seconds", s.truth_seconds},
+                  {"query_seconds", s.query_seconds},
+                  {"wall_seconds", s.wall_seconds},
+                  {"clock_overhead_us", s.clock_overhead_us},
+                  {"skipped", s.skipped}};
+  json models = json::array();
+  for (const ModelInfo& m : run.models)
+    models.push_back({{"object", m.object},
+                      {"hierarchy", m.hierarchy},
+                      {"bv", m.bv},
+                      {"annotation", m.annotation},
+                      {"triangles", m.triangles},
+                      {"nodes", m.nodes},
+                      {"depth", m.depth},
+                      {"model_bytes", m.model_bytes},
+                      {"bytes_per_triangle", m.bytes_per_triangle},
+                      {"build_seconds", m.build_seconds},
+                      {"annotate_seconds", m.annotate_seconds},
+                      {"from_cache", m.from_cache}});
+  doc["models"] = models;
+  json truth = json::array();
+  for (const TruthSummary& t : run.truth)
+    truth.push_back(
+        {{"mesh", t.mesh}, {"distance", t.distance}, {"poses", t.poses}, {"colliding", t.colliding}});
+  doc["ground_truth"] = truth;
+  json rows = json::array();
+  for (const ResultRow& r : run.rows) {
+    json row = json::object();
+    for (const RowField& f : row_fields()) row[f.name] = f.value(r);
+    rows.push_back(std::move(row));
+  }
+  doc["rows"] = rows;
+  json cal = json::array();
+  for (const CalibrationBin& c : run.calibration)
+    cal.push_back({{"mesh", c.mesh},
+                   {"hierarchy", c.hierarchy},
+                   {"strategy", c.strategy},
+                   {"p_min", c.p_min < 0 ? json(nullptr) : json(c.p_min)},
+                   {"budget", c.budget},
+                   {"bin_low", c.bin_low},
+                   {"bin_high", c.bin_high},
+                   {"count", c.count},
+                   {"mean_probability", optional_number(c.mean_probability)},
+                   {"collision_frequency", optional_number(c.collision_frequency)}});
+  doc["calibration"] = cal;
+  doc["policies"] = policies_json();
+  std::ofstream out = open_output(file);
+  out << doc.dump(1) << '\n';
+  if (!out) throw std::runtime_error(file.string() + ": write error");
+}
+
+}  // namespace bvhlab

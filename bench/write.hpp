@@ -1,0 +1,18 @@
+// The write stage of the bench pipeline: a run's rows, calibration bins, models and statistics as files.
+#pragma once
+
+#include "bench/run.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+
+/// The CSV header of results.csv, in order. The schema test holds the writer to it.
+const std::vector<std::string>& results_csv_columns();
+void write_results_csv(const RunOutput& run, const std::filesystem::path& file);
+void write_calibration_csv(const RunOutput& run, const std::filesystem::path& file);
+void write_results_json(const RunOutput& run, const std::filesystem::path& file);
+
+}  // namespace bvhlab
