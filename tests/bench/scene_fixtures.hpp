@@ -1,6 +1,7 @@
 // Helpers for the scene and runner tests: a private temporary folder and small generated mesh files.
 #pragma once
 
+#include "bench/core/scene.hpp"
 #include "bvh/mesh.hpp"
 
 #include <gtest/gtest.h>
@@ -88,6 +89,22 @@ inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::pat
   for (std::string line; std::getline(in, line);)
     if (!line.empty()) rows.push_back(split_csv_line(line));
   return rows;
+}
+
+/// The scene object a scene entry {"mesh": file} gives (normalised, as scenes default to), named by its stem.
+inline SceneObject object_from(const std::filesystem::path& file) {
+  SceneObject object;
+  object.mesh = file.filename().string();
+  object.name = file.stem().string();
+  object.path = file;
+  return object;
+}
+
+/// A bvhlab hierarchy of one BV, named after it, with the default build options.
+inline HierarchySpec hierarchy_of(const std::string& bv) {
+  HierarchySpec h;
+  h.bv = h.name = bv;
+  return h;
 }
 
 }  // namespace bvhlab::testing

@@ -87,12 +87,8 @@ TEST_F(TestPolicies, ASceneRunsAndReportsThem) {
 }
 
 TEST_F(TestPolicies, SavedTreesKeepTheDensityByName) {
-  SceneObject torus;
-  torus.mesh = "torus.obj";
-  torus.name = "torus";
-  torus.path = dir / "torus.obj";
-  HierarchySpec aabb;
-  aabb.bv = aabb.name = "aabb";
+  const SceneObject torus = testing::object_from(dir / "torus.obj");
+  const HierarchySpec aabb = testing::hierarchy_of("aabb");
   const DensitySpec density{"tricount", {{"cap", 5}}};
   build_tree_file(torus, aabb, density, dir / "torus.tree", 1);
   const SavedTreeInfo info = peek_saved_tree(dir / "torus.tree");

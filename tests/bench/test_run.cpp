@@ -369,12 +369,8 @@ TEST_F(RunTest, ReportReadmeStatesTheOperatingPoint) {
 }
 
 TEST_F(RunTest, SavedTreesAnswerLikeTheMeshesTheyWereBuiltFrom) {
-  SceneObject torus;
-  torus.mesh = "torus.obj";
-  torus.name = "torus";
-  torus.path = dir / "torus.obj";
-  HierarchySpec aabb;
-  aabb.bv = aabb.name = "aabb";
+  const SceneObject torus = testing::object_from(dir / "torus.obj");
+  const HierarchySpec aabb = testing::hierarchy_of("aabb");
   const DensitySpec annotation{"adb", {{"grid", 2}, {"tau", 0.5}}};
   const BuildOutcome built = build_tree_file(torus, aabb, annotation, dir / "torus.tree", 2);
   EXPECT_EQ(built.file_bytes, std::filesystem::file_size(dir / "torus.tree"));
