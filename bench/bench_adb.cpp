@@ -74,8 +74,10 @@ template <int G>
 void register_adb(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w,
                   const std::vector<double>& p_mins, double tau) {
   AnnotateStats stats;
-  auto tree = std::make_shared<const Tree<Aabb, AdbDensity<G>>>(
-      annotate<G>(Bvh<Aabb>::build(mesh), AnnotateOptions{.tau = tau}, &stats));
+  AnnotateOptions options;
+  options.tau = tau;
+  auto tree =
+      std::make_shared<const Tree<Aabb, AdbDensity<G>>>(annotate<G>(Bvh<Aabb>::build(mesh), options, &stats));
   std::fprintf(stderr, "bench_adb: %s annotated (g = %d) in %.2f s\n", label.c_str(), G, stats.seconds);
   auto model = std::make_shared<const AdbModel>(G, tau);
   for (double p_min : p_mins) {

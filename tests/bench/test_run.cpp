@@ -102,7 +102,9 @@ TEST_F(RunTest, AnnotationRunsOnlyWhereAStrategyNeedsIt) {
   EXPECT_GT(run.stats.annotation_clip_calls, 0u);
   EXPECT_EQ(run.stats.trees_built, 2u);
   for (const auto& m : run.models) {
-    if (m.hierarchy == "dop24") EXPECT_EQ(m.annotation, "none");
+    if (m.hierarchy == "dop24") {
+      EXPECT_EQ(m.annotation, "none");
+    }
   }
   EXPECT_EQ(run.stats.fcl_models_built, 0u);
 }
