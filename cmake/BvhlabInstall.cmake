@@ -2,7 +2,7 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(BVHLAB_INSTALL_TARGETS bvhlab bvhlab_volumes bvhlab_bvh bvhlab_adb bvhlab_traversal)
+set(BVHLAB_INSTALL_TARGETS bvhlab bvhlab_volumes bvhlab_bvh bvhlab_mesh_io bvhlab_adb bvhlab_traversal)
 install(TARGETS ${BVHLAB_INSTALL_TARGETS} EXPORT bvhlabTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
