@@ -9,7 +9,7 @@ install(TARGETS ${BVHLAB_INSTALL_TARGETS} EXPORT bvhlabTargets
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bvhlab)
 foreach(folder volumes bvh adb traversal)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bvhlab/${folder}
-    FILES_MATCHING PATTERN "*.hpp")
+    FILES_MATCHING PATTERN "*.hpp" PATTERN "*_internal.hpp" EXCLUDE)
 endforeach()
 install(EXPORT bvhlabTargets NAMESPACE bvhlab:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bvhlab)
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/bvhlabConfig.cmake.in
