@@ -1,13 +1,8 @@
-// The one place where run-time names meet compile-time BV policies. A new bounding volume is named
-// here (one line) and nowhere else outside its own header; tools instantiate only what they are asked for.
+// The one place where run-time names meet compile-time BV policies: the shipped models (listed once, in
+// volumes/shipped.hpp) by their names. Tools instantiate only what they are asked for.
 #pragma once
 
-#include "volumes/aabb.hpp"
-#include "volumes/dop24.hpp"
-#include "volumes/kdop.hpp"
-#include "volumes/obb.hpp"
-#include "volumes/restricted_box.hpp"
-#include "volumes/sphere.hpp"
+#include "volumes/shipped.hpp"
 
 #include <optional>
 #include <stdexcept>
@@ -17,11 +12,7 @@
 
 namespace bvhlab {
 
-template <class... Ts>
-struct TypeList {};
-
-using RegisteredVolumes =
-    TypeList<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop24, Dop<26>, Obb, Sphere, RestrictedBox>;
+using RegisteredVolumes = ShippedVolumes;
 
 /// Calls f(std::type_identity<BV>{}) for the BV whose name() is `name`; throws naming the choices.
 template <class F, class... BVs>
