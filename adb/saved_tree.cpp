@@ -1,16 +1,13 @@
 // Saved-tree format: encoding, validating decoder, atomic file writes. See adb/saved_tree.hpp.
 #include "adb/saved_tree.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
+#include "adb/file_io.hpp"
 
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cerrno>
 #include <cmath>
-#include <fstream>
+#include <cstring>
 #include <limits>
 
 namespace bvhlab::saved_tree_detail {
@@ -296,50 +293,18 @@ Parts decode(std::span<const std::byte> buffer, const Layout& expected, std::str
 }
 
 std::vector<std::byte> read_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path.string(), "cannot open for reading");
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) fail(path.string(), "cannot read its size: " + ec.message());
-  std::vector<std::byte> bytes(size);
-  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size)) ||
-      in.gcount() != static_cast<std::streamsize>(size))
-    fail(path.string(), "read error");
-  return bytes;
+  try {
+    return file_io::read_all(path);
+  } catch (const file_io::FileError& e) {
+    fail(path.string(), e.problem());
+  }
 }
 
 void write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes) {
-  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  std::string temp_name = path.filename().string();
-  temp_name.insert(temp_name.begin(), '.');  // hidden, beside the target: the rename stays on one filesystem
-  temp_name += ".tmp-XXXXXX";
-  std::string temp = (dir / temp_name).string();
-  const int fd = ::mkstemp(temp.data());
-  if (fd < 0)
-    fail(path.string(), "cannot create a temporary file in " + dir.string() + ": " + std::strerror(errno));
-  auto abandon = [&](const std::string& problem) {
-    ::close(fd);
-    ::unlink(temp.c_str());
-    fail(path.string(), problem);
-  };
-  ::fchmod(fd, 0644);
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ::ssize_t r = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) abandon(std::string("write failed: ") + std::strerror(errno));
-    written += static_cast<std::size_t>(r);
-  }
-  if (::fsync(fd) != 0) abandon(std::string("fsync failed: ") + std::strerror(errno));
-  if (::close(fd) != 0) {
-    ::unlink(temp.c_str());
-    fail(path.string(), std::string("close failed: ") + std::strerror(errno));
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    ::unlink(temp.c_str());
-    fail(path.string(), "cannot move the written file into place: " + ec.message());
+  try {
+    file_io::write_atomically(path, bytes);
+  } catch (const file_io::FileError& e) {
+    fail(path.string(), e.problem());
   }
 }
 

@@ -12,6 +12,7 @@
 // needs no file. Annotation runs on 2 threads unless --threads=N is given before the benchmark flags.
 #include "adb/adb_density.hpp"
 #include "adb/saved_tree.hpp"
+#include "bench/core/generators.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "volumes/aabb.hpp"
 
@@ -23,7 +24,6 @@
 #include <ctime>
 #include <map>
 #include <memory>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -47,21 +47,8 @@ const std::vector<std::string> kMeshes = {"pinion.off",     "jeep1.ms3d",       
 
 /// A closed torus of 2 * 400 * 250 = 200,000 triangles, in the protocol's normalisation.
 Mesh generated_torus() {
-  Mesh m;
+  Mesh m = generators::make_torus(0.7, 0.3, 400, 250);
   m.name = "generated_torus";
-  const int nu = 400, nv = 250;
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      const double u = 2 * std::numbers::pi * i / nu, v = 2 * std::numbers::pi * j / nv;
-      m.vertices.emplace_back((0.7 + 0.3 * std::cos(v)) * std::cos(u),
-                              (0.7 + 0.3 * std::cos(v)) * std::sin(u), 0.3 * std::sin(v));
-    }
-  auto id = [&](int i, int j) { return static_cast<std::uint32_t>((i % nu) * nv + (j % nv)); };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
   return m;
 }
 

@@ -6,6 +6,7 @@
 // Sets (argument "set"): 0 "mixed" (general position, ~40% intersecting), 1 "near_miss" (gaps of 1e-9..1e-6
 // at unit size, still decidable in double), 2 "touching" (exact contacts on a grid: the fast path must fall
 // back to CGAL), 3 "axis_aligned" (triangles in axis planes, as in CAD meshes).
+#include "bench/core/generators.hpp"
 #include "bvh/triangle_intersection.hpp"
 #include "bvh/triangle_intersection_fast.hpp"
 
@@ -13,7 +14,6 @@
 
 #include <cmath>
 #include <cstddef>
-#include <numbers>
 #include <random>
 #include <vector>
 
@@ -27,31 +27,9 @@ struct PairSet {
   std::vector<TrianglePoints> p, q;
 };
 
-double uniform(Rng& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-Vec3 uniform_point(Rng& rng, double lo, double hi) {
-  return {uniform(rng, lo, hi), uniform(rng, lo, hi), uniform(rng, lo, hi)};
-}
-Vec3 random_unit(Rng& rng) {
-  std::normal_distribution<double> normal;
-  Vec3 v{normal(rng), normal(rng), normal(rng)};
-  return v / v.norm();
-}
-
-// Well-shaped triangle, random orientation, circumradius 0.3..0.6 around `centre`.
-TrianglePoints random_triangle(Rng& rng, const Vec3& centre) {
-  const Vec3 a = random_unit(rng);
-  const Vec3 b = a.cross(random_unit(rng)).normalized();
-  const Vec3 c = a.cross(b);
-  const double radius = uniform(rng, 0.3, 0.6), phase = uniform(rng, 0, 2 * std::numbers::pi);
-  TrianglePoints t;
-  for (int k = 0; k < 3; ++k) {
-    const double angle = phase + 2 * std::numbers::pi * k / 3 + uniform(rng, -0.6, 0.6);
-    t[k] = centre + radius * (std::cos(angle) * b + std::sin(angle) * c);
-  }
-  return t;
-}
+using generators::random_triangle;
+using generators::uniform;
+using generators::uniform_point;
 
 PairSet mixed_set() {
   Rng rng(1);

@@ -2,14 +2,14 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(BVHLAB_INSTALL_TARGETS bvhlab bvhlab_volumes bvhlab_bvh bvhlab_adb bvhlab_traversal)
+set(BVHLAB_INSTALL_TARGETS bvhlab bvhlab_volumes bvhlab_bvh bvhlab_mesh_io bvhlab_adb bvhlab_traversal)
 install(TARGETS ${BVHLAB_INSTALL_TARGETS} EXPORT bvhlabTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bvhlab)
 foreach(folder volumes bvh adb traversal)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bvhlab/${folder}
-    FILES_MATCHING PATTERN "*.hpp")
+    FILES_MATCHING PATTERN "*.hpp" PATTERN "*_internal.hpp" EXCLUDE)
 endforeach()
 install(EXPORT bvhlabTargets NAMESPACE bvhlab:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bvhlab)
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/bvhlabConfig.cmake.in

@@ -357,24 +357,22 @@ int main(int argc, char** argv) {
   // run / report
   std::string scene_file, out_dir, cache_dir, snippet_file;
   bool quiet = false, no_cache = false, no_figures = false;
-  auto* run = app.add_subcommand("run", "Run a scene: results.csv, results.json and calibration.csv");
-  run->add_option("SCENE", scene_file, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
-  run->add_option("-o,--output", out_dir, "Output folder (default: results/<scene name>)");
-  for (auto* sub : {run}) {
+  auto add_cache_and_quiet = [&](CLI::App* sub) {
     sub->add_option("--cache", cache_dir,
                     "Cache directory for trees and ground truth (default: <build>/cache)");
     sub->add_flag("--no-cache", no_cache, "Neither read nor write the cache");
     sub->add_flag("-q,--quiet", quiet, "No progress bar or messages");
-  }
+  };
+  auto* run = app.add_subcommand("run", "Run a scene: results.csv, results.json and calibration.csv");
+  run->add_option("SCENE", scene_file, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
+  run->add_option("-o,--output", out_dir, "Output folder (default: results/<scene name>)");
+  add_cache_and_quiet(run);
   run->footer("Example: bvhlab run bench/scenes/smoke.json -o /tmp/smoke");
   auto* report =
       app.add_subcommand("report", "Run a scene and write a report folder: CSV, JSON, figures, README.md");
   report->add_option("SCENE", scene_file, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
   report->add_option("-o,--output", out_dir, "Report folder")->required();
-  report->add_option("--cache", cache_dir,
-                     "Cache directory for trees and ground truth (default: <build>/cache)");
-  report->add_flag("--no-cache", no_cache, "Neither read nor write the cache");
-  report->add_flag("-q,--quiet", quiet, "No progress bar or messages");
+  add_cache_and_quiet(report);
   report->add_flag("--no-figures", no_figures, "Skip the matplotlib figures");
   report->add_option("--snippet", snippet_file, "Also write a short results section (Markdown) to this file");
   report->footer("Example: bvhlab report bench/scenes/full_protocol.json -o report/full");

@@ -6,12 +6,7 @@
 #include "adb/adb_density.hpp"
 #include "adb/tree.hpp"
 #include "traversal/strategies.hpp"
-#include "volumes/aabb.hpp"
-#include "volumes/dop24.hpp"
-#include "volumes/kdop.hpp"
-#include "volumes/obb.hpp"
-#include "volumes/restricted_box.hpp"
-#include "volumes/sphere.hpp"
+#include "volumes/shipped.hpp"
 
 #include <optional>
 #include <stdexcept>
@@ -28,11 +23,8 @@
 
 namespace bvhlab {
 
-template <class... Ts>
-struct TypeList {};
-
-using RegisteredVolumes =
-    TypeList<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop24, Dop<26>, Obb, Sphere, RestrictedBox>;
+/// The shipped volume models, listed once in volumes/shipped.hpp (the typed volume tests use that list too).
+using RegisteredVolumes = ShippedVolumes;
 
 using RegisteredDensities = TypeList<NoDensity, AdbDensity
 #ifdef BVHLAB_TEST_POLICIES

@@ -1,11 +1,10 @@
 #include "bench/core/tree_cache.hpp"
 
+#include "adb/file_io.hpp"
+
 #include <nlohmann/json.hpp>
 
-#include <cstring>
-#include <fstream>
 #include <iostream>
-#include <random>
 #include <sstream>
 
 namespace bvhlab {
@@ -13,32 +12,12 @@ namespace bvhlab {
 namespace tree_cache_detail {
 
 std::vector<std::byte> read_file_bytes(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot open " + file.string());
-  std::vector<char> chars((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw std::runtime_error("read error in " + file.string());
-  std::vector<std::byte> bytes(chars.size());
-  std::memcpy(bytes.data(), chars.data(), chars.size());
-  return bytes;
+  return file_io::read_all(file);
 }
 
 void write_file_bytes(const std::filesystem::path& file, std::span<const std::byte> bytes) {
   std::filesystem::create_directories(file.parent_path());
-  // A unique temporary name: two runs may fill the same cache at once; the last rename wins, whole.
-  std::random_device entropy;
-  const auto temp =
-      file.parent_path() / ("." + file.filename().string() + "." + std::to_string(entropy()) + ".part");
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot write " + temp.string());
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!out) {
-      out.close();
-      std::filesystem::remove(temp);
-      throw std::runtime_error("write error in " + temp.string());
-    }
-  }
-  std::filesystem::rename(temp, file);
+  file_io::write_atomically(file, bytes);
 }
 
 }  // namespace tree_cache_detail

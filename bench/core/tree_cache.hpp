@@ -81,8 +81,8 @@ Tree<BV, D> attach_polygons(const Tree<BV, D>& saved, const Mesh& mesh) {
   return Tree<BV, D>{std::move(with_polygons), saved.density};
 }
 
+/// adb/file_io.hpp's reader and atomic writer (this one also creates the folder). Throw file_io::FileError.
 std::vector<std::byte> read_file_bytes(const std::filesystem::path& file);
-/// Writes via a temporary file and a rename, so a reader never sees half a file.
 void write_file_bytes(const std::filesystem::path& file, std::span<const std::byte> bytes);
 
 }  // namespace tree_cache_detail

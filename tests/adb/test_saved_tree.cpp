@@ -4,6 +4,7 @@
 
 #include "adb/adb_density.hpp"
 #include "support/generated_meshes.hpp"
+#include "support/volume_lists.hpp"
 #include "volumes/aabb.hpp"
 #include "volumes/dop24.hpp"
 #include "volumes/kdop.hpp"
@@ -366,8 +367,7 @@ TEST(SavedTree, ARestrictedBoxWithAnImpossibleAxisIsRefused) {
 // refused by name (found by tests/fuzz: an infinite 24-DOP slab reached the ADB estimate as a NaN).
 template <class BV>
 class SavedVolumeBytes : public ::testing::Test {};
-using StoredVolumes = ::testing::Types<Aabb, Dop<14>, Dop24, Obb, Sphere>;
-TYPED_TEST_SUITE(SavedVolumeBytes, StoredVolumes);
+TYPED_TEST_SUITE(SavedVolumeBytes, testing::ShippedBoundingVolumes);
 
 TYPED_TEST(SavedVolumeBytes, NonFiniteCoordinatesAreRefused) {
   using BV = TypeParam;

@@ -1,5 +1,6 @@
 // Property tests: the fast triangle test against CGAL ground truth on random and adversarial families,
 // plus hand-written cases with known answers. Every family uses a fixed seed.
+#include "bench/core/generators.hpp"
 #include "bvh/triangle_intersection.hpp"
 #include "bvh/triangle_intersection_fast.hpp"
 
@@ -13,7 +14,6 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
-#include <numbers>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -31,25 +31,19 @@ constexpr std::size_t kScale = 1;
 constexpr std::size_t kScale = 10;
 #endif
 
-double uniform(Rng& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
+using generators::random_triangle;
+using generators::random_unit;
+using generators::uniform;
+using generators::uniform_point;
+
 long long integer(Rng& rng, long long lo, long long hi) {
   return std::uniform_int_distribution<long long>(lo, hi)(rng);
 }
 bool coin(Rng& rng) {
   return integer(rng, 0, 1) == 1;
 }
-Vec3 uniform_point(Rng& rng, double lo, double hi) {
-  return {uniform(rng, lo, hi), uniform(rng, lo, hi), uniform(rng, lo, hi)};
-}
 Vec3 integer_point(Rng& rng, long long lo, long long hi) {
   return Vec3{double(integer(rng, lo, hi)), double(integer(rng, lo, hi)), double(integer(rng, lo, hi))};
-}
-Vec3 random_unit(Rng& rng) {
-  std::normal_distribution<double> normal;
-  Vec3 v{normal(rng), normal(rng), normal(rng)};
-  return v / v.norm();
 }
 // One of the 6 vertex orders, reflections included (they flip the orientation the test must not rely on).
 TrianglePoints permuted(const TrianglePoints& t, Rng& rng) {
@@ -142,20 +136,6 @@ void check_family(const char* name, std::uint64_t seed, std::size_t count, const
 }
 
 // ---- generators ------------------------------------------------------------------------------------
-
-// A random well-shaped triangle: random plane orientation, circumradius 0.3..0.6, perturbed angles.
-TrianglePoints random_triangle(Rng& rng, const Vec3& centre) {
-  const Vec3 a = random_unit(rng);
-  const Vec3 b = a.cross(random_unit(rng)).normalized();
-  const Vec3 c = a.cross(b);
-  const double radius = uniform(rng, 0.3, 0.6), phase = uniform(rng, 0, 2 * std::numbers::pi);
-  TrianglePoints t;
-  for (int k = 0; k < 3; ++k) {
-    const double angle = phase + 2 * std::numbers::pi * k / 3 + uniform(rng, -0.6, 0.6);
-    t[k] = centre + radius * (std::cos(angle) * b + std::sin(angle) * c);
-  }
-  return t;
-}
 
 // Two triangles whose centres lie in a common box: about half intersect.
 Pair general_pair(Rng& rng) {

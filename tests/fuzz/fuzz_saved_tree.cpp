@@ -13,6 +13,7 @@
 // Seeds: run with BVHLAB_FUZZ_WRITE_SEEDS=<dir> to write one saved tree per layout there (and exit).
 #include "adb/adb_density.hpp"
 #include "adb/saved_tree.hpp"
+#include "bench/core/generators.hpp"
 #include "traversal/adb.hpp"
 #include "volumes/aabb.hpp"
 #include "volumes/dop24.hpp"
@@ -27,7 +28,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <numbers>
 #include <vector>
 
 namespace {
@@ -89,21 +89,7 @@ constexpr Loader kLayouts[8] = {
 // --- seeds -------------------------------------------------------------------------------------------------
 
 Mesh seed_mesh() {  // a small torus: enough nodes for every check to matter, few bytes
-  Mesh m;
-  const int nu = 6, nv = 4;
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      const double u = 2 * std::numbers::pi * i / nu, v = 2 * std::numbers::pi * j / nv;
-      m.vertices.emplace_back((0.7 + 0.25 * std::cos(v)) * std::cos(u),
-                              (0.7 + 0.25 * std::cos(v)) * std::sin(u), 0.25 * std::sin(v));
-    }
-  auto id = [&](int i, int j) { return static_cast<std::uint32_t>((i % nu) * nv + (j % nv)); };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return m;
+  return generators::make_torus(0.7, 0.25, 6, 4);
 }
 
 /// grid 0: no density; else a stand-in ADB annotation (the reader checks only pc <= g^3).

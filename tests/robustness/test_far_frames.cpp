@@ -22,7 +22,7 @@ namespace bvhlab::robust {
 namespace {
 
 struct Frame {
-  std::string name;
+  const char* name;  // a literal (a std::string here trips a false -Wmaybe-uninitialized in GCC 12)
   double scale;
   Vec3 offset;
 };

@@ -1,32 +1,14 @@
 // Small procedural meshes for tests that must not depend on files.
 #pragma once
 
+#include "bench/core/generators.hpp"
 #include "bvh/mesh.hpp"
 
-#include <cmath>
-#include <numbers>
 #include <random>
 
 namespace bvhlab::testing {
 
-/// Closed torus around the z axis: 2 * nu * nv triangles.
-inline Mesh make_torus(double major, double minor, int nu, int nv) {
-  Mesh m;
-  m.name = "torus";
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      const double u = 2 * std::numbers::pi * i / nu, v = 2 * std::numbers::pi * j / nv;
-      m.vertices.emplace_back((major + minor * std::cos(v)) * std::cos(u),
-                              (major + minor * std::cos(v)) * std::sin(u), minor * std::sin(v));
-    }
-  auto id = [&](int i, int j) { return static_cast<std::uint32_t>((i % nu) * nv + (j % nv)); };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return m;
-}
+using generators::make_torus;  // bench/core/generators.hpp: one torus for benchmarks and tests
 
 /// `count` random triangles of edge length about `size` inside [-1, 1]^3.
 inline Mesh make_random_soup(int count, double size, std::uint64_t seed) {

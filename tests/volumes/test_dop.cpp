@@ -64,7 +64,11 @@ double reference_volume(const std::array<Vec3, Planes>& normals, std::array<doub
 
 template <class BV>
 class DopTest : public ::testing::Test {};
-using DopModels = ::testing::Types<Dop<6>, Dop<14>, Dop<18>, Dop<26>, Dop24>;
+template <class BV>
+struct IsDop : std::false_type {};
+template <class Set>
+struct IsDop<KDop<Set>> : std::true_type {};
+using DopModels = testing::SelectTypes<IsDop, ShippedVolumes>::type;  // every shipped DOP
 TYPED_TEST_SUITE(DopTest, DopModels, ModelName);
 
 template <class BV>

@@ -2,11 +2,7 @@
 #pragma once
 
 #include "support/test_volumes.hpp"
-#include "volumes/aabb.hpp"
-#include "volumes/dop24.hpp"
-#include "volumes/kdop.hpp"
-#include "volumes/obb.hpp"
-#include "volumes/sphere.hpp"
+#include "support/volume_lists.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,8 +12,9 @@
 
 namespace bvhlab::volume_tests {
 
+/// Every shipped self-contained model, and the capsule that exists only under tests/.
 using AllModels =
-    ::testing::Types<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop<26>, Dop24, Obb, Sphere, testing::Capsule>;
+    testing::ConcatTypes<testing::ShippedBoundingVolumes, ::testing::Types<testing::Capsule>>::type;
 
 struct ModelName {
   template <class BV>

@@ -1,0 +1,41 @@
+// Typed-test lists derived from the one list of shipped volumes (volumes/shipped.hpp): a model added there is
+// tested everywhere it qualifies without being named again.
+#pragma once
+
+#include "volumes/concept.hpp"
+#include "volumes/shipped.hpp"
+
+#include <gtest/gtest.h>
+
+#include <type_traits>
+
+namespace bvhlab::testing {
+
+/// Concatenation of ::testing::Types lists.
+template <class... Lists>
+struct ConcatTypes {
+  using type = ::testing::Types<>;
+};
+template <class... A>
+struct ConcatTypes<::testing::Types<A...>> {
+  using type = ::testing::Types<A...>;
+};
+template <class... A, class... B, class... Rest>
+struct ConcatTypes<::testing::Types<A...>, ::testing::Types<B...>, Rest...>
+    : ConcatTypes<::testing::Types<A..., B...>, Rest...> {};
+
+/// The types of `List` (a TypeList) for which Keep<T>::value holds, in order, as ::testing::Types.
+template <template <class> class Keep, class List>
+struct SelectTypes;
+template <template <class> class Keep, class... Ts>
+struct SelectTypes<Keep, TypeList<Ts...>>
+    : ConcatTypes<std::conditional_t<Keep<Ts>::value, ::testing::Types<Ts>, ::testing::Types<>>...> {};
+
+/// Self-contained models (BoundingVolume); the others are stored relative to their parent.
+template <class BV>
+struct IsSelfContained : std::bool_constant<BoundingVolume<BV>> {};
+
+/// Every shipped self-contained model.
+using ShippedBoundingVolumes = SelectTypes<IsSelfContained, ShippedVolumes>::type;
+
+}  // namespace bvhlab::testing

@@ -1,0 +1,21 @@
+// The bounding-volume models bvhlab ships, listed once. The CLI, scenes and benchmarks offer exactly these
+// (bench/core/registry.hpp), and the typed volume tests run over them (tests/support/volume_lists.hpp).
+#pragma once
+
+#include "volumes/aabb.hpp"
+#include "volumes/dop24.hpp"
+#include "volumes/kdop.hpp"
+#include "volumes/obb.hpp"
+#include "volumes/restricted_box.hpp"
+#include "volumes/sphere.hpp"
+
+namespace bvhlab {
+
+/// A compile-time list of types.
+template <class... Ts>
+struct TypeList {};
+
+/// Every shipped model, in the order tools list them. A new model is added here, and nowhere else.
+using ShippedVolumes = TypeList<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop24, Dop<26>, Obb, Sphere, RestrictedBox>;
+
+}  // namespace bvhlab
