@@ -3,7 +3,7 @@ PRESET ?= release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD_DIR := build/$(PRESET)
 
-.PHONY: demo test deps configure build asan-test tsan-test fuzz clean
+.PHONY: demo test deps configure build asan-test tsan-test fuzz format-check clean
 
 deps:
 	@bash cmake/install-deps.sh
@@ -38,6 +38,10 @@ fuzz:
 	cmake --build --preset fuzz --target bvhlab_fuzzers -j $(JOBS)
 	ctest --preset fuzz
 	FUZZ_SEED=$(FUZZ_SEED) tests/fuzz/run_fuzzers.sh build/fuzz $(FUZZ_SECONDS)
+
+# Every tracked C++ file must already be formatted as .clang-format says; lists the ones that are not.
+format-check: deps
+	git ls-files -z '*.cpp' '*.hpp' | xargs -0 clang-format --dry-run -Werror
 
 clean:
 	rm -rf build

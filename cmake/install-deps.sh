@@ -8,6 +8,8 @@ packages=(build-essential cmake libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev
           python3 python3-matplotlib ca-certificates)
 # Used by the fetch of larger meshes (npm pack) and by the fuzzers (clang, its sanitizer runtimes).
 packages+=(clang libclang-rt-14-dev)
+# `make format-check` (the first stage of .ci/run).
+packages+=(clang-format)
 # npm is needed as a command, from whatever package provides it: some machines carry a nodejs build that
 # bundles npm and conflicts with Debian's npm package, so that package is asked for only when no npm exists.
 command -v npm >/dev/null 2>&1 || packages+=(npm)
