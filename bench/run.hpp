@@ -162,5 +162,4 @@ BuildOutcome build_tree_file(
     const std::filesystem::path& output, unsigned threads = 0,
     std::function<void(const std::string&)> log = [](const std::string&) {});
 
-
 }  // namespace bvhlab
