@@ -118,7 +118,9 @@ TEST(AdbTraversal, CombiningLeafEvidenceOnlyAddsCollisionsAndNeverCostsMore) {
       const Result a = query_adb(scene.tree_a, scene.tree_b, pose, scene.model, literal);
       const Result b = query_adb(scene.tree_a, scene.tree_b, pose, scene.model, combined);
       // Same traversal order until the combined evidence decides, so a literal "collision" is found too.
-      if (a.collides) EXPECT_TRUE(b.collides) << "pose " << k;
+      if (a.collides) {
+        EXPECT_TRUE(b.collides) << "pose " << k;
+      }
       EXPECT_LE(b.counters.bv_tests, a.counters.bv_tests);
       EXPECT_TRUE(b.probability >= 0 && b.probability <= 1);
       changed += a.collides != b.collides;

@@ -39,7 +39,9 @@ TEST(ExactTraversal, FirstContactMatchesCgalOnRandomPoses) {
 TEST(ExactTraversal, AllContactsEqualCgalEnumeration) {
   const Mesh a = testing::make_torus(0.7, 0.25, 24, 12);
   const Mesh b = testing::make_torus(0.6, 0.2, 20, 10);
-  const auto tree_a = Bvh<Aabb>::build(a, {.max_leaf_triangles = 3});
+  BuildOptions three_per_leaf;
+  three_per_leaf.max_leaf_triangles = 3;
+  const auto tree_a = Bvh<Aabb>::build(a, three_per_leaf);
   const auto tree_b = Bvh<Aabb>::build(b);
   const CgalGroundTruth truth(a, b);
   std::mt19937_64 rng(9);
