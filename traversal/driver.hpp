@@ -1,0 +1,443 @@
+// The pair-traversal driver: the one loop behind every strategy (exact first contact, all contacts, ADB with
+// p_min, time-critical, guided exact). A strategy is a configuration of it: a queue policy, a descent
+// policy, a limit and a hooks object, all resolved at compile time. No virtual calls, no copies of trees:
+// the hooks and policies inline into one loop, which costs what a hand-written loop would.
+//
+//   traverse<QueuePolicy, Descent>(trees, hooks, limit);   // trees: TreePair<BV>
+//
+// The loop, in order:
+//   1. If the limit forbids a first BV test: finish(queue, Ended::BudgetExhausted).
+//   2. The root pair is evaluated and admitted (see the hooks below).
+//   3. While the queue is not empty:
+//      - the limit may end the loop before a pop (limit.allows_pop(), e.g. a deadline): finish, as in 1;
+//      - the next pair is taken off the queue (nodes_visited += 1);
+//      - a pair of two leaves goes to leaf_pair(pair);
+//      - any other pair is expanded by the descent policy into its child pairs, which are evaluated in the
+//        descent's order. Staged (when the hooks have children_evaluated or the limit can stop the
+//        loop): all children are evaluated, then children_evaluated(parent, scores, count) is called,
+//        then each child is admitted; if the limit forbids a child's test, the unexpanded parent goes
+//        back onto the queue (it keeps its key for a best-effort answer) and the loop ends with finish.
+//        Otherwise each child is admitted right after its own evaluation (same tests, same queue).
+//   4. finish(queue, Ended::QueueEmpty).
+//   Whenever a hook answers "decided" (admit: Admission::Decide; leaf_pair, children_evaluated:
+//   Step::Decided), traverse returns at once: the hook has shaped the Result, and finish is not called.
+//
+// Queue policies (the order in which admitted pairs are taken):
+//   DepthFirst          a stack: the last admitted pair first. With SplitLarger's order [right, left], the
+//                       left child is visited first.
+//   BestFirst           a priority queue on Pair::key: the highest key first (std::priority_queue, ties in
+//                       its order).
+//   OrderedDepthFirst   a stack on which the pairs admitted since the last pop are ordered by key: depth
+//                       first, into the most promising child (e.g. the most probable) first.
+//
+// Descent policies (the child pairs of a pair that is not two leaves):
+//   SplitLarger  splits one side: the larger node (by Bvh::size; a leaf cannot be split), children in the
+//                order [right, left]. Two child pairs.
+//   SplitBoth    splits both sides (a leaf stands for itself): [(l, l), (l, r), (r, l), (r, r)]; two or four
+//                child pairs.
+//
+// Limits (checked by the driver, never by hooks):
+//   Unlimited    compiles away.
+//   BudgetLimit  a cap on BV tests (checked before every test) and/or a wall-clock deadline (checked every
+//                16 pops). A frame-budget schedule is another limit with the same calls.
+//
+// Hooks: an object with, for Pair = QueuedPair<BV, Key, Tag> (Key: the queue key, or NoKey for a stack;
+// Tag: data the strategy keeps with a queued pair, or NoTag):
+//   using Pair = ...;
+//   Score evaluate(const Pair&)            every BV-pair test, root and children: trees.overlap(pair)
+//                                          (counts the test), plus e.g. an estimate.
+//   Admission admit(Pair&, Score)          files an evaluated pair: Queue (after setting pair.key and
+//                                          pair.tag as needed), Drop, or Decide.
+//   Step leaf_pair(const Pair&)            a pair of two leaves taken off the queue. Exact strategies run
+//                                          trees.intersecting_triangles, the one triangle-pair loop.
+//   Step children_evaluated(const Pair& parent, const Score* scores, int count)   optional: after all of a
+//                                          parent's children were evaluated, before any is admitted (ADB's
+//                                          "confirm with children").
+//   void finish(queue, Ended)              shapes the Result when the loop ends without a decision; the
+//                                          queue holds what was left unexamined.
+// The hooks object holds the Result and any per-query state; it lives on the query's stack.
+//
+// A strategy is a hooks struct plus a choice of policies: exact (traversal/exact.hpp) is ExactHooks with
+// DepthFirst, SplitLarger, Unlimited; ADB (traversal/adb.hpp) is AdbHooks with BestFirst, SplitBoth,
+// BudgetLimit. A probability-ordered depth-first descent is AdbHooks with OrderedDepthFirst
+// (tests/traversal/test_driver.cpp runs it); a frame-budget schedule is any hooks with a limit that grants
+// each query its share of the frame.
+//
+// The hot path's members are [[gnu::always_inline]]: the loop must compile to one function whatever the
+// including unit's inlining budget (large units otherwise leave pieces of it out of line). The volumes' own
+// overlap tests are left to the compiler, as before.
+#pragma once
+
+#include "bvh/bvh.hpp"
+#include "bvh/triangle_intersection.hpp"
+#include "traversal/result.hpp"
+#include "traversal/tree_access.hpp"
+
+#include <chrono>
+#include <concepts>
+#include <cstdint>
+#include <new>
+#include <queue>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace bvhlab {
+
+/// Limits for time-critical queries. Zero means "no limit".
+struct Budget {
+  std::uint64_t max_bv_tests = 0;  ///< hard cap on BV-pair tests (never exceeded)
+  double deadline_us = 0;          ///< wall-clock limit, checked every few node pairs
+  [[nodiscard]] bool unlimited() const { return max_bv_tests == 0 && deadline_us <= 0; }
+};
+
+struct NoKey {};
+struct NoTag {};
+
+/// A node pair on the queue: A's node, B's node, their walkers' state, the queue key and the strategy's tag.
+/// With NoKey and NoTag (and self-contained volumes) it is two indices and nothing else. Built with every
+/// member given ({key, a, b, wa, wb, tag}), so the walkers' state is constructed in place.
+template <TreeVolume BV, class Key = NoKey, class Tag = NoTag>
+struct QueuedPair {
+  using Working = typename VolumeWalker<BV>::Working;
+  [[no_unique_address]] Key key{};
+  std::uint32_t a, b;
+  // Not [[no_unique_address]]: with a non-empty state beside an empty key or tag, GCC 12 then clears the
+  // whole state before constructing it, on every child pair.
+  Working wa;
+  Working wb;
+  [[no_unique_address]] Tag tag{};
+};
+/// Self-contained volumes: the walkers carry no state, and it takes no room.
+template <TreeVolume BV, class Key, class Tag>
+requires std::is_empty_v<typename VolumeWalker<BV>::Working>
+struct QueuedPair<BV, Key, Tag> {
+  using Working = typename VolumeWalker<BV>::Working;
+  [[no_unique_address]] Key key{};
+  std::uint32_t a, b;
+  [[no_unique_address]] Working wa;
+  [[no_unique_address]] Working wb;
+  [[no_unique_address]] Tag tag{};
+};
+
+enum class Admission { Queue, Drop, Decide };
+enum class Step { Continue, Decided };
+enum class Ended { QueueEmpty, BudgetExhausted };
+
+/// The two trees of one query, the pose, the volumes' pair context (Walker::make_context(b_to_a)), and the
+/// query's counters. Only references: the context is a separate local of the query, so passing it to an
+/// out-of-line overlap test does not make the compiler reload these after every test.
+template <TreeVolume BV>
+class TreePair {
+ public:
+  using Walker = VolumeWalker<BV>;
+  using Context = typename Walker::Context;
+
+  TreePair(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, const Context& context,
+           Counters& counters)
+      : a(a), b(b), b_to_a(b_to_a), context(context), counters(counters) {}
+
+  const Bvh<BV>& a;
+  const Bvh<BV>& b;
+  const RigidTransform& b_to_a;
+  const Context& context;
+  Counters& counters;
+
+  template <class Pair>
+  [[gnu::always_inline]] [[nodiscard]] Pair root() const {
+    return Pair{{}, 0, 0, Walker::root_a(a, context), Walker::root_b(b, context), {}};
+  }
+  /// The BV-pair overlap test; counts one BV test.
+  template <class Pair>
+  [[gnu::always_inline]] bool overlap(const Pair& p) const {
+    ++counters.bv_tests;
+    return Walker::overlap(a, p.a, p.wa, b, p.b, p.wb, context);
+  }
+  template <class Pair>
+  [[gnu::always_inline]] [[nodiscard]] Box box_a(const Pair& p) const {
+    return Walker::box(a, p.a, p.wa);
+  }
+  template <class Pair>
+  [[gnu::always_inline]] [[nodiscard]] Box box_b(const Pair& p) const {
+    return Walker::box(b, p.b, p.wb);
+  }
+  template <class Pair>
+  [[gnu::always_inline]] [[nodiscard]] bool is_leaf_pair(const Pair& p) const {
+    return a.node(p.a).is_leaf() && b.node(p.b).is_leaf();
+  }
+
+  /// The one triangle-pair loop: B's triangles of leaf j moved into A's frame, each tested against A's of
+  /// leaf i. on_hit(TrianglePair) (source-mesh indices) returns true to stop; so does this, then.
+  template <class OnHit>
+  [[gnu::always_inline]] bool intersecting_triangles(std::uint32_t i, std::uint32_t j, OnHit&& on_hit) const {
+    const TreeNode& na = a.node(i);
+    const TreeNode& nb = b.node(j);
+    const auto& tri_a = a.triangles();
+    const auto& tri_b = b.triangles();
+    for (std::uint32_t tb = nb.first; tb < nb.first + nb.count; ++tb) {
+      const TrianglePoints moved = {b_to_a.apply(tri_b[tb][0]), b_to_a.apply(tri_b[tb][1]),
+                                    b_to_a.apply(tri_b[tb][2])};
+      for (std::uint32_t ta = na.first; ta < na.first + na.count; ++ta) {
+        ++counters.triangle_tests;
+        if (triangles_intersect(tri_a[ta], moved) &&
+            on_hit(TrianglePair{a.triangle_ids()[ta], b.triangle_ids()[tb]}))
+          return true;
+      }
+    }
+    return false;
+  }
+};
+
+// ---- Queue policies -------------------------------------------------------------------------------------
+
+struct DepthFirst {
+  template <class Pair>
+  class Queue {
+   public:
+    Queue() { items_.reserve(64); }
+    [[nodiscard]] bool empty() const { return items_.empty(); }
+    [[nodiscard]] const Pair& top() const { return items_.back(); }  ///< the next pair to be taken
+    [[gnu::always_inline]] void push(const Pair& p) { items_.push_back(p); }
+    [[gnu::always_inline]] Pair pop() {
+      const Pair p = items_.back();
+      items_.pop_back();
+      return p;
+    }
+
+   private:
+    std::vector<Pair> items_;
+  };
+};
+
+struct BestFirst {
+  template <class Pair>
+  class Queue {
+   public:
+    [[nodiscard]] bool empty() const { return items_.empty(); }
+    [[nodiscard]] const Pair& top() const { return items_.top(); }  ///< the highest key
+    [[gnu::always_inline]] void push(const Pair& p) { items_.push(p); }
+    [[gnu::always_inline]] Pair pop() {
+      const Pair p = items_.top();
+      items_.pop();
+      return p;
+    }
+
+   private:
+    struct ByKey {
+      bool operator()(const Pair& x, const Pair& y) const { return x.key < y.key; }
+    };
+    std::priority_queue<Pair, std::vector<Pair>, ByKey> items_;
+  };
+};
+
+struct OrderedDepthFirst {
+  template <class Pair>
+  class Queue {
+   public:
+    Queue() { items_.reserve(64); }
+    [[nodiscard]] bool empty() const { return items_.empty(); }
+    [[nodiscard]] const Pair& top() const { return items_.back(); }  ///< the next pair to be taken
+    /// Keeps the pairs admitted since the last pop in ascending key order (ties: the later one above),
+    /// so the highest is taken next.
+    void push(const Pair& p) {
+      items_.push_back(p);
+      for (std::size_t i = items_.size() - 1; i > fresh_ && items_[i].key < items_[i - 1].key; --i)
+        std::swap(items_[i], items_[i - 1]);
+    }
+    Pair pop() {
+      const Pair p = items_.back();
+      items_.pop_back();
+      fresh_ = items_.size();
+      return p;
+    }
+
+   private:
+    std::vector<Pair> items_;
+    std::size_t fresh_ = 0;  ///< where the pairs admitted since the last pop begin
+  };
+};
+
+// ---- Descent policies -----------------------------------------------------------------------------------
+
+struct SplitLarger {
+  /// Calls sink.child(Pair&&) on each child pair of `p` (not two leaves), in order; stops, returning false,
+  /// as soon as that returns false.
+  template <TreeVolume BV, class Pair, class Sink>
+  [[gnu::always_inline]] static bool expand(const TreePair<BV>& t, const Pair& p, Sink& sink) {
+    using Walker = VolumeWalker<BV>;
+    const TreeNode& na = t.a.node(p.a);
+    const TreeNode& nb = t.b.node(p.b);
+    const bool split_a = nb.is_leaf() || (!na.is_leaf() && t.a.size(p.a) >= t.b.size(p.b));
+    if (split_a) {
+      for (std::uint32_t child : {na.right(), na.left()})
+        if (!sink.child(Pair{{}, child, p.b, Walker::child_a(t.a, p.wa, child, t.context), p.wb, {}}))
+          return false;
+    } else {
+      for (std::uint32_t child : {nb.right(), nb.left()})
+        if (!sink.child(Pair{{}, p.a, child, p.wa, Walker::child_b(t.b, p.wb, child, t.context), {}}))
+          return false;
+    }
+    return true;
+  }
+};
+
+struct SplitBoth {
+  template <TreeVolume BV, class Pair, class Sink>
+  [[gnu::always_inline]] static bool expand(const TreePair<BV>& t, const Pair& p, Sink& sink) {
+    using Walker = VolumeWalker<BV>;
+    using Working = typename Walker::Working;
+    const TreeNode& na = t.a.node(p.a);
+    const TreeNode& nb = t.b.node(p.b);
+    // A leaf stands for itself; an inner node for its two children.
+    std::uint32_t a_nodes[2] = {p.a, p.a}, b_nodes[2] = {p.b, p.b};
+    Working a_work[2] = {p.wa, p.wa}, b_work[2] = {p.wb, p.wb};
+    const int a_count = na.is_leaf() ? 1 : 2, b_count = nb.is_leaf() ? 1 : 2;
+    if (!na.is_leaf())
+      for (int x = 0; x < 2; ++x) {
+        a_nodes[x] = x ? na.right() : na.left();
+        a_work[x] = Walker::child_a(t.a, p.wa, a_nodes[x], t.context);
+      }
+    if (!nb.is_leaf())
+      for (int y = 0; y < 2; ++y) {
+        b_nodes[y] = y ? nb.right() : nb.left();
+        b_work[y] = Walker::child_b(t.b, p.wb, b_nodes[y], t.context);
+      }
+    for (int x = 0; x < a_count; ++x)
+      for (int y = 0; y < b_count; ++y)
+        if (!sink.child(Pair{{}, a_nodes[x], b_nodes[y], a_work[x], b_work[y], {}})) return false;
+    return true;
+  }
+};
+
+// ---- Limits ---------------------------------------------------------------------------------------------
+
+struct Unlimited {
+  static constexpr bool never_stops = true;
+  static constexpr bool allows_test(const Counters&) { return true; }
+  static constexpr bool allows_pop() { return true; }
+};
+
+class BudgetLimit {
+ public:
+  static constexpr bool never_stops = false;
+  explicit BudgetLimit(const Budget& budget) : budget_(budget), start_(std::chrono::steady_clock::now()) {}
+  [[gnu::always_inline]] [[nodiscard]] bool allows_test(const Counters& c) const {
+    return !(budget_.max_bv_tests && c.bv_tests >= budget_.max_bv_tests);
+  }
+  [[gnu::always_inline]] bool allows_pop() {
+    return !(budget_.deadline_us > 0 && (++pops_ & 15) == 0 &&
+             std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start_).count() >
+                 budget_.deadline_us);
+  }
+
+ private:
+  Budget budget_;
+  std::chrono::steady_clock::time_point start_;
+  std::uint64_t pops_ = 0;
+};
+
+// ---- The loop -------------------------------------------------------------------------------------------
+
+namespace driver_detail {
+template <class Hooks, class Pair, class Score>
+concept HasChildrenHook = requires(Hooks& h, const Pair& p, const Score* s) {
+  { h.children_evaluated(p, s, 1) } -> std::same_as<Step>;
+};
+}  // namespace driver_detail
+
+/// The (up to four) evaluated child pairs of a staged expansion. The pairs are left unconstructed: a
+/// hierarchical volume's state is large, and a slot is written only when a child is stored.
+template <class Pair, class Score>
+struct StagedChildren {
+  union Slots {
+    Slots() {}
+    Pair at[4];
+  } pairs;
+  Score scores[4];
+  int count = 0;
+};
+
+/// One traversal: the loop of the header comment. Descent policies hand it each child pair through child().
+/// It holds only references: the queue, the staged children, the trees and the hooks live on the caller's
+/// stack as separate objects, so the queue's out-of-line growth does not force the compiler to reload the
+/// trees' and hooks' references after every BV test.
+template <class QueuePolicy, class Descent, TreeVolume BV, class Hooks, class Limit>
+class Traversal {
+ public:
+  using Pair = typename Hooks::Pair;
+  using Score = decltype(std::declval<Hooks&>().evaluate(std::declval<const Pair&>()));
+  using Queue = typename QueuePolicy::template Queue<Pair>;
+  using Staged = StagedChildren<Pair, Score>;
+
+  Traversal(const TreePair<BV>& trees, Hooks& hooks, Limit& limit, Queue& queue, Staged& staged)
+      : trees_(trees), hooks_(hooks), limit_(limit), queue_(queue), staged_(staged) {}
+
+  [[gnu::always_inline]] void run() {
+    if (!limit_.allows_test(trees_.counters)) return hooks_.finish(queue_, Ended::BudgetExhausted);
+    if (Pair root = trees_.template root<Pair>(); file(root, hooks_.evaluate(root))) return;
+    while (!queue_.empty()) {
+      if (!limit_.allows_pop()) return hooks_.finish(queue_, Ended::BudgetExhausted);
+      const Pair top = queue_.pop();
+      ++trees_.counters.nodes_visited;
+      if (trees_.is_leaf_pair(top)) {
+        if (hooks_.leaf_pair(top) == Step::Decided) return;
+        continue;
+      }
+      staged_.count = 0;
+      if (!Descent::expand(trees_, top, *this)) {
+        if constexpr (!kStaged) return;  // a child decided
+        queue_.push(top);                // unexpanded: it keeps its key for a best-effort answer
+        return hooks_.finish(queue_, Ended::BudgetExhausted);
+      }
+      if constexpr (kStaged) {
+        if constexpr (driver_detail::HasChildrenHook<Hooks, Pair, Score>)
+          if (hooks_.children_evaluated(top, staged_.scores, staged_.count) == Step::Decided) return;
+        for (int c = 0; c < staged_.count; ++c)
+          if (file(staged_.pairs.at[c], staged_.scores[c])) return;
+      }
+    }
+    hooks_.finish(queue_, Ended::QueueEmpty);
+  }
+
+  /// The next child pair of the pair being expanded. False ends the expansion: a child decided, or (staged)
+  /// the limit forbids its test.
+  [[gnu::always_inline]] bool child(Pair&& p) {
+    if constexpr (!kStaged) {
+      return !file(p, hooks_.evaluate(p));
+    } else {
+      if (!limit_.allows_test(trees_.counters)) return false;
+      staged_.scores[staged_.count] = hooks_.evaluate(p);
+      ::new (&staged_.pairs.at[staged_.count++]) Pair(p);
+      return true;
+    }
+  }
+
+  /// Children are staged (all evaluated, then all admitted) when a hook or the limit needs it; otherwise
+  /// each is admitted right after its test, which keeps a small pair in registers.
+  static constexpr bool kStaged = driver_detail::HasChildrenHook<Hooks, Pair, Score> || !Limit::never_stops;
+
+ private:
+  /// Files an evaluated pair; true when the hook decided.
+  [[gnu::always_inline]] bool file(Pair& p, Score s) {
+    const Admission admission = hooks_.admit(p, s);
+    if (admission == Admission::Queue) queue_.push(p);
+    return admission == Admission::Decide;
+  }
+
+  const TreePair<BV>& trees_;
+  Hooks& hooks_;
+  Limit& limit_;
+  Queue& queue_;
+  Staged& staged_;
+};
+
+/// Runs one traversal; see the header comment for the order of the calls.
+template <class QueuePolicy, class Descent, TreeVolume BV, class Hooks, class Limit>
+[[gnu::always_inline]] inline void traverse(const TreePair<BV>& trees, Hooks& hooks, Limit& limit) {
+  using Run = Traversal<QueuePolicy, Descent, BV, Hooks, Limit>;
+  typename Run::Queue queue;
+  typename Run::Staged staged;
+  Run(trees, hooks, limit, queue, staged).run();
+}
+
+}  // namespace bvhlab
