@@ -4,9 +4,9 @@
 // for (g, tau), is derived from the stored parameters, so a tree and its model cannot disagree.
 #pragma once
 
-#include "adb/annotate.hpp"
-#include "adb/model.hpp"
-#include "adb/tree.hpp"
+#include "annotate.hpp"
+#include "model.hpp"
+#include "tree.hpp"
 
 #include <cstdint>
 #include <memory>

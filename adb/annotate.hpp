@@ -46,7 +46,7 @@
 // - Degenerate (exactly collinear) triangles have area 0 and are skipped. A cell with area 0 never counts.
 #pragma once
 
-#include "adb/tree.hpp"
+#include "tree.hpp"
 
 #include <cstddef>
 #include <cstdint>

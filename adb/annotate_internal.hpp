@@ -3,7 +3,7 @@
 // (annotate_exact.cpp) that the per-node count (annotate.cpp) uses.
 #pragma once
 
-#include "volumes/geometry.hpp"
+#include "../volumes/geometry.hpp"
 
 #include <CGAL/Interval_nt.h>
 

@@ -43,8 +43,8 @@
 //                                   created, for two annotations that cannot be combined (other parameters).
 #pragma once
 
-#include "adb/parameters.hpp"
-#include "bvh/bvh.hpp"
+#include "../bvh/bvh.hpp"
+#include "parameters.hpp"
 
 #include <concepts>
 #include <cstddef>

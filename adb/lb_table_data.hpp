@@ -3,7 +3,7 @@
 // Acceptance = accepted planes / planes drawn, for reference.
 #pragma once
 
-#include "adb/lb_table.hpp"
+#include "lb_table.hpp"
 
 namespace bvhlab {
 

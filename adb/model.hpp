@@ -13,9 +13,9 @@
 //     transcendental math and a small expected count is not rounded away to a probability of 0.
 #pragma once
 
-#include "adb/lb_table.hpp"
-#include "adb/probability.hpp"
-#include "volumes/geometry.hpp"
+#include "../volumes/geometry.hpp"
+#include "lb_table.hpp"
+#include "probability.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -41,7 +41,7 @@
 // target: a failed write leaves the previous file (or none), never a half-written tree.
 #pragma once
 
-#include "adb/tree.hpp"
+#include "tree.hpp"
 
 #include <cstddef>
 #include <cstdint>

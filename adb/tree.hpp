@@ -2,8 +2,8 @@
 // (adb/concept.hpp). A tree without density pays nothing: NoDensity's storage is an empty member.
 #pragma once
 
-#include "adb/concept.hpp"
-#include "bvh/bvh.hpp"
+#include "../bvh/bvh.hpp"
+#include "concept.hpp"
 
 #include <stdexcept>
 #include <type_traits>

@@ -1,8 +1,8 @@
 // Bvh<BV>: a flat, pointer-free bounding-volume hierarchy over one mesh.
 #pragma once
 
-#include "bvh/topology.hpp"
-#include "volumes/concept.hpp"
+#include "../volumes/concept.hpp"
+#include "topology.hpp"
 
 #include <chrono>
 #include <cstdint>

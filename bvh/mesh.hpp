@@ -1,7 +1,7 @@
 // A triangle mesh as plain arrays: the one input type of every builder and tool.
 #pragma once
 
-#include "volumes/geometry.hpp"
+#include "../volumes/geometry.hpp"
 
 #include <array>
 #include <cstdint>

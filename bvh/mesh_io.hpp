@@ -1,7 +1,7 @@
 // Mesh loading (anything assimp reads), validation, and the benchmark normalisation.
 #pragma once
 
-#include "bvh/mesh.hpp"
+#include "mesh.hpp"
 
 #include <cstddef>
 #include <filesystem>

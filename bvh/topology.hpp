@@ -1,7 +1,7 @@
 // Tree topology, independent of the bounding volume (after Embree: topology apart from node layout).
 #pragma once
 
-#include "bvh/mesh.hpp"
+#include "mesh.hpp"
 
 #include <cstdint>
 #include <functional>

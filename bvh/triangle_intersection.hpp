@@ -1,7 +1,7 @@
 // Exact triangle-triangle intersection (closed triangles: touching counts as intersecting).
 #pragma once
 
-#include "volumes/geometry.hpp"
+#include "../volumes/geometry.hpp"
 
 namespace bvhlab {
 

@@ -11,7 +11,7 @@
 // Nothing is precomputed per triangle: the caller passes the six vertices.
 #pragma once
 
-#include "bvh/triangle_intersection.hpp"
+#include "triangle_intersection.hpp"
 
 #include <cmath>
 #include <utility>

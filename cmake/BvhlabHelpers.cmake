@@ -11,12 +11,14 @@ if(BVHLAB_WERROR)
     $<$<AND:$<CXX_COMPILER_ID:GNU>,$<VERSION_LESS:$<CXX_COMPILER_VERSION>,13>>:-Wno-error=restrict>)
 endif()
 
-# The source tree's root is the include root: #include "volumes/aabb.hpp".
-# Installed headers keep the same relative paths under include/bvhlab.
+# In the build, the source tree's root is the include root: #include "volumes/aabb.hpp". Installed, the
+# headers sit under include/bvhlab and users write #include <bvhlab/volumes/aabb.hpp>, which cannot clash
+# with another project's volumes/ or adb/; the library's headers include each other by relative paths
+# ("../bvh/bvh.hpp"), which hold in both layouts.
 function(bvhlab_folder_includes target scope)
   target_include_directories(${target} ${scope}
     $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
-    $<INSTALL_INTERFACE:include/bvhlab>)
+    $<INSTALL_INTERFACE:include>)
 endfunction()
 
 # bvhlab_add_test(NAME name SOURCES a.cpp ... [LIBS ...] [LABELS ...] [TIMEOUT s] [NEEDS_MESHES])

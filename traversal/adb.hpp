@@ -16,8 +16,8 @@
 //     adb/model.hpp.
 #pragma once
 
-#include "adb/tree.hpp"
-#include "traversal/driver.hpp"
+#include "../adb/tree.hpp"
+#include "driver.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -68,10 +68,10 @@
 // overlap tests are left to the compiler, as before.
 #pragma once
 
-#include "bvh/bvh.hpp"
-#include "bvh/triangle_intersection.hpp"
-#include "traversal/result.hpp"
-#include "traversal/tree_access.hpp"
+#include "../bvh/bvh.hpp"
+#include "../bvh/triangle_intersection.hpp"
+#include "result.hpp"
+#include "tree_access.hpp"
 
 #include <chrono>
 #include <concepts>

@@ -2,7 +2,7 @@
 // Stops at the first intersecting triangle pair, or lists all of them.
 #pragma once
 
-#include "traversal/driver.hpp"
+#include "driver.hpp"
 
 #include <stdexcept>
 

@@ -2,10 +2,10 @@
 // traversal loops in traversal/exact.hpp and traversal/adb.hpp.
 #pragma once
 
-#include "adb/parameters.hpp"
-#include "traversal/adb.hpp"
-#include "traversal/exact.hpp"
-#include "traversal/strategy.hpp"
+#include "../adb/parameters.hpp"
+#include "adb.hpp"
+#include "exact.hpp"
+#include "strategy.hpp"
 
 #include <span>
 

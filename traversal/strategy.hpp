@@ -24,9 +24,9 @@
 //   S::query(a, b, b_to_a, options) Result for two Tree<BV, D> with accepts<D>; const and thread-safe.
 #pragma once
 
-#include "adb/parameters.hpp"
-#include "traversal/adb.hpp"
-#include "traversal/result.hpp"
+#include "../adb/parameters.hpp"
+#include "adb.hpp"
+#include "result.hpp"
 
 #include <concepts>
 #include <span>

@@ -5,7 +5,7 @@
 //                     boxtree) carry their decoded volume down the tree. Both compile to the direct code.
 #pragma once
 
-#include "bvh/bvh.hpp"
+#include "../bvh/bvh.hpp"
 
 namespace bvhlab {
 

@@ -3,8 +3,8 @@
 // query. Corners are stored as floats rounded outwards: 24 bytes a node, still conservative.
 #pragma once
 
-#include "volumes/concept.hpp"
-#include "volumes/storage.hpp"
+#include "concept.hpp"
+#include "storage.hpp"
 
 #include <cmath>
 

@@ -28,7 +28,7 @@
 //                               (defaults to x, y, z); the DOP-tree uses its own orientations.
 #pragma once
 
-#include "volumes/geometry.hpp"
+#include "geometry.hpp"
 
 #include <concepts>
 #include <span>

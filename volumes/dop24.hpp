@@ -7,7 +7,7 @@
 // DOP-tree.
 #pragma once
 
-#include "volumes/kdop.hpp"
+#include "kdop.hpp"
 
 namespace bvhlab {
 

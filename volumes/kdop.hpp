@@ -24,8 +24,8 @@
 // aabb.hpp, scaled by the magnitudes involved.
 #pragma once
 
-#include "volumes/concept.hpp"
-#include "volumes/storage.hpp"
+#include "concept.hpp"
+#include "storage.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -16,8 +16,8 @@
 // rounding of those products (absolute errors grow with |t|, not with the box size).
 #pragma once
 
-#include "volumes/concept.hpp"
-#include "volumes/storage.hpp"
+#include "concept.hpp"
+#include "storage.hpp"
 
 #include <Eigen/Eigenvalues>
 

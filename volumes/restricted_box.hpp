@@ -8,9 +8,9 @@
 // so the comparison allows a slack of a few ulps of the magnitudes per level (see `overlap`).
 #pragma once
 
-#include "volumes/aabb.hpp"
-#include "volumes/concept.hpp"
-#include "volumes/storage.hpp"
+#include "aabb.hpp"
+#include "concept.hpp"
+#include "storage.hpp"
 
 #include <cstdint>
 

@@ -2,12 +2,12 @@
 // (bench/core/registry.hpp), and the typed volume tests run over them (tests/support/volume_lists.hpp).
 #pragma once
 
-#include "volumes/aabb.hpp"
-#include "volumes/dop24.hpp"
-#include "volumes/kdop.hpp"
-#include "volumes/obb.hpp"
-#include "volumes/restricted_box.hpp"
-#include "volumes/sphere.hpp"
+#include "aabb.hpp"
+#include "dop24.hpp"
+#include "kdop.hpp"
+#include "obb.hpp"
+#include "restricted_box.hpp"
+#include "sphere.hpp"
 
 namespace bvhlab {
 

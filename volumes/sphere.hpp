@@ -7,8 +7,8 @@
 // stored sphere holds every point.
 #pragma once
 
-#include "volumes/concept.hpp"
-#include "volumes/storage.hpp"
+#include "concept.hpp"
+#include "storage.hpp"
 
 #include <algorithm>
 #include <cmath>

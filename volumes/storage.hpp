@@ -3,7 +3,7 @@
 // outward rounding: half the memory traffic, still conservative.
 #pragma once
 
-#include "volumes/geometry.hpp"
+#include "geometry.hpp"
 
 #include <array>
 #include <cmath>

@@ -1,7 +1,7 @@
 // Loads a tetrahedron from memory through the installed mesh loader and builds a tree over it.
-#include <bvh/bvh.hpp>
-#include <bvh/mesh_io.hpp>
-#include <volumes/aabb.hpp>
+#include <bvhlab/bvh/bvh.hpp>
+#include <bvhlab/bvh/mesh_io.hpp>
+#include <bvhlab/volumes/aabb.hpp>
 
 #include <cstdio>
 #include <span>

@@ -1,7 +1,7 @@
 // Builds two trees over a generated mesh and runs an exact and an ADB query through the installed headers.
-#include <adb/adb_density.hpp>
-#include <traversal/strategies.hpp>
-#include <volumes/aabb.hpp>
+#include <bvhlab/adb/adb_density.hpp>
+#include <bvhlab/traversal/strategies.hpp>
+#include <bvhlab/volumes/aabb.hpp>
 
 #include <cstdio>
 
