@@ -130,7 +130,8 @@ struct QueryRun {
   std::string name_a, name_b, bv;
 };
 
-QueryRun run(const QueryArgs& args, bool trees, const QueryRequest& request, const RigidTransform& pose) {
+QueryRun execute_query(const QueryArgs& args, bool trees, const QueryRequest& request,
+                       const RigidTransform& pose) {
   QueryRun out;
   if (trees) {  // saved trees: ADB without polygons; BV, grid and tau come from the files
     out.outcome = run_query_on_trees(args.a, args.b, request.strategy, pose);
@@ -194,7 +195,7 @@ int query_command(const QueryArgs& args) {
   const bool trees = saved_trees(args);
   const QueryRequest request = query_request(args, trees);
   const RigidTransform pose = parse_pose(args.pose, args.protocol);
-  const QueryRun result = run(args, trees, request, pose);
+  const QueryRun result = execute_query(args, trees, request, pose);
   if (args.json)
     print_json(result.outcome, args.all);
   else
