@@ -287,6 +287,9 @@ class TreeStore {
   std::vector<std::string> order_;
 };
 
+// ---------------------------------------------------------------------------------------------------------
+// Objects.
+
 Mesh load_scene_object(const SceneObject& object) {
   if (object.path.empty()) throw MeshError(object.mesh + ": mesh not found");
   Mesh mesh = load_mesh(object.path).mesh;
