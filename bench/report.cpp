@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -156,17 +157,21 @@ std::vector<OperatingPoint> operating_points(const RunOutput& run) {
   return out;
 }
 
-std::string report_readme(const RunOutput& run, bool figures_ok, const std::string& plot_error) {
+namespace {
+
+/// "distances 0.5–1" or why the quality range fell back to all distances.
+std::string quality_range_text(const RunOutput& run, double lo, double hi, bool fell_back) {
+  const ReportSpec& report = run.scene.report;
+  return fell_back ? std::string("all distances (the workload has none in ") + fmt("%g", report.quality_min) +
+                         "–" + fmt("%g", report.quality_max) + ")"
+                   : "distances " + fmt("%g", lo) + "–" + fmt("%g", hi);
+}
+
+/// Title, where and how the run was made, the workload, and what was skipped.
+void readme_header(std::ostream& md, const RunOutput& run) {
   const Scene& scene = run.scene;
   const Environment& env = run.environment;
   const RunStats& stats = run.stats;
-  bool fell_back = false;
-  const auto [lo, hi] = quality_range(run, &fell_back);
-  const std::string range_text = fell_back ? std::string("all distances (the workload has none in ") +
-                                                 fmt("%g", scene.report.quality_min) + "–" +
-                                                 fmt("%g", scene.report.quality_max) + ")"
-                                           : "distances " + fmt("%g", lo) + "–" + fmt("%g", hi);
-  std::ostringstream md;
   md << "# bvhlab report: " << scene.name << "\n\n";
   md << "Scene `" << (scene.file.empty() ? std::string("<memory>") : scene.file.filename().string())
      << "`, run " << env.timestamp << " on " << env.machine << "; " << env.compiler << ", " << env.build_type
@@ -190,8 +195,11 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
      << fmt("%.3f", stats.clock_overhead_us)
      << " µs, measured at the start of the run), all strategies on the same poses in one process.\n\n";
   for (const auto& why : stats.skipped) md << "> **Skipped:** " << why << "\n\n";
+}
 
-  // The operating point, stated plainly.
+/// The operating point, stated plainly.
+void readme_operating_point(std::ostream& md, const RunOutput& run, const std::string& range_text) {
+  const Scene& scene = run.scene;
   md << "## Result at the operating point\n\n";
   const auto points = operating_points(run);
   if (points.empty()) {
@@ -218,14 +226,18 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
           "ratios "
           "within one run.\n";
   md << "\n";
+}
 
-  // Figures.
+void readme_figures(std::ostream& md, bool figures_ok, const std::string& plot_error) {
   md << "## Figures\n\n";
   if (!figures_ok) md << "> The figures could not be drawn: " << plot_error << "\n\n";
   for (const auto& f : report_figures())
     md << "![" << f.caption << "](" << f.file << ")\n\n*" << f.caption << "*\n\n";
+}
 
-  // Summary table over the time-versus-quality range.
+/// The summary table over the time-versus-quality range.
+void readme_summary(std::ostream& md, const RunOutput& run, double lo, double hi,
+                    const std::string& range_text) {
   md << "## Summary over " << range_text << "\n\n";
   md << "| mesh | hierarchy | strategy | mean µs | max µs | FP % | FN % | BV tests/query | triangle "
         "tests/query | "
@@ -238,41 +250,52 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
   md << "\nMaximum times include the odd preemption by the operating system (milliseconds on a shared "
         "machine); "
         "the mean is the robust figure. FCL exposes no work counters (n/a).\n\n";
+}
 
-  // Per-distance tables.
+/// Every distance a row has, in order.
+std::vector<double> row_distances(const RunOutput& run) {
   std::vector<double> distances;
   for (const auto& r : run.rows)
     if (std::find(distances.begin(), distances.end(), r.distance) == distances.end())
       distances.push_back(r.distance);
   std::sort(distances.begin(), distances.end());
-  auto per_distance_table = [&](const std::string& title, bool inexact_only, auto cell) {
-    md << "## " << title << "\n\n| mesh | hierarchy | strategy |";
-    for (double d : distances) md << " d=" << fmt("%g", d) << " |";
-    md << "\n|---|---|---|";
-    for (std::size_t i = 0; i < distances.size(); ++i) md << "---:|";
-    md << "\n";
-    for (const auto& s : summarize(run.rows, -1e300, 1e300)) {
-      if (inexact_only && s.exact_strategy) continue;
-      md << "| " << s.mesh << " | " << s.hierarchy << " | " << series_name(s) << " |";
-      for (double d : distances) {
-        const ResultRow* row = nullptr;
-        for (const auto& r : run.rows)
-          if (r.distance == d && r.mesh == s.mesh && r.hierarchy == s.hierarchy && r.strategy == s.strategy &&
-              r.p_min == s.p_min && r.budget == s.budget)
-            row = &r;
-        md << " " << (row ? cell(*row) : std::string("")) << " |";
-      }
-      md << "\n";
+  return distances;
+}
+
+/// One table of a value per series (rows) and distance (columns).
+void per_distance_table(std::ostream& md, const RunOutput& run, const std::vector<double>& distances,
+                        const std::string& title, bool inexact_only,
+                        const std::function<std::string(const ResultRow&)>& cell) {
+  md << "## " << title << "\n\n| mesh | hierarchy | strategy |";
+  for (double d : distances) md << " d=" << fmt("%g", d) << " |";
+  md << "\n|---|---|---|";
+  for (std::size_t i = 0; i < distances.size(); ++i) md << "---:|";
+  md << "\n";
+  for (const auto& s : summarize(run.rows, -1e300, 1e300)) {
+    if (inexact_only && s.exact_strategy) continue;
+    md << "| " << s.mesh << " | " << s.hierarchy << " | " << series_name(s) << " |";
+    for (double d : distances) {
+      const ResultRow* row = nullptr;
+      for (const auto& r : run.rows)
+        if (r.distance == d && r.mesh == s.mesh && r.hierarchy == s.hierarchy && r.strategy == s.strategy &&
+            r.p_min == s.p_min && r.budget == s.budget)
+          row = &r;
+      md << " " << (row ? cell(*row) : std::string("")) << " |";
     }
     md << "\n";
-  };
-  per_distance_table("Mean time per query (µs) by distance", false,
+  }
+  md << "\n";
+}
+
+void readme_per_distance(std::ostream& md, const RunOutput& run, const std::vector<double>& distances) {
+  per_distance_table(md, run, distances, "Mean time per query (µs) by distance", false,
                      [](const ResultRow& r) { return micros(r.mean_time_us); });
   if (std::any_of(run.rows.begin(), run.rows.end(), [](const ResultRow& r) { return !r.exact_strategy; }))
-    per_distance_table("False positives / false negatives (%) by distance", true,
+    per_distance_table(md, run, distances, "False positives / false negatives (%) by distance", true,
                        [](const ResultRow& r) { return percent(r.fp_rate) + " / " + percent(r.fn_rate); });
+}
 
-  // Models.
+void readme_models(std::ostream& md, const RunOutput& run) {
   md << "## Models\n\n| object | hierarchy | BV | annotation | triangles | nodes | depth | bytes/triangle | "
         "build s | "
         "annotate s | from cache |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---|\n";
@@ -286,8 +309,10 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
         "polygons. "
         "Build and annotation times are those measured when the tree was made (cached trees keep "
         "theirs).\n\n";
+}
 
-  // Ground truth.
+void readme_ground_truth(std::ostream& md, const RunOutput& run, const std::vector<double>& distances) {
+  const RunStats& stats = run.stats;
   md << "## Ground truth\n\nExact first-contact traversal, computed once per (mesh, pose set) and cached; "
      << stats.cgal_checked
      << " poses cross-checked against CGAL (exact predicates): " << stats.cgal_mismatches << " disagreement"
@@ -310,7 +335,9 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
     }
     md << "\n";
   }
+}
 
+void readme_run(std::ostream& md, const RunStats& stats) {
   md << "\n## Run\n\n"
      << stats.queries << " timed queries (" << fmt("%.1f", stats.query_seconds)
      << " s inside queries), preprocessing " << fmt("%.1f", stats.preprocess_seconds) << " s, ground truth "
@@ -323,6 +350,24 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
         "hierarchy, strategy, p_min, budget and distance), `results.json` (the same plus models, ground "
         "truth and "
         "run statistics), `calibration.csv`.\n";
+}
+
+}  // namespace
+
+std::string report_readme(const RunOutput& run, bool figures_ok, const std::string& plot_error) {
+  bool fell_back = false;
+  const auto [lo, hi] = quality_range(run, &fell_back);
+  const std::string range_text = quality_range_text(run, lo, hi, fell_back);
+  const std::vector<double> distances = row_distances(run);
+  std::ostringstream md;
+  readme_header(md, run);
+  readme_operating_point(md, run, range_text);
+  readme_figures(md, figures_ok, plot_error);
+  readme_summary(md, run, lo, hi, range_text);
+  readme_per_distance(md, run, distances);
+  readme_models(md, run);
+  readme_ground_truth(md, run, distances);
+  readme_run(md, run.stats);
   return md.str();
 }
 

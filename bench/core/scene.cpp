@@ -486,17 +486,9 @@ std::vector<PoseGroup> load_pose_file(const std::filesystem::path& file) {
   return parse_poses(parse_json(read_text(file, "pose"), source), source);
 }
 
-Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_dir,
-                  std::string_view source_name) {
-  const std::string source(source_name);
-  const json document = parse_json(json_text, source);
-  const Node root(document, "", source);
-  root.expect_object({"name", "description", "objects", "pairs", "hierarchies", "annotation", "strategies",
-                      "workload", "report"});
-  Scene scene;
-  scene.name = root.has("name") ? root.child("name").string() : "scene";
+namespace {
 
-  // Objects.
+void parse_objects(const Node& root, const std::filesystem::path& base_dir, Scene& scene) {
   const Node objects = root.child("objects");
   for (std::size_t i = 0, n = objects.array_size(); i < n; ++i) {
     const Node o = objects.child(i);
@@ -524,102 +516,112 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
           "meshes/fetch.sh, or mark the object \"optional\": true)");
     scene.objects.push_back(std::move(obj));
   }
+}
 
-  // Pairs.
-  if (root.has("pairs")) {
-    const Node pairs = root.child("pairs");
-    for (std::size_t i = 0, n = pairs.array_size(); i < n; ++i) {
-      const Node p = pairs.child(i);
-      if (!p.value().is_array() || p.value().size() != 2)
-        p.fail("expected [\"object A\", \"object B\"]; " + p.got());
-      ScenePair pair{p.child(std::size_t{0}).string(), p.child(1).string()};
-      for (std::size_t k = 0; k < 2; ++k) {
-        const std::string& nm = k ? pair.b : pair.a;
-        if (!scene.object(nm)) {
-          std::vector<std::string> names;
-          for (const auto& o : scene.objects) names.push_back(o.name);
-          p.child(k).fail("no object named \"" + nm + "\"; expected one of " + join(names));
-        }
-      }
-      scene.pairs.push_back(pair);
-    }
-  } else {
+/// "pairs", or each object with a copy of itself.
+void parse_pairs(const Node& root, Scene& scene) {
+  if (!root.has("pairs")) {
     for (const auto& o : scene.objects) scene.pairs.push_back({o.name, o.name});
+    return;
   }
+  const Node pairs = root.child("pairs");
+  for (std::size_t i = 0, n = pairs.array_size(); i < n; ++i) {
+    const Node p = pairs.child(i);
+    if (!p.value().is_array() || p.value().size() != 2)
+      p.fail("expected [\"object A\", \"object B\"]; " + p.got());
+    ScenePair pair{p.child(std::size_t{0}).string(), p.child(1).string()};
+    for (std::size_t k = 0; k < 2; ++k) {
+      const std::string& nm = k ? pair.b : pair.a;
+      if (!scene.object(nm)) {
+        std::vector<std::string> names;
+        for (const auto& o : scene.objects) names.push_back(o.name);
+        p.child(k).fail("no object named \"" + nm + "\"; expected one of " + join(names));
+      }
+    }
+    scene.pairs.push_back(pair);
+  }
+}
 
-  // Hierarchies.
+/// One entry of "hierarchies"; nullopt (with a note in the scene) for an optional one this build lacks.
+std::optional<HierarchySpec> parse_hierarchy(const Node& h, const std::vector<std::string>& bv_names,
+                                             Scene& scene) {
+  h.expect_object({"bv", "name", "split", "max_leaf_triangles", "optional"});
+  HierarchySpec spec;
+  const bool optional = h.has("optional") && h.child("optional").boolean();
+  const std::string bv = h.child("bv").string();
+  const bool known = std::find(bv_names.begin(), bv_names.end(), bv) != bv_names.end();
+  const bool missing_fcl = bv.rfind("fcl_", 0) == 0 && !fcl_available();
+  if (optional && (!known || missing_fcl)) {
+    scene.notes.push_back("hierarchy " + (h.has("name") ? h.child("name").string() : bv) + " skipped: " +
+                          (missing_fcl ? "this build has no FCL (BVHLAB_WITH_FCL=OFF)"
+                                       : "\"" + bv + "\" is not a registered bounding volume"));
+    return std::nullopt;
+  }
+  spec.bv = h.child("bv").choice(bv_names);
+  if (missing_fcl)
+    h.child("bv").fail("\"" + spec.bv + "\" needs a build with FCL (configure with -DBVHLAB_WITH_FCL=ON)");
+  spec.name = h.has("name") ? h.child("name").string() : spec.bv;
+  if (spec.name.empty()) h.child("name").fail("expected a non-empty name");
+  if (scene.hierarchy(spec.name))
+    (h.has("name") ? h.child("name") : h.child("bv"))
+        .fail("duplicate hierarchy name \"" + spec.name + "\" (give each hierarchy its own \"name\")");
+  if (h.has("split")) {
+    if (spec.is_fcl()) h.child("split").fail("FCL builds its own hierarchy; \"split\" does not apply");
+    spec.build.split = split_method_from_string(h.child("split").choice({"sah", "median"}));
+  }
+  if (h.has("max_leaf_triangles")) {
+    if (spec.is_fcl())
+      h.child("max_leaf_triangles").fail("FCL builds its own hierarchy; this does not apply");
+    spec.build.max_leaf_triangles = static_cast<std::uint32_t>(h.child("max_leaf_triangles").integer(1, 255));
+  }
+  return spec;
+}
+
+void parse_hierarchies(const Node& root, Scene& scene) {
   const std::vector<std::string> bv_names = hierarchy_bv_names();
   const Node hierarchies = root.child("hierarchies");
-  for (std::size_t i = 0, n = hierarchies.array_size(); i < n; ++i) {
-    const Node h = hierarchies.child(i);
-    h.expect_object({"bv", "name", "split", "max_leaf_triangles", "optional"});
-    HierarchySpec spec;
-    const bool optional = h.has("optional") && h.child("optional").boolean();
-    const std::string bv = h.child("bv").string();
-    const bool known = std::find(bv_names.begin(), bv_names.end(), bv) != bv_names.end();
-    const bool missing_fcl = bv.rfind("fcl_", 0) == 0 && !fcl_available();
-    if (optional && (!known || missing_fcl)) {
-      scene.notes.push_back("hierarchy " + (h.has("name") ? h.child("name").string() : bv) + " skipped: " +
-                            (missing_fcl ? "this build has no FCL (BVHLAB_WITH_FCL=OFF)"
-                                         : "\"" + bv + "\" is not a registered bounding volume"));
-      continue;
-    }
-    spec.bv = h.child("bv").choice(bv_names);
-    if (missing_fcl)
-      h.child("bv").fail("\"" + spec.bv + "\" needs a build with FCL (configure with -DBVHLAB_WITH_FCL=ON)");
-    spec.name = h.has("name") ? h.child("name").string() : spec.bv;
-    if (spec.name.empty()) h.child("name").fail("expected a non-empty name");
-    if (scene.hierarchy(spec.name))
-      (h.has("name") ? h.child("name") : h.child("bv"))
-          .fail("duplicate hierarchy name \"" + spec.name + "\" (give each hierarchy its own \"name\")");
-    if (h.has("split")) {
-      if (spec.is_fcl()) h.child("split").fail("FCL builds its own hierarchy; \"split\" does not apply");
-      spec.build.split = split_method_from_string(h.child("split").choice({"sah", "median"}));
-    }
-    if (h.has("max_leaf_triangles")) {
-      if (spec.is_fcl())
-        h.child("max_leaf_triangles").fail("FCL builds its own hierarchy; this does not apply");
-      spec.build.max_leaf_triangles =
-          static_cast<std::uint32_t>(h.child("max_leaf_triangles").integer(1, 255));
-    }
-    scene.hierarchies.push_back(std::move(spec));
-  }
+  for (std::size_t i = 0, n = hierarchies.array_size(); i < n; ++i)
+    if (std::optional<HierarchySpec> spec = parse_hierarchy(hierarchies.child(i), bv_names, scene))
+      scene.hierarchies.push_back(std::move(*spec));
   if (scene.hierarchies.empty()) hierarchies.fail("no hierarchy is available in this build");
+}
 
-  // Density ("annotation"): a registered density and its parameters.
-  if (root.has("annotation")) {
-    const Node a = root.child("annotation");
-    if (!a.value().is_object()) a.fail("expected an object; " + a.got());
-    scene.density.name = a.child("type").choice(density_names());
-    const DensityInfo& info = density_info(scene.density.name);
-    std::vector<std::string> fields{"type"};
-    for (const ParamSpec& p : info.parameters) fields.emplace_back(p.name);
-    a.expect_object(fields);
-    ParamValues given;
-    for (const ParamSpec& p : info.parameters)
-      if (a.has(std::string(p.name)))
-        given[std::string(p.name)] = read_parameter(a.child(std::string(p.name)), p);
-    scene.density.values = checked(a, [&] {
-      return with_density(scene.density.name, [&]<class D>(std::type_identity<D>) {
-        (void)density_params<D>(given);  // the density's own checks, beyond each parameter's range
-        return resolve_parameters(D::parameters(), given, D::name());
-      });
+/// The density ("annotation"): a registered density and its parameters.
+void parse_density(const Node& root, Scene& scene) {
+  if (!root.has("annotation")) return;
+  const Node a = root.child("annotation");
+  if (!a.value().is_object()) a.fail("expected an object; " + a.got());
+  scene.density.name = a.child("type").choice(density_names());
+  const DensityInfo& info = density_info(scene.density.name);
+  std::vector<std::string> fields{"type"};
+  for (const ParamSpec& p : info.parameters) fields.emplace_back(p.name);
+  a.expect_object(fields);
+  ParamValues given;
+  for (const ParamSpec& p : info.parameters)
+    if (a.has(std::string(p.name)))
+      given[std::string(p.name)] = read_parameter(a.child(std::string(p.name)), p);
+  scene.density.values = checked(a, [&] {
+    return with_density(scene.density.name, [&]<class D>(std::type_identity<D>) {
+      (void)density_params<D>(given);  // the density's own checks, beyond each parameter's range
+      return resolve_parameters(D::parameters(), given, D::name());
     });
-  }
+  });
+}
 
-  // A name of a hierarchy left out above may still be referred to: it is skipped there too.
-  auto skipped_hierarchy = [&](const std::string& name) {
-    return std::any_of(scene.notes.begin(), scene.notes.end(), [&](const std::string& note) {
-      return note.rfind("hierarchy " + name + " skipped", 0) == 0;
-    });
-  };
+/// Whether the hierarchy of this name was optional and left out (a name may still be referred to).
+bool hierarchy_skipped(const Scene& scene, const std::string& name) {
+  return std::any_of(scene.notes.begin(), scene.notes.end(), [&](const std::string& note) {
+    return note.rfind("hierarchy " + name + " skipped", 0) == 0;
+  });
+}
 
-  // Strategies.
+void parse_strategies(const Node& root, Scene& scene) {
+  auto skipped = [&](const std::string& name) { return hierarchy_skipped(scene, name); };
   const Node strategies = root.child("strategies");
   for (std::size_t i = 0, n = strategies.array_size(); i < n; ++i) {
     const Node s = strategies.child(i);
     if (!s.value().is_object()) s.fail("expected an object; " + s.got());
-    std::optional<StrategySpec> spec = parse_strategy(s, scene, skipped_hierarchy);
+    std::optional<StrategySpec> spec = parse_strategy(s, scene, skipped);
     if (!spec) {  // every hierarchy it names was optional and left out
       scene.notes.push_back("strategy /strategies/" + std::to_string(i) + " (" + s.child("type").string() +
                             ") skipped: none of its hierarchies is available");
@@ -632,8 +634,27 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
                    [&](const HierarchySpec& h) { return scene.needs_density(h); }))
     root.child("annotation")
         .fail("a density is set but no strategy needs it (annotating would cost time for nothing)");
+}
 
-  // Workload.
+/// A "poses" workload: the pose file, read now, and its content as the workload's identity.
+void parse_pose_file(const Node& w, const std::filesystem::path& base_dir, WorkloadSpec& workload) {
+  w.expect_object({"type", "file"});
+  workload.kind = WorkloadSpec::Kind::PoseFile;
+  const Node f = w.child("file");
+  std::filesystem::path file(f.string());
+  if (!file.is_absolute()) file = base_dir / file;
+  workload.pose_file = file;
+  std::string text;
+  try {
+    text = read_text(file, "pose");
+    workload.groups = parse_poses(parse_json(text, file.string()), file.string());
+  } catch (const SceneError& e) {
+    f.fail(e.what());
+  }
+  workload.identity = "poses:" + ContentHash().update(text).hex();
+}
+
+void parse_workload(const Node& root, const std::filesystem::path& base_dir, WorkloadSpec& workload) {
   if (root.has("workload")) {
     const Node w = root.child("workload");
     if (!w.value().is_object()) w.fail("expected an object; " + w.got());
@@ -641,39 +662,44 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
     if (protocol) {
       w.expect_object({"type", "distances", "steps"});
       if (w.has("distances")) {
-        scene.workload.distances = w.child("distances").numbers(0, 0, 1e6);
-        if (scene.workload.distances.empty()) w.child("distances").fail("expected at least one distance");
+        workload.distances = w.child("distances").numbers(0, 0, 1e6);
+        if (workload.distances.empty()) w.child("distances").fail("expected at least one distance");
       }
-      if (w.has("steps")) scene.workload.steps = static_cast<int>(w.child("steps").integer(1, 10'000'000));
+      if (w.has("steps")) workload.steps = static_cast<int>(w.child("steps").integer(1, 10'000'000));
     } else {
-      w.expect_object({"type", "file"});
-      scene.workload.kind = WorkloadSpec::Kind::PoseFile;
-      const Node f = w.child("file");
-      std::filesystem::path file(f.string());
-      if (!file.is_absolute()) file = base_dir / file;
-      scene.workload.pose_file = file;
-      std::string text;
-      try {
-        text = read_text(file, "pose");
-        scene.workload.groups = parse_poses(parse_json(text, file.string()), file.string());
-      } catch (const SceneError& e) {
-        f.fail(e.what());
-      }
-      scene.workload.identity = "poses:" + ContentHash().update(text).hex();
+      parse_pose_file(w, base_dir, workload);
     }
   }
-  if (scene.workload.kind == WorkloadSpec::Kind::Protocol) {
-    std::string identity = "protocol:steps=" + std::to_string(scene.workload.steps) + ":d=";
-    for (double d : scene.workload.distances) {
+  if (workload.kind == WorkloadSpec::Kind::Protocol) {
+    std::string identity = "protocol:steps=" + std::to_string(workload.steps) + ":d=";
+    for (double d : workload.distances) {
       char buf[32];
       std::snprintf(buf, sizeof buf, "%.17g,", d);
       identity += buf;
-      scene.workload.groups.push_back({d, protocol_poses(d, scene.workload.steps)});
+      workload.groups.push_back({d, protocol_poses(d, workload.steps)});
     }
-    scene.workload.identity = identity;
+    workload.identity = identity;
   }
+}
 
-  parse_report(root, scene, skipped_hierarchy);
+}  // namespace
+
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_dir,
+                  std::string_view source_name) {
+  const std::string source(source_name);
+  const json document = parse_json(json_text, source);
+  const Node root(document, "", source);
+  root.expect_object({"name", "description", "objects", "pairs", "hierarchies", "annotation", "strategies",
+                      "workload", "report"});
+  Scene scene;
+  scene.name = root.has("name") ? root.child("name").string() : "scene";
+  parse_objects(root, base_dir, scene);
+  parse_pairs(root, scene);
+  parse_hierarchies(root, scene);
+  parse_density(root, scene);
+  parse_strategies(root, scene);
+  parse_workload(root, base_dir, scene.workload);
+  parse_report(root, scene, [&](const std::string& name) { return hierarchy_skipped(scene, name); });
   return scene;
 }
 

@@ -1,0 +1,133 @@
+#include "bench/aggregate.hpp"
+
+#include "bench/core/policies.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace bvhlab {
+namespace {
+
+constexpr double kNotApplicable = std::numeric_limits<double>::quiet_NaN();
+
+/// What a row is: the pair, the hierarchy, the strategy variant, the distance and A's model.
+ResultRow series_row(const std::string& label, const HierarchySpec& h, const ModelInfo& model,
+                     const StrategyVariant& variant, double distance) {
+  ResultRow row;
+  row.mesh = label;
+  row.hierarchy = h.name;
+  row.bv = h.bv;
+  row.annotation = model.annotation;
+  row.strategy = variant.strategy;
+  row.label = variant.label();
+  row.exact_strategy = strategy_info(variant.strategy).exact;
+  row.p_min = variant.value_or("p_min", -1);
+  row.budget = variant.budget_label();
+  row.distance = distance;
+  row.model_bytes = model.model_bytes;
+  row.bytes_per_triangle = model.bytes_per_triangle;
+  return row;
+}
+
+}  // namespace
+
+std::vector<TruthSummary> summarize_truth(const std::string& label, const WorkloadSpec& workload,
+                                          const Truth& truth) {
+  std::vector<TruthSummary> out;
+  for (std::size_t g = 0; g < workload.groups.size(); ++g) {
+    TruthSummary summary{label, workload.groups[g].distance, truth[g].size(), 0};
+    for (auto t : truth[g]) summary.colliding += t;
+    out.push_back(summary);
+  }
+  return out;
+}
+
+void Aggregation::add_group(const PreparedPair& pair, const RunPlan& plan, const PoseGroup& group,
+                            const std::vector<std::uint8_t>& truth, const GroupRecords& records,
+                            RunOutput& output) {
+  for (std::size_t i = 0; i < plan.hierarchies.size(); ++i) {
+    const HierarchySpec& h = *plan.hierarchies[i].hierarchy;
+    const PreparedHierarchy& hierarchy = *pair.hierarchies[i];
+    for (std::size_t v = 0; v < plan.hierarchies[i].variants.size(); ++v) {
+      const StrategyVariant& variant = plan.hierarchies[i].variants[v];
+      ResultRow row = series_row(pair.label, h, hierarchy.model, variant, group.distance);
+      const std::string key = pair.label + "\x1f" + h.name + "\x1f" + variant.label();
+      tally(records[i][v], truth, key, hierarchy.has_counters(), row, output.stats);
+      if (!row.exact_strategy && !series_.count(key)) {
+        series_[key] = CalibrationBin{pair.label, h.name, row.strategy, row.budget, row.p_min};
+        order_.push_back(key);
+      }
+      output.rows.push_back(row);
+    }
+  }
+}
+
+void Aggregation::tally(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,
+                        const std::string& series_key, bool has_counters, ResultRow& row, RunStats& stats) {
+  row.queries = records.size();
+  std::size_t fp = 0, fn = 0, truth_yes = 0, answer_yes = 0, inexact = 0, exhausted = 0;
+  double sum_us = 0, max_us = 0;
+  Counters counters;
+  const bool calibrate = !row.exact_strategy;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const QueryRecord& r = records[k];
+    const bool truly = truth[k] != 0;
+    fp += r.collides && !truly;
+    fn += !r.collides && truly;
+    truth_yes += truly;
+    answer_yes += r.collides;
+    inexact += !r.exact;
+    exhausted += r.budget_exhausted;
+    const double micros = std::max(0.0, r.micros - clock_overhead_us_);
+    sum_us += micros;
+    max_us = std::max(max_us, micros);
+    counters += r.counters;
+    if (calibrate) {
+      auto& acc = bins_[series_key];
+      const std::size_t bin =
+          std::min<std::size_t>(9, static_cast<std::size_t>(std::max(0.0, r.probability) * 10));
+      ++acc.count[bin];
+      acc.probability_sum[bin] += r.probability;
+      acc.colliding[bin] += truly;
+    }
+  }
+  const double n = std::max<double>(1.0, double(records.size()));
+  row.truth_colliding_rate = double(truth_yes) / n;
+  row.answer_colliding_rate = double(answer_yes) / n;
+  row.fp_rate = double(fp) / n;
+  row.fn_rate = double(fn) / n;
+  row.inexact_rate = double(inexact) / n;
+  row.budget_exhausted_rate = double(exhausted) / n;
+  row.mean_time_us = sum_us / n;
+  row.max_time_us = max_us;
+  if (has_counters) {
+    row.bv_tests_per_query = double(counters.bv_tests) / n;
+    row.triangle_tests_per_query = double(counters.triangle_tests) / n;
+    row.nodes_visited_per_query = double(counters.nodes_visited) / n;
+  } else {
+    row.bv_tests_per_query = row.triangle_tests_per_query = row.nodes_visited_per_query = kNotApplicable;
+  }
+  stats.queries += records.size();
+  stats.query_seconds += sum_us * 1e-6;
+}
+
+std::vector<CalibrationBin> Aggregation::calibration() const {
+  std::vector<CalibrationBin> out;
+  for (const std::string& key : order_) {
+    const Bins& acc = bins_.at(key);
+    for (std::size_t bin = 0; bin < 10; ++bin) {
+      CalibrationBin b = series_.at(key);
+      b.bin_low = double(bin) / 10;
+      b.bin_high = double(bin + 1) / 10;
+      b.count = acc.count[bin];
+      b.mean_probability =
+          acc.count[bin] ? acc.probability_sum[bin] / double(acc.count[bin]) : kNotApplicable;
+      b.collision_frequency =
+          acc.count[bin] ? double(acc.colliding[bin]) / double(acc.count[bin]) : kNotApplicable;
+      out.push_back(b);
+    }
+  }
+  return out;
+}
+
+}  // namespace bvhlab

@@ -1,0 +1,50 @@
+// The aggregate stage of the bench pipeline (parse -> plan -> prepare -> measure -> aggregate -> write): per
+// series and distance, the answers against the ground truth, the times and the work counters as one
+// results row; per inexact series, the calibration of its probabilities. Internal to the runner.
+#pragma once
+
+#include "bench/measure.hpp"
+
+#include <array>
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+
+/// The ground truth's colliding fraction per distance, for one pair.
+std::vector<TruthSummary> summarize_truth(const std::string& label, const WorkloadSpec& workload,
+                                          const Truth& truth);
+
+/// The aggregate stage of one run.
+class Aggregation {
+ public:
+  /// Every query time is reduced by the clock's own cost (clamped at 0).
+  explicit Aggregation(double clock_overhead_us) : clock_overhead_us_(clock_overhead_us) {}
+  /// One row per planned series of the pair on pose group `group` (`truth`: its ground truth), appended to
+  /// output.rows in plan order; the queries and their time are added to output.stats.
+  void add_group(const PreparedPair& pair, const RunPlan& plan, const PoseGroup& group,
+                 const std::vector<std::uint8_t>& truth, const GroupRecords& records, RunOutput& output);
+  /// Ten probability bins per inexact series, series in the order they first appeared.
+  [[nodiscard]] std::vector<CalibrationBin> calibration() const;
+
+ private:
+  /// Per bin of the probability: queries, their summed probability, and how many truly collide.
+  struct Bins {
+    std::array<std::size_t, 10> count{};
+    std::array<double, 10> probability_sum{};
+    std::array<std::size_t, 10> colliding{};
+  };
+  /// The answers and times of one series, against the truth, into `row`; probabilities into the series'
+  /// bins if it is inexact.
+  void tally(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,
+             const std::string& series_key, bool has_counters, ResultRow& row, RunStats& stats);
+
+  double clock_overhead_us_;
+  std::map<std::string, Bins> bins_;
+  std::map<std::string, CalibrationBin> series_;  ///< what each binned series is, by key
+  std::vector<std::string> order_;
+};
+
+}  // namespace bvhlab

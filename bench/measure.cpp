@@ -1,0 +1,252 @@
+#include "bench/measure.hpp"
+
+#include "bench/core/ground_truth.hpp"
+#include "bench/core/tree_cache.hpp"
+
+#include <unistd.h>
+
+#include <thread>
+
+namespace bvhlab {
+namespace {
+
+/// Poses per block of the interleaved timing loop (see Measurement::time_group).
+constexpr std::size_t kPoseBlock = 50;
+
+/// Reads a ground-truth file's fields in order; throws on a short file.
+struct Reader {
+  std::span<const std::byte> bytes;
+  std::size_t position = 0;
+  std::string_view take(std::size_t n) {
+    if (bytes.size() - position < n) throw std::runtime_error("truncated");
+    std::string_view out(reinterpret_cast<const char*>(bytes.data()) + position, n);
+    position += n;
+    return out;
+  }
+  std::uint64_t u64() {
+    const std::string_view raw = take(8);
+    std::uint64_t v = 0;
+    for (int i = 7; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(raw[static_cast<std::size_t>(i)]);
+    return v;
+  }
+};
+
+Truth exact_truth(const WorkloadSpec& workload, const PreparedHierarchy& exact, unsigned threads) {
+  Truth truth(workload.groups.size());
+  for (std::size_t g = 0; g < workload.groups.size(); ++g) {
+    const auto& poses = workload.groups[g].poses;
+    truth[g].assign(poses.size(), 0);
+    const unsigned workers =
+        std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(poses.size() / 64 + 1)));
+    std::vector<std::thread> pool;
+    for (unsigned w = 0; w < workers; ++w)
+      pool.emplace_back([&, w] {
+        for (std::size_t i = w; i < poses.size(); i += workers) truth[g][i] = exact.exact_collides(poses[i]);
+      });
+    for (auto& t : pool) t.join();
+  }
+  return truth;
+}
+
+}  // namespace
+
+double clock_overhead_us() {
+  std::vector<double> samples(20001);
+  for (double& sample : samples) {
+    const auto start = Clock::now();
+    const auto stop = Clock::now();
+    sample = std::chrono::duration<double, std::micro>(stop - start).count();
+  }
+  std::nth_element(samples.begin(), samples.begin() + samples.size() / 2, samples.end());
+  return samples[samples.size() / 2];
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Ground truth on disk.
+
+std::optional<Truth> TruthCache::load(const std::string& key, const WorkloadSpec& workload,
+                                      std::string* why) const {
+  if (dir_.empty()) return std::nullopt;
+  const auto file = file_of(key);
+  if (!std::filesystem::exists(file)) return std::nullopt;
+  try {
+    const std::vector<std::byte> bytes = tree_cache_detail::read_file_bytes(file);
+    Reader in{bytes};
+    if (in.take(8) != std::string_view("BVHLGT01")) throw std::runtime_error("not a ground-truth file");
+    if (in.u64() != ContentHash().update(key).digest())
+      throw std::runtime_error("stale: made for another key");
+    const std::uint64_t groups = in.u64();
+    if (groups != workload.groups.size()) throw std::runtime_error("stale: wrong number of pose groups");
+    Truth truth(groups);
+    for (std::size_t g = 0; g < groups; ++g) {
+      const std::uint64_t n = in.u64();
+      if (n != workload.groups[g].poses.size()) throw std::runtime_error("stale: wrong number of poses");
+      const std::string_view bits = in.take((n + 7) / 8);
+      truth[g].resize(n);
+      for (std::size_t i = 0; i < n; ++i)
+        truth[g][i] = (static_cast<unsigned char>(bits[i / 8]) >> (i % 8)) & 1;
+    }
+    const std::size_t body = in.position;
+    if (in.u64() != hash_bytes(std::span(bytes).first(body))) throw std::runtime_error("checksum mismatch");
+    if (in.position != bytes.size()) throw std::runtime_error("trailing bytes");
+    return truth;
+  } catch (const std::exception& e) {
+    *why = file.filename().string() + ": " + e.what();
+    return std::nullopt;
+  }
+}
+
+void TruthCache::store(const std::string& key, const Truth& truth, const LogFn& log) const {
+  if (dir_.empty()) return;
+  std::string out = "BVHLGT01";
+  auto put = [&](std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+  };
+  put(ContentHash().update(key).digest());
+  put(truth.size());
+  for (const auto& group : truth) {
+    put(group.size());
+    std::string bits((group.size() + 7) / 8, '\0');
+    for (std::size_t i = 0; i < group.size(); ++i)
+      if (group[i]) bits[i / 8] = static_cast<char>(bits[i / 8] | (1 << (i % 8)));
+    out += bits;
+  }
+  put(hash_bytes(std::as_bytes(std::span(out.data(), out.size()))));
+  try {
+    tree_cache_detail::write_file_bytes(file_of(key), std::as_bytes(std::span(out.data(), out.size())));
+  } catch (const std::exception& e) {
+    log(std::string("truth cache: could not store (") + e.what() + ")");
+  }
+}
+
+std::filesystem::path TruthCache::file_of(const std::string& key) const {
+  return dir_ / (ContentHash().update(key).hex() + ".truth");
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Progress.
+
+Progress::Progress(bool enabled, std::size_t total)
+    : enabled_(enabled && total > 0), total_(total), tty_(isatty(2)) {}
+
+void Progress::advance(std::size_t done, const std::string& label) {
+  if (!enabled_) return;
+  done_ += done;
+  const double fraction = std::min(1.0, double(done_) / double(total_));
+  if (tty_) {
+    const auto now = Clock::now();
+    if (done_ < total_ && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    const int width = 30, filled = static_cast<int>(fraction * width);
+    std::fprintf(stderr, "\r[%s%s] %3d%%  %-48.48s", std::string(filled, '#').c_str(),
+                 std::string(width - filled, '.').c_str(), static_cast<int>(fraction * 100), label.c_str());
+    if (done_ >= total_) std::fputc('\n', stderr);
+  } else {
+    const int tenth = static_cast<int>(fraction * 10);
+    if (tenth > printed_tenth_) {
+      printed_tenth_ = tenth;
+      std::fprintf(stderr, "  %3d%% of the queries done (%s)\n", tenth * 10, label.c_str());
+    }
+  }
+  std::fflush(stderr);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// The stage.
+
+Measurement::Measurement(const Scene& scene, const RunPlan& plan, const RunOptions& options, RunStats& stats,
+                         LogFn log, unsigned threads)
+    : scene_(scene),
+      plan_(plan),
+      stats_(stats),
+      log_(std::move(log)),
+      threads_(threads),
+      warmup_(options.warmup_queries),
+      truth_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "truth"),
+      progress_(options.progress, plan.total_queries) {}
+
+Truth Measurement::ground_truth(const PreparedPair& pair, Preparation& preparation) {
+  const auto truth_start = Clock::now();
+  const std::string truth_key =
+      "truth v1|A=" + pair.a->key + "|B=" + pair.b->key + "|" + scene_.workload.identity;
+  std::string why;
+  std::optional<Truth> truth = truth_cache_.load(truth_key, scene_.workload, &why);
+  if (truth) {
+    ++stats_.truth_cache_hits;
+  } else {
+    if (!why.empty()) {
+      ++stats_.truth_cache_rejected;
+      log_("truth cache: rejected " + why + "; recomputing");
+    }
+    truth = compute_truth(pair, preparation);
+    ++stats_.truth_computed;
+    truth_cache_.store(truth_key, *truth, log_);
+  }
+  cross_check(pair, *truth);
+  stats_.truth_seconds += seconds_since(truth_start);
+  return std::move(*truth);
+}
+
+Truth Measurement::compute_truth(const PreparedPair& pair, Preparation& preparation) {
+  const PreparedHierarchy* exact = nullptr;
+  for (std::size_t i = 0; i < plan_.hierarchies.size() && !exact; ++i)
+    if (!plan_.hierarchies[i].hierarchy->is_fcl()) exact = pair.hierarchies[i].get();
+  std::unique_ptr<PreparedHierarchy> fallback;
+  if (!exact) {  // an FCL-only scene: the truth still comes from bvhlab's exact traversal
+    fallback = preparation.plain_aabb(*pair.a, *pair.b);
+    exact = fallback.get();
+  }
+  log_("computing the ground truth of " + pair.label + " (exact traversal)");
+  return exact_truth(scene_.workload, *exact, threads_);
+}
+
+// Against CGAL on poses spread evenly over the whole workload.
+void Measurement::cross_check(const PreparedPair& pair, const Truth& truth) {
+  const WorkloadSpec& workload = scene_.workload;
+  std::size_t total_poses = 0;
+  for (const auto& group : workload.groups) total_poses += group.poses.size();
+  const std::size_t sample =
+      std::min<std::size_t>(static_cast<std::size_t>(scene_.report.cgal_sample), total_poses);
+  if (sample == 0) return;
+  const CgalGroundTruth cgal(pair.a->mesh, pair.b->mesh);
+  for (std::size_t k = 0; k < sample; ++k) {
+    std::size_t index = (2 * k + 1) * total_poses / (2 * sample);
+    std::size_t g = 0;
+    while (index >= workload.groups[g].poses.size()) index -= workload.groups[g++].poses.size();
+    const bool expected = truth[g][index];
+    if (cgal.collides(workload.groups[g].poses[index]) != expected) {
+      ++stats_.cgal_mismatches;
+      log_("ground truth: CGAL disagrees on " + pair.label + " at distance " +
+           g17(workload.groups[g].distance) + ", pose " + std::to_string(index) + " (truth says " +
+           (expected ? "collision" : "none") + ")");
+    }
+    ++stats_.cgal_checked;
+  }
+}
+
+// Every hierarchy and strategy on the same poses. The poses run in blocks, each block through every
+// series in turn, so a slow spell of a shared machine (another process, frequency changes) spreads
+// over all series instead of landing on one; within a block the caches stay warm.
+GroupRecords Measurement::time_group(const PreparedPair& pair, std::size_t g) {
+  const PoseGroup& group = scene_.workload.groups[g];
+  const auto& planned = plan_.hierarchies;
+  GroupRecords series(planned.size());
+  for (std::size_t i = 0; i < planned.size(); ++i) series[i].resize(planned[i].variants.size());
+  const std::span<const RigidTransform> poses(group.poses);
+  for (std::size_t begin = 0; begin < poses.size(); begin += kPoseBlock) {
+    const auto block = poses.subspan(begin, std::min(kPoseBlock, poses.size() - begin));
+    for (std::size_t i = 0; i < planned.size(); ++i)
+      for (std::size_t v = 0; v < planned[i].variants.size(); ++v) {
+        pair.hierarchies[i]->run(planned[i].variants[v], block, warmup_, block_records_);
+        series[i][v].insert(series[i][v].end(), block_records_.begin(), block_records_.end());
+      }
+    char distance[16];
+    std::snprintf(distance, sizeof distance, "%g", group.distance);
+    std::size_t done = 0;
+    for (const auto& h : planned) done += h.variants.size() * block.size();
+    progress_.advance(done, pair.label + " d=" + distance);
+  }
+  return series;
+}
+
+}  // namespace bvhlab

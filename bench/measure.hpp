@@ -1,0 +1,102 @@
+// The measure stage of the bench pipeline (parse -> plan -> prepare -> measure -> aggregate -> write): each
+// pair's exact ground truth (cached on disk, cross-checked against CGAL on a sample), then every planned
+// series timed on the same poses. Internal to the runner (bench/run.cpp).
+#pragma once
+
+#include "bench/prepare.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+
+/// The timing loop: `warmup` untimed queries, then each pose timed on its own. A template so that each
+/// prepared hierarchy's run() compiles it around its own query, inlined.
+template <class Query>
+void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
+                  Query&& query) {
+  out.clear();
+  out.reserve(poses.size());
+  bool sink = false;
+  for (std::size_t k = 0; k < poses.size() && k < static_cast<std::size_t>(std::max(warmup, 0)); ++k)
+    sink ^= query(poses[k]).collides;
+  for (const RigidTransform& pose : poses) {
+    const auto start = Clock::now();
+    const Result r = query(pose);
+    const auto stop = Clock::now();
+    out.push_back({r.collides, r.exact, r.budget_exhausted, r.probability,
+                   std::chrono::duration<double, std::micro>(stop - start).count(), r.counters});
+  }
+  if (sink && out.empty()) std::fputc(' ', stderr);  // keeps the warm-up from being optimised away
+}
+
+/// What an empty timed region costs: the median of back-to-back clock reads. Subtracted from every query time
+/// (clamped at 0), so that sub-microsecond ADB answers are not inflated by the clock itself.
+double clock_overhead_us();
+
+using Truth = std::vector<std::vector<std::uint8_t>>;  // [group][pose] -> 0/1
+
+/// Exact answers per pose group on disk, one file per key. An empty directory: nothing is read or written.
+class TruthCache {
+ public:
+  explicit TruthCache(std::filesystem::path dir) : dir_(std::move(dir)) {}
+  /// The cached truth, or nothing; `why` names a file that was there but stale or corrupt.
+  std::optional<Truth> load(const std::string& key, const WorkloadSpec& workload, std::string* why) const;
+  void store(const std::string& key, const Truth& truth, const LogFn& log) const;
+  [[nodiscard]] std::filesystem::path file_of(const std::string& key) const;
+
+ private:
+  std::filesystem::path dir_;
+};
+
+/// Progress bar on stderr: redrawn in place on a terminal, a line per tenth otherwise.
+class Progress {
+ public:
+  Progress(bool enabled, std::size_t total);
+  void advance(std::size_t done, const std::string& label);
+
+ private:
+  bool enabled_;
+  std::size_t total_, done_ = 0;
+  bool tty_;
+  int printed_tenth_ = 0;
+  Clock::time_point last_{};
+};
+
+/// One pose group's timed records: [planned hierarchy][variant][pose].
+using GroupRecords = std::vector<std::vector<std::vector<QueryRecord>>>;
+
+/// The measure stage of one run.
+class Measurement {
+ public:
+  Measurement(const Scene& scene, const RunPlan& plan, const RunOptions& options, RunStats& stats, LogFn log,
+              unsigned threads);
+  /// The pair's ground truth: from the disk cache, else the exact traversal on the first bvhlab hierarchy
+  /// (plain AABB trees from `preparation` if there is none); then the CGAL cross-check.
+  Truth ground_truth(const PreparedPair& pair, Preparation& preparation);
+  /// Every planned series of the pair on pose group `g`.
+  GroupRecords time_group(const PreparedPair& pair, std::size_t g);
+
+ private:
+  Truth compute_truth(const PreparedPair& pair, Preparation& preparation);
+  void cross_check(const PreparedPair& pair, const Truth& truth);
+
+  const Scene& scene_;
+  const RunPlan& plan_;
+  RunStats& stats_;
+  LogFn log_;
+  unsigned threads_;
+  int warmup_;
+  TruthCache truth_cache_;
+  Progress progress_;
+  std::vector<QueryRecord> block_records_;
+};
+
+}  // namespace bvhlab

@@ -1,0 +1,427 @@
+#include "bench/prepare.hpp"
+
+#include "bench/core/content_hash.hpp"
+#include "bench/core/policies.hpp"
+#include "bench/core/registry.hpp"
+#include "bench/core/tree_cache.hpp"
+#include "bench/measure.hpp"
+#include "bvh/mesh_io.hpp"
+#include "traversal/strategies.hpp"
+
+#ifdef BVHLAB_HAVE_FCL
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/narrowphase/collision.h>
+#endif
+
+#include <algorithm>
+#include <cstdio>
+#include <thread>
+
+namespace bvhlab {
+
+std::string g17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+namespace {
+
+template <class BV, class D>
+class BvhlabHierarchy final : public PreparedHierarchy {
+ public:
+  BvhlabHierarchy(std::shared_ptr<const Tree<BV, D>> a, std::shared_ptr<const Tree<BV, D>> b)
+      : a_(std::move(a)), b_(std::move(b)) {}
+
+  void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
+           std::vector<QueryRecord>& out) const override {
+    with_configured(variant, [&]<class S>(std::type_identity<S>, const typename S::Options& options) {
+      timed_series(poses, warmup, out,
+                   [&](const RigidTransform& p) { return S::query(*a_, *b_, p, options); });
+    });
+  }
+  [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
+    Result result;
+    with_configured(variant, [&]<class S>(std::type_identity<S>, const typename S::Options& options) {
+      result = S::query(*a_, *b_, pose, options);
+    });
+    return result;
+  }
+  [[nodiscard]] bool exact_collides(const RigidTransform& pose) const override {
+    return query_exact(a_->bvh, b_->bvh, pose).collides;
+  }
+
+ private:
+  /// Calls f(type_identity<S>, options) for the variant's strategy S, configured; throws when S cannot run
+  /// on these trees.
+  template <class F>
+  static void with_configured(const StrategyVariant& variant, F&& f) {
+    with_strategy(variant.strategy, [&]<class S>(std::type_identity<S> strategy) {
+      if constexpr (S::template accepts<D>)
+        f(strategy, strategy_options<S>(variant.values, variant.budget));
+      else
+        throw std::invalid_argument("strategy " + variant.label() + " does not run on trees with density '" +
+                                    std::string(D::name()) + "'");
+    });
+  }
+  std::shared_ptr<const Tree<BV, D>> a_, b_;
+};
+
+#ifdef BVHLAB_HAVE_FCL
+template <class FclBV>
+class FclHierarchy final : public PreparedHierarchy {
+ public:
+  using Model = fcl::BVHModel<FclBV>;
+  FclHierarchy(std::shared_ptr<const Model> a, std::shared_ptr<const Model> b)
+      : a_(std::move(a)), b_(std::move(b)) {}
+
+  void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
+           std::vector<QueryRecord>& out) const override {
+    if (variant.strategy != ExactStrategy::name())
+      throw std::logic_error("runner: FCL hierarchies run the exact strategy only");
+    timed_series(poses, warmup, out, [&](const RigidTransform& p) { return query(p); });
+  }
+  [[nodiscard]] bool exact_collides(const RigidTransform& pose) const override {
+    return query(pose).collides;
+  }
+  [[nodiscard]] bool has_counters() const override { return false; }
+  [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
+    if (variant.strategy != ExactStrategy::name())
+      throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only");
+    return query(pose);
+  }
+
+ private:
+  Result query(const RigidTransform& pose) const {
+    const fcl::CollisionRequestd request(1, false);
+    fcl::Transform3d tf = fcl::Transform3d::Identity();
+    tf.linear() = pose.rotation;
+    tf.translation() = pose.translation;
+    fcl::CollisionResultd result;
+    fcl::collide(a_.get(), fcl::Transform3d::Identity(), b_.get(), tf, request, result);
+    Result r;
+    r.collides = result.isCollision();
+    r.probability = r.collides ? 1 : 0;
+    return r;
+  }
+  std::shared_ptr<const Model> a_, b_;
+};
+#endif
+
+// Progress of a long build or annotation as log lines, every 10%, for meshes large enough to wait on.
+std::function<void(std::size_t, std::size_t)> percent_logger(const LogFn& log, std::string what,
+                                                             std::size_t triangles) {
+  constexpr std::size_t kLargeMesh = 100'000;
+  if (triangles < kLargeMesh) return {};
+  return [log, what = std::move(what), next = std::size_t{10}](std::size_t done, std::size_t total) mutable {
+    const std::size_t percent = total ? 100 * done / total : 100;
+    if (percent < next) return;
+    log("  " + what + " " + std::to_string(percent) + "%");
+    next = percent / 10 * 10 + 10;
+  };
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------
+// Trees: from the run's memory, else the disk cache, else built (and then cached).
+
+class TreeStore {
+ public:
+  TreeStore(const std::filesystem::path& cache_dir, RunStats& stats, LogFn log, unsigned threads)
+      : cache_(cache_dir.empty() ? cache_dir : cache_dir / "trees", log),
+        stats_(stats),
+        log_(std::move(log)),
+        threads_(threads) {}
+
+  /// The tree of `object` for hierarchy `h` with density D (parameters `density`): from this run's memory,
+  /// else the disk cache, else built (a density starts from the plain tree, itself remembered).
+  template <class BV, class D>
+  std::shared_ptr<const Tree<BV, D>> tree(const ObjectData& object, const HierarchySpec& h,
+                                          const DensitySpec& density, ModelInfo* info = nullptr) {
+    const std::string annotation = density.label();
+    const std::string key = plain_key<BV>(object, h) + (annotation == "none" ? "" : "|" + annotation);
+    using T = Tree<BV, D>;
+    if (auto hit = memo_.find(key); hit != memo_.end()) {
+      if (info) *info = infos_.at(key);
+      return std::static_pointer_cast<const T>(hit->second);
+    }
+    CachedTreeTimes times;
+    auto start = Clock::now();
+    std::optional<T> tree = cache_.load<BV, D>(key, object.mesh, &times, annotation);
+    stats_.preprocess_seconds += seconds_since(start);
+    const bool from_cache = tree.has_value();
+    if (!tree) {
+      tree.emplace(make_tree<BV, D>(object, h, density, times));
+      cache_.store(key, *tree, times);
+    }
+    auto shared = std::make_shared<const T>(std::move(*tree));
+    remember(key, shared, describe(*shared, object, h, annotation, times, from_cache), info);
+    return shared;
+  }
+
+#ifdef BVHLAB_HAVE_FCL
+  template <class FclBV>
+  std::shared_ptr<const fcl::BVHModel<FclBV>> fcl_model(const ObjectData& object, const HierarchySpec& h,
+                                                        ModelInfo* info) {
+    const std::string key = "fcl|" + h.bv + "|" + object.key;
+    using Model = fcl::BVHModel<FclBV>;
+    if (auto hit = memo_.find(key); hit != memo_.end()) {
+      *info = infos_.at(key);
+      return std::static_pointer_cast<const Model>(hit->second);
+    }
+    log_("building " + h.bv + " model of " + object.spec->name);
+    const auto start = Clock::now();
+    auto model = std::make_shared<Model>();
+    std::vector<fcl::Vector3d> points(object.mesh.vertices.begin(), object.mesh.vertices.end());
+    std::vector<fcl::Triangle> triangles;
+    triangles.reserve(object.mesh.triangles.size());
+    for (const auto& t : object.mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+    model->beginModel();
+    model->addSubModel(points, triangles);
+    model->endModel();
+    ++stats_.fcl_models_built;
+    ModelInfo m;
+    m.object = object.spec->name;
+    m.hierarchy = h.name;
+    m.bv = h.bv;
+    m.annotation = "none";
+    m.triangles = object.mesh.triangle_count();
+    m.nodes = static_cast<std::size_t>(model->getNumBVs());
+    m.model_bytes = double(m.nodes) * double(sizeof(fcl::BVNode<FclBV>));
+    m.bytes_per_triangle = m.triangles ? m.model_bytes / double(m.triangles) : 0;
+    m.build_seconds = seconds_since(start);
+    stats_.preprocess_seconds += m.build_seconds;
+    remember(key, std::shared_ptr<const Model>(model), m, info);
+    return model;
+  }
+#endif
+
+  [[nodiscard]] std::vector<ModelInfo> models() const {
+    std::vector<ModelInfo> out;
+    for (const auto& key : order_) out.push_back(infos_.at(key));
+    return out;
+  }
+  [[nodiscard]] const TreeCache& cache() const {
+    return cache_;
+  }
+
+ private:
+  template <class BV, class D>
+  Tree<BV, D> make_tree(const ObjectData& object, const HierarchySpec& h, const DensitySpec& density,
+                        CachedTreeTimes& times) {
+    if constexpr (std::is_same_v<D, NoDensity>) {
+      log_("building " + std::string(BV::name()) + " tree of " + object.spec->name + " (" +
+           std::to_string(object.mesh.triangle_count()) + " triangles)");
+      BuildOptions options = h.build;
+      options.threads = threads_;
+      options.progress = percent_logger(log_, "building: triangles placed", object.mesh.triangle_count());
+      Tree<BV, NoDensity> built{Bvh<BV>::build(object.mesh, options), {}};
+      ++stats_.trees_built;
+      times.build_seconds = built.bvh.stats().build_seconds;
+      return built;
+    } else {
+      ModelInfo plain_info;
+      Bvh<BV> bvh = tree<BV, NoDensity>(object, h, DensitySpec{}, &plain_info)->bvh;  // a copy to annotate
+      const auto start = Clock::now();
+      log_("annotating " + std::string(BV::name()) + " tree of " + object.spec->name + " (" +
+           density.label() + ")");
+      AnnotationContext context;
+      context.threads = threads_;
+      context.progress = percent_logger(log_, "annotating", object.mesh.triangle_count());
+      AnnotateStats annotate_stats;
+      Tree<BV, D> annotated =
+          annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &annotate_stats);
+      ++stats_.trees_annotated;
+      stats_.annotation_clip_calls += annotate_stats.clip_calls;
+      times.build_seconds = plain_info.build_seconds;
+      times.annotate_seconds = annotate_stats.seconds;
+      stats_.preprocess_seconds += seconds_since(start);
+      return annotated;
+    }
+  }
+
+  template <class BV>
+  static std::string plain_key(const ObjectData& object, const HierarchySpec& h) {
+    return "bvhlab-tree v1|" + object.key + "|bv=" + std::string(BV::name()) +
+           "|split=" + std::string(to_string(h.build.split)) +
+           "|leaf=" + std::to_string(h.build.max_leaf_triangles);
+  }
+
+  template <class T>
+  static ModelInfo describe(const T& tree, const ObjectData& object, const HierarchySpec& h,
+                            const std::string& annotation, const CachedTreeTimes& times, bool from_cache) {
+    const BvhStats s = tree.bvh.stats();
+    ModelInfo m;
+    m.object = object.spec->name;
+    m.hierarchy = h.name;
+    m.bv = h.bv;
+    m.annotation = annotation;
+    m.triangles = s.triangles;
+    m.nodes = s.nodes;
+    m.depth = s.depth;
+    // Nodes and volumes, plus what the density adds; polygons are not counted (an ADB query does not need
+    // them).
+    m.model_bytes = double(s.nodes * s.bytes_per_node) + double(T::DensityType::memory_bytes(tree.density));
+    m.bytes_per_triangle = s.triangles ? m.model_bytes / double(s.triangles) : 0;
+    m.build_seconds = times.build_seconds;
+    m.annotate_seconds = times.annotate_seconds;
+    m.from_cache = from_cache;
+    return m;
+  }
+
+  void remember(const std::string& key, std::shared_ptr<const void> value, const ModelInfo& info,
+                ModelInfo* out) {
+    memo_[key] = std::move(value);
+    infos_[key] = info;
+    order_.push_back(key);
+    if (out) *out = info;
+  }
+
+  TreeCache cache_;
+  RunStats& stats_;
+  LogFn log_;
+  unsigned threads_;
+  std::map<std::string, std::shared_ptr<const void>> memo_;
+  std::map<std::string, ModelInfo> infos_;
+  std::vector<std::string> order_;
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// Objects.
+
+Mesh load_scene_object(const SceneObject& object) {
+  if (object.path.empty()) throw MeshError(object.mesh + ": mesh not found");
+  Mesh mesh = load_mesh(object.path).mesh;
+  if (object.normalize) normalize_to_unit_cube(mesh);
+  for (Vec3& v : mesh.vertices) v = object.placement.apply(v * object.scale);
+  return mesh;
+}
+
+ObjectData load_object(const SceneObject& spec) {
+  ObjectData out;
+  out.spec = &spec;
+  out.mesh = load_scene_object(spec);
+  const RigidTransform& p = spec.placement;
+  std::string key = "mesh=" + ContentHash::to_hex(hash_file(spec.path)) +
+                    "|normalize=" + (spec.normalize ? "1" : "0") + "|scale=" + g17(spec.scale) +
+                    "|placement=";
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) key += g17(p.rotation(i, j)) + ",";
+  for (int i = 0; i < 3; ++i) key += g17(p.translation(i)) + ",";
+  out.key = key;
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// The stage: objects once per run, trees through the store.
+
+Preparation::Preparation(const std::filesystem::path& cache_dir, RunStats& stats, LogFn log, unsigned threads)
+    : store_(std::make_unique<TreeStore>(cache_dir, stats, std::move(log), threads)), stats_(stats) {}
+
+Preparation::~Preparation() = default;
+
+const ObjectData& Preparation::object(const SceneObject& spec) {
+  auto it = objects_.find(spec.name);
+  if (it == objects_.end()) {
+    const auto start = Clock::now();
+    it = objects_.emplace(spec.name, load_object(spec)).first;
+    ++stats_.meshes_loaded;
+    stats_.preprocess_seconds += seconds_since(start);
+  }
+  return it->second;
+}
+
+PreparedPair Preparation::pair(const Scene& scene, const ScenePair& pair, const RunPlan& plan) {
+  PreparedPair out;
+  out.a = &object(*scene.object(pair.a));
+  out.b = &object(*scene.object(pair.b));
+  out.label = pair.label();
+  for (const PlannedHierarchy& h : plan.hierarchies) out.hierarchies.push_back(hierarchy(h, *out.a, *out.b));
+  return out;
+}
+
+/// The planned hierarchy's trees (or FCL models) for objects a and b, ready to time.
+std::unique_ptr<PreparedHierarchy> Preparation::hierarchy(const PlannedHierarchy& planned,
+                                                          const ObjectData& a, const ObjectData& b) {
+  const HierarchySpec& h = *planned.hierarchy;
+  std::unique_ptr<PreparedHierarchy> out;
+  ModelInfo info;
+  if (h.is_fcl()) {
+#ifdef BVHLAB_HAVE_FCL
+    if (h.bv == "fcl_obb") {
+      auto ma = store_->fcl_model<fcl::OBBd>(a, h, &info);
+      ModelInfo ignored;
+      auto mb = store_->fcl_model<fcl::OBBd>(b, h, &ignored);
+      out = std::make_unique<FclHierarchy<fcl::OBBd>>(ma, mb);
+    } else {
+      auto ma = store_->fcl_model<fcl::OBBRSSd>(a, h, &info);
+      ModelInfo ignored;
+      auto mb = store_->fcl_model<fcl::OBBRSSd>(b, h, &ignored);
+      out = std::make_unique<FclHierarchy<fcl::OBBRSSd>>(ma, mb);
+    }
+#else
+    throw std::invalid_argument("hierarchy " + h.name + " needs FCL, which this build lacks");
+#endif
+  } else {
+    const DensitySpec& density = planned.density;  // the plan decided whether the trees are annotated
+    with_volume(h.bv, [&]<class BV>(std::type_identity<BV>) {
+      with_density(density.name, [&]<class D>(std::type_identity<D>) {
+        if constexpr (DensityFor<D, BV>) {
+          auto ta = store_->tree<BV, D>(a, h, density, &info);
+          auto tb = &a == &b ? ta : store_->tree<BV, D>(b, h, density);
+          out = std::make_unique<BvhlabHierarchy<BV, D>>(ta, tb);
+        } else {
+          throw std::invalid_argument("density " + std::string(D::name()) + " cannot annotate " +
+                                      std::string(BV::name()) + " trees");
+        }
+      });
+    });
+  }
+  out->model = info;
+  return out;
+}
+
+std::unique_ptr<PreparedHierarchy> Preparation::plain_aabb(const ObjectData& a, const ObjectData& b) {
+  HierarchySpec aabb;
+  aabb.bv = aabb.name = "aabb";
+  return std::make_unique<BvhlabHierarchy<Aabb, NoDensity>>(store_->tree<Aabb, NoDensity>(a, aabb, {}),
+                                                            store_->tree<Aabb, NoDensity>(b, aabb, {}));
+}
+
+std::vector<ModelInfo> Preparation::models() const {
+  return store_->models();
+}
+
+void Preparation::count_cache(RunStats& stats) const {
+  const auto& counts = store_->cache().counts();
+  stats.tree_cache_hits = counts.hits;
+  stats.tree_cache_rejected = counts.rejected;
+  stats.tree_cache_stored = counts.stored;
+}
+
+BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hierarchy,
+                             const DensitySpec& density, const std::filesystem::path& output,
+                             unsigned threads, std::function<void(const std::string&)> log) {
+  if (hierarchy.is_fcl()) throw std::invalid_argument("FCL models cannot be saved as bvhlab trees");
+  BuildOutcome outcome;
+  RunStats stats;
+  TreeStore store({}, stats, std::move(log),
+                  threads ? threads : std::max(1u, std::thread::hardware_concurrency()));
+  const ObjectData data = load_object(object);
+  std::vector<std::byte> bytes;
+  with_volume(hierarchy.bv, [&]<class BV>(std::type_identity<BV>) {
+    with_density(density.name, [&]<class D>(std::type_identity<D>) {
+      if constexpr (DensityFor<D, BV>)
+        bytes = save_tree_to_buffer(*store.tree<BV, D>(data, hierarchy, density, &outcome.model));
+      else
+        throw std::invalid_argument("density " + density.name + " cannot annotate " + hierarchy.bv +
+                                    " trees");
+    });
+  });
+  saved_tree_detail::write_file_atomically(output, bytes);
+  outcome.file_bytes = std::filesystem::file_size(output);
+  return outcome;
+}
+
+}  // namespace bvhlab

@@ -1,0 +1,108 @@
+// Saved trees (adb/saved_tree.hpp) as the CLI reads them: recognised, described, queried without polygons.
+#include "bench/run.hpp"
+
+#include "adb/saved_tree.hpp"
+#include "bench/core/policies.hpp"
+#include "bench/core/registry.hpp"
+#include "traversal/strategies.hpp"
+
+#include <chrono>
+#include <fstream>
+#include <tuple>
+
+namespace bvhlab {
+
+using Clock = std::chrono::steady_clock;
+
+bool is_saved_tree(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  char magic[8] = {};
+  return in.read(magic, 8) && std::string_view(magic, 8) == "BVHLTREE";
+}
+
+namespace {
+
+/// Calls f(tree) with the saved tree in `file`, typed by the BV and density its header names.
+template <class F>
+void with_saved_tree(const std::filesystem::path& file, F&& f) {
+  const std::vector<std::byte> bytes = saved_tree_detail::read_file(file);
+  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, file.string());
+  auto named = [&](auto&& dispatch) {
+    try {
+      dispatch();
+    } catch (const SavedTreeError&) {
+      throw;
+    } catch (const std::invalid_argument& e) {  // an unknown BV or density name
+      throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
+    }
+  };
+  named([&] {
+    with_volume(header.bv_name, [&]<class BV>(std::type_identity<BV>) {
+      with_density(header.density_name, [&]<class D>(std::type_identity<D>) {
+        f(load_tree_from_buffer<BV, D>(bytes, file.string()));
+      });
+    });
+  });
+}
+
+}  // namespace
+
+SavedTreeInfo peek_saved_tree(const std::filesystem::path& file) {
+  SavedTreeInfo info;
+  with_saved_tree(file, [&]<class BV, class D>(const Tree<BV, D>& tree) {
+    info.bv = BV::name();
+    info.density = D::name();
+    info.annotation = D::describe(tree.density);
+    info.nodes = tree.bvh.nodes().size();
+    const BvhStats stats = tree.bvh.stats();
+    info.triangles = stats.triangles;
+  });
+  return info;
+}
+
+QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
+                                const StrategyVariant& strategy, const RigidTransform& pose) {
+  const StrategyInfo& info = strategy_info(strategy.strategy);
+  if (info.needs_polygons)
+    throw std::invalid_argument("saved trees carry no polygons, and strategy " + strategy.strategy +
+                                " tests triangles; give the meshes instead");
+  QueryOutcome outcome;
+  with_saved_tree(a, [&]<class BV, class D>(const Tree<BV, D>& tree_a) {
+    with_saved_tree(b, [&]<class BV2, class D2>(const Tree<BV2, D2>& tree_b) {
+      if constexpr (!std::is_same_v<BV, BV2> || !std::is_same_v<D, D2>) {
+        throw std::invalid_argument("the two trees differ in BV or density (" + std::string(BV::name()) +
+                                    ", " + D::describe(tree_a.density) + " vs " + std::string(BV2::name()) +
+                                    ", " + D2::describe(tree_b.density) + ")");
+      } else {
+        with_strategy(strategy.strategy, [&]<class S>(std::type_identity<S>) {
+          if constexpr (S::template accepts<D>) {
+            const auto options = strategy_options<S>(strategy.values, strategy.budget);
+            const auto start = Clock::now();
+            outcome.result = S::query(tree_a, tree_b, pose, options);
+            outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+          } else {
+            throw std::invalid_argument("strategy " + strategy.strategy +
+                                        " does not run on trees with density '" + std::string(D::name()) +
+                                        "'");
+          }
+        });
+        for (auto [model, tree, file] :
+             {std::tuple{&outcome.model_a, &tree_a, &a}, std::tuple{&outcome.model_b, &tree_b, &b}}) {
+          const BvhStats st = tree->bvh.stats();
+          model->object = file->filename().string();
+          model->hierarchy = model->bv = BV::name();
+          model->annotation = D::describe(tree->density);
+          model->triangles = st.triangles;
+          model->nodes = st.nodes;
+          model->depth = st.depth;
+          model->model_bytes = double(st.nodes * st.bytes_per_node + D::memory_bytes(tree->density));
+          model->bytes_per_triangle = st.triangles ? model->model_bytes / double(st.triangles) : 0;
+          model->from_cache = true;
+        }
+      }
+    });
+  });
+  return outcome;
+}
+
+}  // namespace bvhlab
