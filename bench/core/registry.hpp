@@ -17,8 +17,9 @@
 #include <vector>
 
 #ifdef BVHLAB_TEST_POLICIES
-// The test-only policies (tests/support/test_policies.hpp): built into the test variant of the CLI only.
-#include "tests/support/test_policies.hpp"
+// The test-only policies (tests/support/): built into the test variant of the runner and CLI only.
+#include "tests/support/test_density.hpp"
+#include "tests/support/test_strategy.hpp"
 #endif
 
 namespace bvhlab {
