@@ -8,7 +8,6 @@
 
 #include <chrono>
 #include <fstream>
-#include <tuple>
 
 namespace bvhlab {
 
@@ -27,20 +26,15 @@ template <class F>
 void with_saved_tree(const std::filesystem::path& file, F&& f) {
   const std::vector<std::byte> bytes = saved_tree_detail::read_file(file);
   const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, file.string());
-  auto named = [&](auto&& dispatch) {
-    try {
-      dispatch();
-    } catch (const SavedTreeError&) {
-      throw;
-    } catch (const std::invalid_argument& e) {  // an unknown BV or density name
-      throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
-    }
-  };
-  named([&] {
-    with_volume(header.bv_name, [&]<class BV>(std::type_identity<BV>) {
-      with_density(header.density_name, [&]<class D>(std::type_identity<D>) {
-        f(load_tree_from_buffer<BV, D>(bytes, file.string()));
-      });
+  try {  // a name this build does not know is refused naming the file; f's own errors pass unchanged
+    with_volume(header.bv_name, [](auto) {});
+    with_density(header.density_name, [](auto) {});
+  } catch (const std::invalid_argument& e) {
+    throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
+  }
+  with_volume(header.bv_name, [&]<class BV>(std::type_identity<BV>) {
+    with_density(header.density_name, [&]<class D>(std::type_identity<D>) {
+      f(load_tree_from_buffer<BV, D>(bytes, file.string()));
     });
   });
 }
@@ -60,6 +54,38 @@ SavedTreeInfo peek_saved_tree(const std::filesystem::path& file) {
   return info;
 }
 
+namespace {
+
+/// B's tree typed as A's: its header must name the same BV and density (else the error describes both).
+template <class BV, class D>
+Tree<BV, D> load_matching(const Tree<BV, D>& tree_a, const std::filesystem::path& b) {
+  const std::vector<std::byte> bytes = saved_tree_detail::read_file(b);
+  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, b.string());
+  if (header.bv_name != BV::name() || header.density_name != D::name()) {
+    const SavedTreeInfo other = peek_saved_tree(b);
+    throw std::invalid_argument("the two trees differ in BV or density (" + std::string(BV::name()) + ", " +
+                                D::describe(tree_a.density) + " vs " + other.bv + ", " + other.annotation +
+                                ")");
+  }
+  return load_tree_from_buffer<BV, D>(bytes, b.string());
+}
+
+template <class BV, class D>
+void describe_saved(ModelInfo& model, const Tree<BV, D>& tree, const std::filesystem::path& file) {
+  const BvhStats st = tree.bvh.stats();
+  model.object = file.filename().string();
+  model.hierarchy = model.bv = BV::name();
+  model.annotation = D::describe(tree.density);
+  model.triangles = st.triangles;
+  model.nodes = st.nodes;
+  model.depth = st.depth;
+  model.model_bytes = double(st.nodes * st.bytes_per_node + D::memory_bytes(tree.density));
+  model.bytes_per_triangle = st.triangles ? model.model_bytes / double(st.triangles) : 0;
+  model.from_cache = true;
+}
+
+}  // namespace
+
 QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
                                 const StrategyVariant& strategy, const RigidTransform& pose) {
   const StrategyInfo& info = strategy_info(strategy.strategy);
@@ -67,40 +93,23 @@ QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::files
     throw std::invalid_argument("saved trees carry no polygons, and strategy " + strategy.strategy +
                                 " tests triangles; give the meshes instead");
   QueryOutcome outcome;
+  // One dispatch on A's header; B is loaded as the same type (a nested dispatch would instantiate every
+  // pair of types, nearly all of them only to refuse).
   with_saved_tree(a, [&]<class BV, class D>(const Tree<BV, D>& tree_a) {
-    with_saved_tree(b, [&]<class BV2, class D2>(const Tree<BV2, D2>& tree_b) {
-      if constexpr (!std::is_same_v<BV, BV2> || !std::is_same_v<D, D2>) {
-        throw std::invalid_argument("the two trees differ in BV or density (" + std::string(BV::name()) +
-                                    ", " + D::describe(tree_a.density) + " vs " + std::string(BV2::name()) +
-                                    ", " + D2::describe(tree_b.density) + ")");
+    const Tree<BV, D> tree_b = load_matching(tree_a, b);
+    with_strategy(strategy.strategy, [&]<class S>(std::type_identity<S>) {
+      if constexpr (S::template accepts<D>) {
+        const auto options = strategy_options<S>(strategy.values, strategy.budget);
+        const auto start = Clock::now();
+        outcome.result = S::query(tree_a, tree_b, pose, options);
+        outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
       } else {
-        with_strategy(strategy.strategy, [&]<class S>(std::type_identity<S>) {
-          if constexpr (S::template accepts<D>) {
-            const auto options = strategy_options<S>(strategy.values, strategy.budget);
-            const auto start = Clock::now();
-            outcome.result = S::query(tree_a, tree_b, pose, options);
-            outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
-          } else {
-            throw std::invalid_argument("strategy " + strategy.strategy +
-                                        " does not run on trees with density '" + std::string(D::name()) +
-                                        "'");
-          }
-        });
-        for (auto [model, tree, file] :
-             {std::tuple{&outcome.model_a, &tree_a, &a}, std::tuple{&outcome.model_b, &tree_b, &b}}) {
-          const BvhStats st = tree->bvh.stats();
-          model->object = file->filename().string();
-          model->hierarchy = model->bv = BV::name();
-          model->annotation = D::describe(tree->density);
-          model->triangles = st.triangles;
-          model->nodes = st.nodes;
-          model->depth = st.depth;
-          model->model_bytes = double(st.nodes * st.bytes_per_node + D::memory_bytes(tree->density));
-          model->bytes_per_triangle = st.triangles ? model->model_bytes / double(st.triangles) : 0;
-          model->from_cache = true;
-        }
+        throw std::invalid_argument("strategy " + strategy.strategy +
+                                    " does not run on trees with density '" + std::string(D::name()) + "'");
       }
     });
+    describe_saved(outcome.model_a, tree_a, a);
+    describe_saved(outcome.model_b, tree_b, b);
   });
   return outcome;
 }

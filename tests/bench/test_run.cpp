@@ -399,6 +399,17 @@ TEST_F(RunTest, SavedTreesAnswerLikeTheMeshesTheyWereBuiltFrom) {
   }
   StrategyVariant exact;
   EXPECT_THROW(run_query_on_trees(dir / "torus.tree", dir / "torus.tree", exact, {}), std::invalid_argument);
+  // Trees of another volume or density cannot be paired; the error describes both.
+  build_tree_file(torus, testing::hierarchy_of("obb"), annotation, dir / "torus_obb.tree", 2);
+  build_tree_file(torus, aabb, DensitySpec{"adb", {{"grid", 3}, {"tau", 0.5}}}, dir / "torus_g3.tree", 2);
+  for (const char* other : {"torus_obb.tree", "torus_g3.tree"}) {
+    try {
+      run_query_on_trees(dir / "torus.tree", dir / other, request.strategy, {});
+      ADD_FAILURE() << other << " was paired with an AABB grid-2 tree";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("adb grid=2 tau=0.5"), std::string::npos) << e.what();
+    }
+  }
   EXPECT_THROW(peek_saved_tree(dir / "torus.obj"), std::runtime_error);
 }
 
