@@ -1,6 +1,7 @@
-// The test-only density and strategy (tests/support/test_density.hpp, test_strategy.hpp) through the whole bench: they are
-// added by their header and one registry line each, and this binary is built with BVHLAB_TEST_POLICIES.
-// Everything below reaches them by name only: the tables, a scene, the runner, saved trees and the report.
+// The test-only density and strategy (tests/support/test_density.hpp, test_strategy.hpp) through the whole
+// bench: they are added by their header and one registry line each, and this binary is built with
+// BVHLAB_TEST_POLICIES. Everything below reaches them by name only: the tables, a scene, the runner, saved
+// trees and the report.
 #include "bench/core/policies.hpp"
 #include "bench/report.hpp"
 #include "bench/run.hpp"
