@@ -251,19 +251,12 @@ class TreeStore {
   template <class T>
   static ModelInfo describe(const T& tree, const ObjectData& object, const HierarchySpec& h,
                             const std::string& annotation, const CachedTreeTimes& times, bool from_cache) {
-    const BvhStats s = tree.bvh.stats();
     ModelInfo m;
     m.object = object.spec->name;
     m.hierarchy = h.name;
     m.bv = h.bv;
     m.annotation = annotation;
-    m.triangles = s.triangles;
-    m.nodes = s.nodes;
-    m.depth = s.depth;
-    // Nodes and volumes, plus what the density adds; polygons are not counted (an ADB query does not need
-    // them).
-    m.model_bytes = double(s.nodes * s.bytes_per_node) + double(T::DensityType::memory_bytes(tree.density));
-    m.bytes_per_triangle = s.triangles ? m.model_bytes / double(s.triangles) : 0;
+    describe_tree_size(m, tree);
     m.build_seconds = times.build_seconds;
     m.annotate_seconds = times.annotate_seconds;
     m.from_cache = from_cache;

@@ -3,6 +3,7 @@
 // this run's memory, else the disk cache, else built and annotated. Internal to the runner (bench/run.cpp).
 #pragma once
 
+#include "adb/tree.hpp"
 #include "bench/plan.hpp"
 #include "bench/run.hpp"
 #include "traversal/result.hpp"
@@ -35,6 +36,18 @@ struct ObjectData {
 };
 /// Loads the object's mesh and computes its key. Throws MeshError.
 ObjectData load_object(const SceneObject& spec);
+
+/// The size fields of `m` from a tree: counts, depth, and the bytes a query reads (nodes, volumes and what
+/// the density adds; polygons are not counted, an ADB query does not need them).
+template <class BV, class D>
+void describe_tree_size(ModelInfo& m, const Tree<BV, D>& tree) {
+  const BvhStats s = tree.bvh.stats();
+  m.triangles = s.triangles;
+  m.nodes = s.nodes;
+  m.depth = s.depth;
+  m.model_bytes = double(s.nodes * s.bytes_per_node) + double(D::memory_bytes(tree.density));
+  m.bytes_per_triangle = s.triangles ? m.model_bytes / double(s.triangles) : 0;
+}
 
 /// One timed query, as the measure stage records it.
 struct QueryRecord {

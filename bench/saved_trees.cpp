@@ -4,6 +4,7 @@
 #include "adb/saved_tree.hpp"
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
+#include "bench/prepare.hpp"
 #include "traversal/strategies.hpp"
 
 #include <chrono>
@@ -72,15 +73,10 @@ Tree<BV, D> load_matching(const Tree<BV, D>& tree_a, const std::filesystem::path
 
 template <class BV, class D>
 void describe_saved(ModelInfo& model, const Tree<BV, D>& tree, const std::filesystem::path& file) {
-  const BvhStats st = tree.bvh.stats();
   model.object = file.filename().string();
   model.hierarchy = model.bv = BV::name();
   model.annotation = D::describe(tree.density);
-  model.triangles = st.triangles;
-  model.nodes = st.nodes;
-  model.depth = st.depth;
-  model.model_bytes = double(st.nodes * st.bytes_per_node + D::memory_bytes(tree.density));
-  model.bytes_per_triangle = st.triangles ? model.model_bytes / double(st.triangles) : 0;
+  describe_tree_size(model, tree);
   model.from_cache = true;
 }
 
