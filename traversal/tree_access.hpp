@@ -34,11 +34,11 @@ struct VolumeWalker<BV> {
   static Working root_b(const Bvh<BV>&, const Context&) { return {}; }
   static Working child_a(const Bvh<BV>&, const Working&, std::uint32_t, const Context&) { return {}; }
   static Working child_b(const Bvh<BV>&, const Working&, std::uint32_t, const Context&) { return {}; }
-  // flatten: the volume's test is compiled whole into this one function, a single call site for the
-  // compiler to inline into the traversal or not. Left to itself, a unit near its inlining budget keeps the
-  // test out of line at most of the traversal's call sites, each call reloading the pair context.
-  [[gnu::flatten]] static bool overlap(const Bvh<BV>& a, std::uint32_t i, const Working&, const Bvh<BV>& b,
-                                       std::uint32_t j, const Working&, const Context& c) {
+  // always_inline: the walker adds nothing to the volume's test, so the traversal calls BV::overlap
+  // directly; whether that test is inlined is the volume's own choice (see Obb::overlap).
+  [[gnu::always_inline]] static bool overlap(const Bvh<BV>& a, std::uint32_t i, const Working&,
+                                             const Bvh<BV>& b, std::uint32_t j, const Working&,
+                                             const Context& c) {
     return BV::overlap(a.volume(i), b.volume(j), c);
   }
   static Box box(const Bvh<BV>& tree, std::uint32_t i, const Working&) {

@@ -71,7 +71,7 @@ struct Obb {
             pose.translation.cwiseAbs().maxCoeff()};
   }
 
-  static bool overlap(const Obb& a, const Obb& b, const PairContext& c) {
+  [[gnu::flatten]] static bool overlap(const Obb& a, const Obb& b, const PairContext& c) {
     const Mat3 ra = axes_of(a.orientation), rb = axes_of(b.orientation);
     const Vec3 ca = to_vec(a.center), cb = to_vec(b.center), ha = to_vec(a.half), hb = to_vec(b.half);
     const auto rotation = c.rotation.map();
