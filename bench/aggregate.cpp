@@ -20,12 +20,14 @@ ResultRow series_row(const std::string& label, const HierarchySpec& h, const Mod
   row.annotation = model.annotation;
   row.strategy = variant.strategy;
   row.label = variant.label();
-  row.exact_strategy = strategy_info(variant.strategy).exact;
+  const StrategyInfo& strategy = strategy_info(variant.strategy);
+  row.exact_strategy = strategy.exact;
   row.p_min = variant.value_or("p_min", -1);
   row.budget = variant.budget_label();
   row.distance = distance;
-  row.model_bytes = model.model_bytes;
-  row.bytes_per_triangle = model.bytes_per_triangle;
+  // The bytes the strategy reads: a strategy that needs no density does not read the annotation.
+  row.model_bytes = strategy.needs_density ? model.model_bytes : model.model_bytes - model.density_bytes;
+  row.bytes_per_triangle = model.triangles ? row.model_bytes / double(model.triangles) : 0;
   return row;
 }
 

@@ -45,7 +45,8 @@ void describe_tree_size(ModelInfo& m, const Tree<BV, D>& tree) {
   m.triangles = s.triangles;
   m.nodes = s.nodes;
   m.depth = s.depth;
-  m.model_bytes = double(s.nodes * s.bytes_per_node) + double(D::memory_bytes(tree.density));
+  m.density_bytes = double(D::memory_bytes(tree.density));
+  m.model_bytes = double(s.nodes * s.bytes_per_node) + m.density_bytes;
   m.bytes_per_triangle = s.triangles ? m.model_bytes / double(s.triangles) : 0;
 }
 
