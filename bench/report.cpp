@@ -123,21 +123,69 @@ std::vector<SeriesSummary> summarize(const std::vector<ResultRow>& rows, double 
 }
 
 namespace {
-// The time-versus-quality range, or every distance when the workload has none inside it.
-std::pair<double, double> quality_range(const RunOutput& run, bool* fell_back = nullptr) {
-  const ReportSpec& r = run.scene.report;
-  const bool any = std::any_of(run.rows.begin(), run.rows.end(), [&](const ResultRow& row) {
-    return row.distance >= r.quality_min - 1e-12 && row.distance <= r.quality_max + 1e-12;
-  });
-  if (fell_back) *fell_back = !any;
-  return any ? std::pair{r.quality_min, r.quality_max} : std::pair{-1e300, 1e300};
+
+/// Every distance a row has, in order.
+std::vector<double> row_distances(const RunOutput& run) {
+  std::vector<double> distances;
+  for (const auto& r : run.rows)
+    if (std::find(distances.begin(), distances.end(), r.distance) == distances.end())
+      distances.push_back(r.distance);
+  std::sort(distances.begin(), distances.end());
+  return distances;
 }
+
+/// The distances the time-versus-quality summary covers, and the words that say which.
+struct QualityRange {
+  double lo = -1e300, hi = 1e300;  ///< the smallest and largest distance of a row inside the range
+  bool all = true;                 ///< every distance of the run
+  std::string text;                ///< "distances 1.2–1.6", "all distances", ...
+};
+
+/// The poses of the workload's groups inside [lo, hi], and all of them.
+std::pair<std::size_t, std::size_t> poses_inside(const WorkloadSpec& workload, double lo, double hi) {
+  std::size_t inside = 0, total = 0;
+  for (const PoseGroup& g : workload.groups) {
+    total += g.poses.size();
+    if (g.distance >= lo && g.distance <= hi) inside += g.poses.size();
+  }
+  return {inside, total};
+}
+
+/// The scene's quality distances that the run has: the range named by the distances it holds (a scene whose
+/// distances stop at 1.6 is summarised over 1.2–1.6), or all distances when it holds none of them. A pose
+/// file's groups are the user's own: without quality distances in the scene, all its poses are used.
+QualityRange quality_range(const RunOutput& run) {
+  const ReportSpec& spec = run.scene.report;
+  const bool pose_file = run.scene.workload.kind == WorkloadSpec::Kind::PoseFile;
+  QualityRange out;
+  if (pose_file && !spec.quality_given) {
+    out.text = "all poses";
+    return out;
+  }
+  std::vector<double> inside;
+  for (double d : row_distances(run))
+    if (d >= spec.quality_min - 1e-12 && d <= spec.quality_max + 1e-12) inside.push_back(d);
+  if (inside.empty()) {
+    out.text = "all distances (the workload has none in " + fmt("%g", spec.quality_min) + "–" +
+               fmt("%g", spec.quality_max) + ")";
+    return out;
+  }
+  out = {inside.front(), inside.back(), false, ""};
+  out.text = inside.size() == 1 ? "distance " + fmt("%g", out.lo)
+                                : "distances " + fmt("%g", out.lo) + "–" + fmt("%g", out.hi);
+  if (pose_file) {
+    const auto [used, total] = poses_inside(run.scene.workload, out.lo, out.hi);
+    out.text += " (" + std::to_string(used) + " of " + std::to_string(total) + " poses)";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<OperatingPoint> operating_points(const RunOutput& run) {
   const ReportSpec& spec = run.scene.report;
-  const auto [lo, hi] = quality_range(run);
-  const auto series = summarize(run.rows, lo, hi);
+  const QualityRange range = quality_range(run);
+  const auto series = summarize(run.rows, range.lo, range.hi);
   std::vector<OperatingPoint> out;
   std::vector<std::string> meshes;
   for (const auto& s : series)
@@ -159,13 +207,71 @@ std::vector<OperatingPoint> operating_points(const RunOutput& run) {
 
 namespace {
 
-/// "distances 0.5–1" or why the quality range fell back to all distances.
-std::string quality_range_text(const RunOutput& run, double lo, double hi, bool fell_back) {
-  const ReportSpec& report = run.scene.report;
-  return fell_back ? std::string("all distances (the workload has none in ") + fmt("%g", report.quality_min) +
-                         "–" + fmt("%g", report.quality_max) + ")"
-                   : "distances " + fmt("%g", lo) + "–" + fmt("%g", hi);
+/// How an object enters the run: its file, its units, its scale and placement.
+std::string object_text(const SceneObject& o) {
+  std::string text = "`" + o.name + "` (" + std::filesystem::path(o.mesh).filename().string() + ", " +
+                     (o.normalize ? "normalised: centred, longest side 2" : "in its file's units");
+  if (o.scale != 1) text += ", scaled by " + fmt("%g", o.scale);
+  const RigidTransform& p = o.placement;
+  if (!p.translation.isZero() || !p.rotation.isIdentity()) text += ", placed by the scene";
+  return text + ")";
 }
+
+const SceneObject* find_object(const Scene& scene, const std::string& name) {
+  for (const auto& o : scene.objects)
+    if (o.name == name) return &o;
+  return nullptr;
+}
+
+/// "`jeep` (jeep1.ms3d, normalised: ...) against a copy of itself; `env` (...) against `rob` (...)".
+std::string pairs_text(const Scene& scene) {
+  std::string text;
+  for (const ScenePair& p : scene.pairs) {
+    const SceneObject* a = find_object(scene, p.a);
+    const SceneObject* b = find_object(scene, p.b);
+    if (!a || !b) continue;
+    text += (text.empty() ? "" : "; ") + object_text(*a) + " against " +
+            (p.a == p.b ? std::string("a copy of itself") : object_text(*b));
+  }
+  return text;
+}
+
+/// Whether every object is in the protocol's normalised units (normalised, not scaled).
+bool normalised_units(const Scene& scene) {
+  return std::all_of(scene.objects.begin(), scene.objects.end(),
+                     [](const SceneObject& o) { return o.normalize && o.scale == 1; });
+}
+
+/// The workload paragraph: the pairs as the scene gives them, the poses, and the units of the distances.
+std::string workload_text(const Scene& scene) {
+  const WorkloadSpec& w = scene.workload;
+  std::ostringstream md;
+  if (w.kind == WorkloadSpec::Kind::Protocol) {
+    md << "Workload: the tumbling protocol (adb/README.md, section 4) on " << pairs_text(scene)
+       << ". A stays put; B at (d, 0, 0) turns a full R_z(θ)R_x(θ) in " << w.steps
+       << " steps per distance d ∈ {";
+    for (std::size_t i = 0; i < w.distances.size(); ++i) md << (i ? ", " : "") << fmt("%g", w.distances[i]);
+    md << "}. "
+       << (normalised_units(scene) ? "Distances are in the normalised model's units (its longest side is 2)."
+                                   : "Distances are in the scene's units (each object as listed above).")
+       << "\n\n";
+  } else {
+    md << "Workload: " << w.groups.size() << " pose groups from `" << w.pose_file.filename().string()
+       << "` on " << pairs_text(scene)
+       << ". The distance column is the pose file's group (by default the length of the translation).\n\n";
+  }
+  return md.str();
+}
+
+}  // namespace
+
+std::string distance_label(const Scene& scene) {
+  if (scene.workload.kind == WorkloadSpec::Kind::PoseFile) return "pose group (the pose file's \"group\")";
+  return normalised_units(scene) ? "distance d of B's centre (each model normalised: longest side 2)"
+                                 : "distance d of B's centre (scene units)";
+}
+
+namespace {
 
 /// Title, where and how the run was made, the workload, and what was skipped.
 void readme_header(std::ostream& md, const RunOutput& run) {
@@ -176,18 +282,7 @@ void readme_header(std::ostream& md, const RunOutput& run) {
   md << "Scene `" << (scene.file.empty() ? std::string("<memory>") : scene.file.filename().string())
      << "`, run " << env.timestamp << " on " << env.machine << "; " << env.compiler << ", " << env.build_type
      << " build, commit `" << env.git_commit << "`.\n\n";
-  const WorkloadSpec& w = scene.workload;
-  if (w.kind == WorkloadSpec::Kind::Protocol) {
-    md << "Workload: the tumbling protocol (adb/README.md, section 4): two copies of each model, normalised "
-          "to "
-          "[-1, 1]^3; B at (d, 0, 0) turns a full R_z(θ)R_x(θ) in "
-       << w.steps << " steps per distance d ∈ {";
-    for (std::size_t i = 0; i < w.distances.size(); ++i) md << (i ? ", " : "") << fmt("%g", w.distances[i]);
-    md << "}. Distances are in the normalised model's units (its longest side is 2).\n\n";
-  } else {
-    md << "Workload: " << w.groups.size() << " pose groups from `" << w.pose_file.filename().string()
-       << "`.\n\n";
-  }
+  md << workload_text(scene);
   if (scene.density.name != NoDensity::name())
     md << "Density annotation of the trees that need one: `" << scene.density.label()
        << "` (parameters in `bvhlab policies`; the ADB method in adb/README.md).\n\n";
@@ -236,13 +331,12 @@ void readme_figures(std::ostream& md, bool figures_ok, const std::string& plot_e
 }
 
 /// The summary table over the time-versus-quality range.
-void readme_summary(std::ostream& md, const RunOutput& run, double lo, double hi,
-                    const std::string& range_text) {
-  md << "## Summary over " << range_text << "\n\n";
+void readme_summary(std::ostream& md, const RunOutput& run, const QualityRange& range) {
+  md << "## Summary over " << range.text << "\n\n";
   md << "| mesh | hierarchy | strategy | mean µs | max µs | FP % | FN % | BV tests/query | triangle "
         "tests/query | "
         "bytes/triangle |\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const auto& s : summarize(run.rows, lo, hi))
+  for (const auto& s : summarize(run.rows, range.lo, range.hi))
     md << "| " << s.mesh << " | " << s.hierarchy << " | " << series_name(s) << " | " << micros(s.mean_time_us)
        << " | " << micros(s.max_time_us) << " | " << percent(s.fp_rate) << " | " << percent(s.fn_rate)
        << " | " << count(s.bv_tests_per_query) << " | " << count(s.triangle_tests_per_query) << " | "
@@ -250,16 +344,6 @@ void readme_summary(std::ostream& md, const RunOutput& run, double lo, double hi
   md << "\nMaximum times include the odd preemption by the operating system (milliseconds on a shared "
         "machine); "
         "the mean is the robust figure. FCL exposes no work counters (n/a).\n\n";
-}
-
-/// Every distance a row has, in order.
-std::vector<double> row_distances(const RunOutput& run) {
-  std::vector<double> distances;
-  for (const auto& r : run.rows)
-    if (std::find(distances.begin(), distances.end(), r.distance) == distances.end())
-      distances.push_back(r.distance);
-  std::sort(distances.begin(), distances.end());
-  return distances;
 }
 
 /// One table of a value per series (rows) and distance (columns).
@@ -355,15 +439,13 @@ void readme_run(std::ostream& md, const RunStats& stats) {
 }  // namespace
 
 std::string report_readme(const RunOutput& run, bool figures_ok, const std::string& plot_error) {
-  bool fell_back = false;
-  const auto [lo, hi] = quality_range(run, &fell_back);
-  const std::string range_text = quality_range_text(run, lo, hi, fell_back);
+  const QualityRange range = quality_range(run);
   const std::vector<double> distances = row_distances(run);
   std::ostringstream md;
   readme_header(md, run);
-  readme_operating_point(md, run, range_text);
+  readme_operating_point(md, run, range.text);
   readme_figures(md, figures_ok, plot_error);
-  readme_summary(md, run, lo, hi, range_text);
+  readme_summary(md, run, range);
   readme_per_distance(md, run, distances);
   readme_models(md, run);
   readme_ground_truth(md, run, distances);
@@ -373,15 +455,12 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
 
 std::string report_snippet(const RunOutput& run, const std::filesystem::path& report_dir) {
   std::ostringstream md;
-  bool fell_back = false;
-  const auto [lo, hi] = quality_range(run, &fell_back);
+  const QualityRange range = quality_range(run);
   md << "## Results\n\nScene `" << run.scene.file.filename().string() << "` (" << run.stats.queries
      << " timed queries; `make demo` runs `bench/scenes/demo.json`) writes a report folder (`"
      << report_dir.filename().string() << "/README.md`, `results.csv`, five figures). On "
      << run.environment.machine << " (" << run.environment.build_type << ", commit `"
-     << run.environment.git_commit << "`), over "
-     << (fell_back ? std::string("all distances") : "distances " + fmt("%g", lo) + "–" + fmt("%g", hi))
-     << ":\n\n";
+     << run.environment.git_commit << "`), over " << range.text << ":\n\n";
   for (const auto& p : operating_points(run))
     md << "- **" << p.mesh << "**: ADB on " << p.adb.hierarchy << " (p_min = " << fmt("%g", p.adb.p_min)
        << ") " << micros(p.adb.mean_time_us) << " µs per query vs " << micros(p.baseline.mean_time_us)
@@ -424,12 +503,12 @@ ReportFiles write_report(const RunOutput& run, const std::filesystem::path& dir,
       files.plot_error = "plot script " + script.string() + " not found";
     } else {
       const ReportSpec& r = run.scene.report;
-      bool fell_back = false;
-      const auto [lo, hi] = quality_range(run, &fell_back);
+      const QualityRange range = quality_range(run);
       std::string command = shell_quote(python) + " " + shell_quote(script.string()) + " " +
-                            shell_quote(files.dir.string()) + " --quality-min " +
-                            fmt("%.17g", fell_back ? -1e300 : lo) + " --quality-max " +
-                            fmt("%.17g", fell_back ? 1e300 : hi);
+                            shell_quote(files.dir.string()) + " --quality-min " + fmt("%.17g", range.lo) +
+                            " --quality-max " + fmt("%.17g", range.hi) + " --quality-text " +
+                            shell_quote(range.text) + " --distance-label " +
+                            shell_quote(distance_label(run.scene));
       if (!r.operating_hierarchy.empty())
         command += " --operating-strategy " + shell_quote(r.operating_strategy) + " --operating-hierarchy " +
                    shell_quote(r.operating_hierarchy) + " --operating-p-min " +

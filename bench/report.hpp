@@ -37,6 +37,9 @@ struct OperatingPoint {
   double speedup = 0;  ///< baseline mean time / ADB mean time
 };
 std::vector<OperatingPoint> operating_points(const RunOutput& run);
+/// The x-axis label of the figures over distance, in the scene's own terms (normalised units, scene units,
+/// or a pose file's groups).
+std::string distance_label(const Scene& scene);
 
 struct ReportOptions {
   bool figures = true;           ///< run the plot script

@@ -340,6 +340,7 @@ void parse_report(const Node& root, Scene& scene, Skipped&& skipped) {
       if (q[0] > q[1]) r.child("quality_distances").fail("expected [min, max] with min <= max");
       report.quality_min = q[0];
       report.quality_max = q[1];
+      report.quality_given = true;
     }
     if (r.has("cgal_sample"))
       report.cgal_sample = static_cast<int>(r.child("cgal_sample").integer(0, 1'000'000));

@@ -121,7 +121,10 @@ struct WorkloadSpec {
 
 struct ReportSpec {
   double quality_min = 1.2, quality_max = 2.0;  ///< distances the time-versus-quality summary uses
-  int cgal_sample = 64;                         ///< poses per object pair cross-checked against CGAL
+  /// Given in the scene. When not, a pose-file workload is summarised over all its poses: its groups are
+  /// the user's own, and the protocol's quality distances mean nothing for them.
+  bool quality_given = false;
+  int cgal_sample = 64;                     ///< poses per object pair cross-checked against CGAL
   std::string operating_hierarchy;          ///< default: the first hierarchy the operating strategy runs on
   double operating_p_min = -1;              ///< default: the largest p_min <= 0.9, else the largest
   std::string operating_strategy;           ///< default: the first inexact strategy with a p_min

@@ -1,0 +1,128 @@
+// The report follows its scene: the distances it summarises are the ones the run has, a pose file is
+// summarised over all its poses unless the scene says otherwise, the workload text names the scene's
+// objects and units, and a strategy that reads no density is sized without one.
+#include "bench/report.hpp"
+#include "bench/run.hpp"
+#include "scene_fixtures.hpp"
+#include "support/generated_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+namespace bvhlab {
+namespace {
+
+using testing::TempDir;
+
+class ReportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    testing::write_obj(testing::make_torus(0.7, 0.25, 24, 12), dir / "torus.obj");
+    testing::write_obj(testing::make_torus(0.5, 0.2, 16, 8), dir / "ring.obj");
+    options.cache_dir.clear();
+    options.threads = 2;
+    options.warmup_queries = 0;
+    options.log = [](const std::string&) {};
+  }
+
+  /// A protocol scene on the torus; `extra` adds or overrides top-level fields.
+  Scene protocol_scene(const std::string& distances, const std::string& extra = "") {
+    return parse_scene(R"({"name": "r", "objects": [{"mesh": "torus.obj", "normalize": true}],
+        "hierarchies": [{"bv": "aabb"}, {"bv": "dop24"}],
+        "annotation": {"type": "adb", "grid": 2, "tau": 0.5},
+        "strategies": [{"type": "exact"}, {"type": "adb", "p_min": [0.9], "hierarchies": ["aabb"]}],
+        "workload": {"distances": )" +
+                           distances + R"(, "steps": 8}, "report": {"cgal_sample": 2)" + extra + "}}",
+                       dir.path(), "r.json");
+  }
+
+  std::string readme(const RunOutput& run) {
+    ReportOptions no_figures;
+    no_figures.figures = false;
+    return testing::read_text(write_report(run, dir / "report", no_figures).readme);
+  }
+
+  TempDir dir;
+  RunOptions options;
+};
+
+TEST_F(ReportTest, NamesTheDistancesTheRunHasNotTheWholeQualityRange) {
+  const RunOutput run = run_scene(protocol_scene("[0.8, 1.2, 1.6]"), options);
+  const std::string text = readme(run);
+  EXPECT_NE(text.find("Summary over distances 1.2–1.6"), std::string::npos) << text;
+  EXPECT_EQ(text.find("1.2–2"), std::string::npos) << text;
+}
+
+TEST_F(ReportTest, SaysWhenTheRunHasNoneOfTheQualityDistances) {
+  const RunOutput run = run_scene(protocol_scene("[0.4, 0.8]"), options);
+  EXPECT_NE(readme(run).find("all distances (the workload has none in 1.2–2)"), std::string::npos);
+  ASSERT_EQ(operating_points(run).size(), 1u);
+  EXPECT_EQ(operating_points(run)[0].adb.queries, 2u * 8);
+}
+
+TEST_F(ReportTest, PoseFileIsSummarisedOverAllItsPosesUnlessTheSceneSaysOtherwise) {
+  testing::write_text(dir / "poses.json", R"({"poses": [
+      {"translation": [0, 0, 0], "group": 0}, {"translation": [0.3, 0, 0], "group": 0},
+      {"translation": [1.5, 0, 0], "group": 1.5}, {"translation": [5, 0, 0], "group": 5}]})");
+  const auto pose_scene = [&](const std::string& report) {
+    return parse_scene(R"({"objects": [{"mesh": "torus.obj", "normalize": true}],
+        "hierarchies": [{"bv": "aabb"}, {"bv": "dop24"}], "annotation": {"type": "adb", "grid": 2, "tau": 0.5},
+        "strategies": [{"type": "exact"}, {"type": "adb", "p_min": 0.9, "hierarchies": ["aabb"]}],
+        "workload": {"type": "poses", "file": "poses.json"}, "report": {"cgal_sample": 1)" +
+                           report + "}}",
+                       dir.path(), "p.json");
+  };
+  const RunOutput all = run_scene(pose_scene(""), options);
+  ASSERT_EQ(operating_points(all).size(), 1u);
+  EXPECT_EQ(operating_points(all)[0].adb.queries, 4u);
+  EXPECT_NE(readme(all).find("Summary over all poses"), std::string::npos);
+
+  const RunOutput some = run_scene(pose_scene(R"(, "quality_distances": [1, 2])"), options);
+  ASSERT_EQ(operating_points(some).size(), 1u);
+  EXPECT_EQ(operating_points(some)[0].adb.queries, 1u);
+  EXPECT_NE(readme(some).find("distance 1.5 (1 of 4 poses)"), std::string::npos) << readme(some);
+}
+
+TEST_F(ReportTest, WorkloadTextAndDistanceLabelFollowTheSceneObjects) {
+  const Scene normalised = protocol_scene("[1.2]");
+  const std::string normalised_text = readme(run_scene(normalised, options));
+  EXPECT_NE(normalised_text.find("`torus` (torus.obj, normalised: centred, longest side 2) against a copy of "
+                                 "itself"),
+            std::string::npos)
+      << normalised_text;
+  EXPECT_NE(normalised_text.find("normalised model's units"), std::string::npos);
+  EXPECT_NE(distance_label(normalised).find("normalised"), std::string::npos);
+
+  const Scene raw = parse_scene(R"({"objects": [{"mesh": "torus.obj", "normalize": false},
+      {"mesh": "ring.obj", "normalize": false, "scale": 0.5}], "pairs": [["torus", "ring"]],
+      "hierarchies": [{"bv": "aabb"}], "strategies": [{"type": "exact"}],
+      "workload": {"distances": [1.2], "steps": 4}, "report": {"cgal_sample": 1}})",
+                                dir.path(), "raw.json");
+  const std::string raw_text = readme(run_scene(raw, options));
+  EXPECT_NE(raw_text.find("`torus` (torus.obj, in its file's units) against `ring` (ring.obj, in its file's "
+                          "units, scaled by 0.5)"),
+            std::string::npos)
+      << raw_text;
+  EXPECT_EQ(raw_text.find("normalised"), std::string::npos) << raw_text;
+  EXPECT_NE(distance_label(raw).find("scene units"), std::string::npos);
+}
+
+TEST_F(ReportTest, AStrategyWithoutDensityIsSizedWithoutTheAnnotation) {
+  const RunOutput annotated = run_scene(protocol_scene("[1.2]"), options);
+  const RunOutput plain = run_scene(parse_scene(R"({"objects": [{"mesh": "torus.obj", "normalize": true}],
+      "hierarchies": [{"bv": "aabb"}], "strategies": [{"type": "exact"}],
+      "workload": {"distances": [1.2], "steps": 8}, "report": {"cgal_sample": 1}})",
+                                                dir.path(), "plain.json"),
+                                    options);
+  const auto row_of = [](const RunOutput& run, const std::string& strategy) {
+    for (const ResultRow& r : run.rows)
+      if (r.hierarchy == "aabb" && r.strategy == strategy) return r;
+    ADD_FAILURE() << "no aabb " << strategy << " row";
+    return ResultRow{};
+  };
+  const ResultRow exact = row_of(annotated, "exact"), adb = row_of(annotated, "adb");
+  EXPECT_DOUBLE_EQ(exact.bytes_per_triangle, row_of(plain, "exact").bytes_per_triangle);
+  EXPECT_GT(adb.bytes_per_triangle, exact.bytes_per_triangle);  // the annotation is not free
+}
+
+}  // namespace
+}  // namespace bvhlab
