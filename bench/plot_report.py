@@ -1,8 +1,12 @@
 #!/usr/bin/env python3
 """Draws the five figures of a bvhlab report from its results.csv and calibration.csv.
 
-    plot_report.py REPORT_DIR [--quality-min 1.2] [--quality-max 2.0]
-                   [--operating-strategy adb] [--operating-hierarchy aabb] [--operating-p-min 0.9]
+    plot_report.py REPORT_DIR [--quality-min 1.2] [--quality-max 2.0] [--quality-text "distances 1.2-2"]
+                   [--distance-label "..."] [--operating-strategy adb] [--operating-hierarchy aabb]
+                   [--operating-p-min 0.9]
+
+The labels come from the scene (`bvhlab report` passes them): the distance axis says whether distances are
+in normalised or the scene's own units, and figure 3 names the distances it summarises.
 
 Strategies are told apart by the columns results.csv takes from bvhlab's strategy table: "exact" (1 for an
 exact strategy), "strategy" (its name) and "label" (name, labelled parameters, budget); no strategy name is
@@ -27,7 +31,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-DISTANCE_LABEL = "distance d of B's centre (model units; each model scaled to [-1, 1]³)"
+DEFAULT_DISTANCE_LABEL = "distance d of B's centre"
 TIME_LABEL = "mean time per query (µs)"
 MIN_BIN_ANSWERS = 5  # calibration bins with fewer answers say nothing
 
@@ -130,6 +134,45 @@ def legend_below(fig, axes):
                    fontsize=9, frameon=False)
 
 
+def series_colours(keys):
+    """One distinct colour per series key, in order: tab10, then the rest of tab20, then a hue wheel."""
+    palette = list(plt.get_cmap("tab10").colors) + list(plt.get_cmap("tab20").colors[1::2])
+    extra = max(0, len(keys) - len(palette))
+    palette += [plt.get_cmap("hsv")(i / max(1, extra)) for i in range(extra)]
+    return {k: palette[i] for i, k in enumerate(keys)}
+
+
+def layered(index):
+    """Marker size and drawing order for the index-th series: later series smaller and on top, so that a
+    series lying on another stays visible."""
+    return {"markersize": max(5.0, 9.0 - 0.5 * index), "zorder": 3 + index}
+
+
+def log_axis(ax, axis="y"):
+    """A log axis that shows numbers even when it spans less than a decade (1, 2, 5 per decade)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    target = ax.yaxis if axis == "y" else ax.xaxis
+    (ax.set_yscale if axis == "y" else ax.set_xscale)("log")
+    target.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    target.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    target.set_minor_formatter(NullFormatter())
+
+
+def spread_labels(ax, points, colour_of, min_pixels=14):
+    """Annotates (x, y, text) points, pushing a label up while it would overlap one already placed."""
+    ax.figure.canvas.draw()  # fixes the data-to-pixel transform
+    placed = []
+    for x, y, text, key in points:
+        px, py = ax.transData.transform((x, y))
+        dy = 4
+        while any(abs(px - qx) < 3 * min_pixels and abs(py + dy - qy) < min_pixels for qx, qy in placed):
+            dy += min_pixels
+        placed.append((px, py + dy))
+        ax.annotate(text, (x, y), textcoords="offset points", xytext=(5, dy * 72 / ax.figure.dpi), fontsize=8,
+                    color=colour_of(key))
+
+
 LINES = ["-", "--", ":", "-.", (0, (5, 1, 1, 1))]
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
 
@@ -158,16 +201,16 @@ def figure_time_vs_distance(rows, args, out):
     strategies = list(dict.fromkeys(r["strategy"] for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
     for (ax,), mesh in zip(per_mesh, meshes):
-        for key, series in grouped([r for r in rows if r["mesh"] == mesh]).items():
+        shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
+                 if is_exact(s[0]) or is_operating(s[0], args)]
+        for i, series in enumerate(shown):
             first = series[0]
-            if not is_exact(first) and not is_operating(first, args):
-                continue
             colour, line, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
             ax.plot([num(r["distance"]) for r in series], [num(r["mean_time_us"]) for r in series], line,
-                    marker=marker, color=colour, label=f"{first['hierarchy']}: {series_label(first)}")
-        ax.set_yscale("log")
+                    marker=marker, color=colour, label=f"{first['hierarchy']}: {series_label(first)}", **layered(i))
+        log_axis(ax)
         ax.set_title(f"{mesh}: time per query")
-        ax.set_xlabel(DISTANCE_LABEL, fontsize=9)
+        ax.set_xlabel(args.distance_label, fontsize=9)
         ax.set_ylabel(TIME_LABEL)
         ax.grid(True, which="both", alpha=0.3)
     legend_below(fig, axes)
@@ -175,35 +218,36 @@ def figure_time_vs_distance(rows, args, out):
     plt.close(fig)
 
 
+def dodge(series_count, distances):
+    """Horizontal offsets that keep series at equal rates (often 0%) side by side instead of on top."""
+    if series_count < 2 or len(distances) < 2:
+        return [0.0] * series_count
+    step = min(b - a for a, b in zip(distances, distances[1:]) if b > a) if len(set(distances)) > 1 else 1.0
+    width = 0.25 * step
+    return [width * (i / (series_count - 1) - 0.5) for i in range(series_count)]
+
+
 def figure_errors_vs_distance(rows, args, out):
     meshes = meshes_of(rows)
     inexact = [r for r in rows if not is_exact(r)]
+    colours = series_colours(list(grouped(inexact).keys()))  # one colour per series, the same in every panel
+    distances = sorted({num(r["distance"]) for r in rows})
     fig, per_mesh, axes = subplots(len(meshes), rows_per_mesh=2, height=3.6)
-    cmap = plt.get_cmap("viridis")
     for (fp_ax, fn_ax), mesh in zip(per_mesh, meshes):
         series_list = list(grouped([r for r in inexact if r["mesh"] == mesh]).values())
-        adb_count = sum(1 for s in series_list if is_sweep(s[0], args))
-        other_count = len(series_list) - adb_count
-        adb_index = other_index = 0
-        for series in series_list:
+        for i, (series, offset) in enumerate(zip(series_list, dodge(len(series_list), distances))):
             first = series[0]
-            # The operating strategy over p_min in viridis, the other inexact series (budgets, other strategies) in
-            # warm colours: two families, told apart at a glance.
-            if is_sweep(first, args):
-                colour = cmap(adb_index / max(1, adb_count - 1) * 0.85)
-                adb_index += 1
-            else:
-                colour = plt.get_cmap("autumn")(other_index / max(1, other_count) * 0.7)
-                other_index += 1
             marker = "^" if is_sweep(first, args) else "D"
-            label = f"{first['hierarchy']}: {series_label(first)}"
-            d = [num(r["distance"]) for r in series]
-            fp_ax.plot(d, [100 * num(r["fp_rate"]) for r in series], marker=marker, color=colour, label=label)
-            fn_ax.plot(d, [100 * num(r["fn_rate"]) for r in series], marker=marker, color=colour, label=label)
+            style = dict(marker=marker, color=colours[series_key(first)], label=f"{first['hierarchy']}: {series_label(first)}",
+                         **layered(i))
+            d = [num(r["distance"]) + offset for r in series]
+            fp_ax.plot(d, [100 * num(r["fp_rate"]) for r in series], **style)
+            fn_ax.plot(d, [100 * num(r["fn_rate"]) for r in series], **style)
         fp_ax.set_title(f"{mesh}: false positives")
         fn_ax.set_title(f"{mesh}: false negatives")
         for ax, kind in ((fp_ax, "false-positive"), (fn_ax, "false-negative")):
-            ax.set_xlabel(DISTANCE_LABEL, fontsize=9)
+            ax.set_xlabel(args.distance_label + ("; series side by side" if len(series_list) > 1 else ""),
+                          fontsize=9)
             ax.set_ylabel(kind + " rate (% of queries)")
             floor_at_zero(ax)
             ax.grid(True, alpha=0.3)
@@ -223,7 +267,7 @@ def figure_error_vs_time(rows, args, out):
         groups = grouped([r for r in rows if r["mesh"] == mesh])
         curves = {}
         budget_markers = iter(["D", "P", "X", "*", "v", "<", ">"])  # one marker per time-critical budget
-        for key, series in groups.items():
+        for i, series in enumerate(groups.values()):
             first = series[0]
             agg = aggregate(series, args.quality_min, args.quality_max)
             if agg is None:
@@ -234,46 +278,62 @@ def figure_error_vs_time(rows, args, out):
             colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
             if first["budget"]:
                 marker = next(budget_markers, "D")
-            ax.plot([agg["time"]], [100 * (agg["fp"] + agg["fn"])], marker, color=colour, markersize=8,
-                    linestyle="none", label=f"{first['hierarchy']}: {series_label(first)}")
+            ax.plot([agg["time"]], [100 * (agg["fp"] + agg["fn"])], marker, color=colour, linestyle="none",
+                    label=f"{first['hierarchy']}: {series_label(first)}", **layered(i))
+        labels = []
         for hierarchy, points in curves.items():
             points.sort(key=lambda p: p[0])
             colour, line, marker = style_for(hierarchy, args.operating_strategy, hierarchies, strategies)
             xs = [p[1]["time"] for p in points]
             ys = [100 * (p[1]["fp"] + p[1]["fn"]) for p in points]
             ax.plot(xs, ys, "-", marker="^", color=colour, label=f"{hierarchy}: {args.operating_strategy} over p_min")
-            for (p, _), x, y in zip(points, xs, ys):
-                ax.annotate(f"{p:g}", (x, y), textcoords="offset points", xytext=(5, 4), fontsize=8, color=colour)
-        ax.set_xscale("log")
-        ax.set_title(f"{mesh}: error vs time, d in [{args.quality_min:g}, {args.quality_max:g}]"
-                     if args.quality_min > -1e299 else f"{mesh}: error vs time, all distances")
+            labels += [(x, y, f"{p:g}", hierarchy) for (p, _), x, y in zip(points, xs, ys)]
+        log_axis(ax, "x")
+        ax.set_title(f"{mesh}: error vs time, {args.quality_text}")
         ax.set_xlabel(TIME_LABEL + ", log scale")
         ax.set_ylabel("wrong answers (FP + FN, % of queries)")
         floor_at_zero(ax)
         ax.grid(True, which="both", alpha=0.3)
+        spread_labels(ax, labels, lambda h: style_for(h, args.operating_strategy, hierarchies, strategies)[0])
     legend_below(fig, axes)
     fig.savefig(out, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
 
+def adjacent_runs(bins):
+    """Splits bins (sorted by bin_low) where one does not start where the previous one ended."""
+    runs = []
+    for b in bins:
+        if runs and abs(num(runs[-1][-1]["bin_high"]) - num(b["bin_low"])) < 1e-9:
+            runs[-1].append(b)
+        else:
+            runs.append([b])
+    return runs
+
+
 def figure_calibration(calibration, args, out):
     meshes = meshes_of(calibration) or ["(no ADB strategy)"]
     fig, per_mesh, axes = subplots(len(meshes), width=5.2, height=4.6)
-    cmap = plt.get_cmap("viridis")
+    operated = [c for c in calibration if c["strategy"] == args.operating_strategy]
+    colours = series_colours(list(grouped(operated).keys()))  # one colour per series, the same in every panel
     for (ax,), mesh in zip(per_mesh, meshes):
         ax.plot([0, 1], [0, 1], "--", color="grey", label="perfect calibration")
-        series = grouped([c for c in calibration if c["mesh"] == mesh and c["strategy"] == args.operating_strategy])
+        series = grouped([c for c in operated if c["mesh"] == mesh])
         for i, (key, bins) in enumerate(series.items()):
-            used = [b for b in bins if int(b["count"]) >= MIN_BIN_ANSWERS]
+            used = sorted((b for b in bins if int(b["count"]) >= MIN_BIN_ANSWERS), key=lambda b: num(b["bin_low"]))
             if not used:
                 continue
-            colour = cmap(i / max(1, len(series) - 1) * 0.9)
-            xs = [num(b["mean_probability"]) for b in used]
-            ys = [num(b["collision_frequency"]) for b in used]
-            sizes = [12 + 60 * math.sqrt(int(b["count"]) / max(int(c["count"]) for c in used)) for b in used]
+            colour = colours[key]
+            most = max(int(c["count"]) for c in used)
+            for run in adjacent_runs(used):  # no line across an empty or left-out bin
+                if len(run) > 1:
+                    ax.plot([num(b["mean_probability"]) for b in run], [num(b["collision_frequency"]) for b in run],
+                            "-", color=colour, alpha=0.5, linewidth=1, zorder=2 + i)
             first = bins[0]
-            ax.plot(xs, ys, "-", color=colour, alpha=0.5, linewidth=1)
-            ax.scatter(xs, ys, s=sizes, color=colour, label=f"{first['hierarchy']}: p_min={float(first['p_min']):g}")
+            ax.scatter([num(b["mean_probability"]) for b in used], [num(b["collision_frequency"]) for b in used],
+                       s=[12 + 60 * math.sqrt(int(b["count"]) / most) for b in used], color=colour,
+                       edgecolors="black", linewidths=0.4, zorder=3 + i,
+                       label=f"{first['hierarchy']}: p_min={float(first['p_min']):g}")
         ax.set_xlim(-0.02, 1.02)
         ax.set_ylim(-0.02, 1.02)
         ax.set_aspect("equal")
@@ -296,17 +356,17 @@ def figure_time_vs_size(rows, args, out):
     strategies = list(dict.fromkeys(r["strategy"] for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
     for (ax,), mesh in zip(per_mesh, meshes):
-        for key, series in grouped([r for r in rows if r["mesh"] == mesh]).items():
+        shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
+                 if is_exact(s[0]) or is_operating(s[0], args)]
+        for i, series in enumerate(shown):
             first = series[0]
-            if not is_exact(first) and not is_operating(first, args):
-                continue
             agg = aggregate(series, -1e300, 1e300)
             if agg is None or not math.isfinite(agg["bytes"]):
                 continue
             colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
             label = f"{first['hierarchy']}: {series_label(first)}"
-            ax.plot([agg["bytes"]], [agg["time"]], marker, color=colour, markersize=9, linestyle="none", label=label)
-        ax.set_yscale("log")
+            ax.plot([agg["bytes"]], [agg["time"]], marker, color=colour, linestyle="none", label=label, **layered(i))
+        log_axis(ax)
         ax.set_title(f"{mesh}: time vs model size (all distances)")
         ax.set_xlabel("model size (bytes per triangle, without polygons)")
         ax.set_ylabel(TIME_LABEL)
@@ -322,6 +382,8 @@ def main():
     parser.add_argument("report_dir")
     parser.add_argument("--quality-min", type=float, default=1.2)
     parser.add_argument("--quality-max", type=float, default=2.0)
+    parser.add_argument("--quality-text", default="the quality distances")
+    parser.add_argument("--distance-label", default=DEFAULT_DISTANCE_LABEL)
     parser.add_argument("--operating-strategy", default="")
     parser.add_argument("--operating-hierarchy", default="")
     parser.add_argument("--operating-p-min", type=float, default=-1)
