@@ -14,7 +14,9 @@ configure: deps
 build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)
 
-demo: build
+# The demo needs the CLI only: no tests, benchmarks or fuzzers are built first.
+demo: configure
+	cmake --build --preset $(PRESET) -j $(JOBS) --target bvhlab_cli
 	$(BUILD_DIR)/bench/bvhlab demo --build-dir $(BUILD_DIR)
 
 test: build
