@@ -135,7 +135,7 @@ void write_calibration_csv(const RunOutput& run, const std::filesystem::path& fi
   if (!out) throw std::runtime_error(file.string() + ": write error");
 }
 
-void write_results_json(const RunOutput& run, const std::filesystem::path& file) {
+json results_document(const RunOutput& run) {
   const Environment& env = run.environment;
   const RunStats& s = run.stats;
   json doc;
@@ -206,8 +206,12 @@ void write_results_json(const RunOutput& run, const std::filesystem::path& file)
                    {"collision_frequency", optional_number(c.collision_frequency)}});
   doc["calibration"] = cal;
   doc["policies"] = policies_json();
+  return doc;
+}
+
+void write_results_json(const RunOutput& run, const std::filesystem::path& file) {
   std::ofstream out = open_output(file);
-  out << doc.dump(1) << '\n';
+  out << results_document(run).dump(1) << '\n';
   if (!out) throw std::runtime_error(file.string() + ": write error");
 }
 

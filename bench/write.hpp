@@ -3,6 +3,8 @@
 
 #include "bench/run.hpp"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -13,6 +15,8 @@ namespace bvhlab {
 const std::vector<std::string>& results_csv_columns();
 void write_results_csv(const RunOutput& run, const std::filesystem::path& file);
 void write_calibration_csv(const RunOutput& run, const std::filesystem::path& file);
+/// results.json's document: scene, environment, stats, models, ground truth, rows, calibration and policies.
+nlohmann::json results_document(const RunOutput& run);
 void write_results_json(const RunOutput& run, const std::filesystem::path& file);
 
 }  // namespace bvhlab

@@ -10,6 +10,8 @@ packages=(build-essential cmake libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev
 packages+=(clang libclang-rt-14-dev)
 # `make format-check` (the first stage of .ci/run).
 packages+=(clang-format)
+# The Python module (python/) and its tests: headers, pybind11, numpy, pytest.
+packages+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest)
 # npm is needed as a command, from whatever package provides it: some machines carry a nodejs build that
 # bundles npm and conflicts with Debian's npm package, so that package is asked for only when no npm exists.
 command -v npm >/dev/null 2>&1 || packages+=(npm)

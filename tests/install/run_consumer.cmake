@@ -1,5 +1,6 @@
 # ctest -P script: install the build tree into a scratch prefix, then configure, build and run the consumer.
-# Inputs: BUILD_DIR, SOURCE_DIR, WORK_DIR, GENERATOR, BUILD_TYPE, CXX_COMPILER, CXX_FLAGS, LINKER_FLAGS.
+# Inputs: BUILD_DIR, SOURCE_DIR, WORK_DIR, GENERATOR, BUILD_TYPE, CXX_COMPILER, CXX_FLAGS, LINKER_FLAGS;
+# with the Python module, PYTHON (the interpreter) and PYTHON_DIR (its install folder below the prefix).
 file(REMOVE_RECURSE "${WORK_DIR}")
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -15,3 +16,18 @@ run(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 run("${WORK_DIR}/build/consumer")
 run("${WORK_DIR}/build/consumer_load")
 message(STATUS "consumer built against ${WORK_DIR}/prefix and ran")
+if(PYTHON)
+  set(site "${WORK_DIR}/prefix/${PYTHON_DIR}")
+  file(GLOB module "${site}/bvhlab*.so")
+  if(NOT module)
+    message(FATAL_ERROR "the Python module is not installed in ${site}")
+  endif()
+  run(${CMAKE_COMMAND} -E env "PYTHONPATH=${site}" ${PYTHON} -c [=[
+import sys, bvhlab
+assert bvhlab.__file__.startswith(sys.argv[1]), bvhlab.__file__
+tree = bvhlab.Tree(bvhlab.load_mesh(sys.argv[2], normalize=True))
+assert bvhlab.query(tree, tree, translation=[0.5, 0, 0]).collides
+assert not bvhlab.query(tree, tree, translation=[3, 0, 0]).collides
+]=] "${site}" "${SOURCE_DIR}/meshes/pinion.off")
+  message(STATUS "the Python module imported from ${site} and ran")
+endif()

@@ -1,0 +1,202 @@
+#include "python/any_tree.hpp"
+
+#include "adb/saved_tree.hpp"
+#include "bench/core/policies.hpp"
+#include "bench/core/registry.hpp"
+#include "bench/core/tree_cache.hpp"
+#include "bench/prepare.hpp"
+#include "traversal/strategies.hpp"
+
+#include <stdexcept>
+
+namespace bvhlab::python {
+
+namespace fs = std::filesystem;
+
+/// The typed tree behind a handle: every operation that needs the tree's type is a virtual here.
+struct AnyTree::Model {
+  virtual ~Model() = default;
+  [[nodiscard]] virtual std::vector<std::byte> save_bytes(const std::string& source) const = 0;
+  /// `self` is this model's own shared pointer: the prepared query keeps both trees alive.
+  [[nodiscard]] virtual std::unique_ptr<PreparedQuery> prepare(std::shared_ptr<const Model> self,
+                                                               std::shared_ptr<const Model> b,
+                                                               const StrategyVariant& variant) const = 0;
+  TreeInfo info;
+};
+
+namespace {
+
+template <class BV, class D>
+struct TypedModel;
+
+/// Strategy S on two trees of one type, configured once.
+template <class S, class BV, class D>
+class TypedQuery final : public PreparedQuery {
+ public:
+  TypedQuery(std::shared_ptr<const TypedModel<BV, D>> a, std::shared_ptr<const TypedModel<BV, D>> b,
+             typename S::Options options)
+      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)) {}
+
+  void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
+    for (std::size_t i = 0; i < poses.size(); ++i) sink(i, S::query(a_->tree, b_->tree, poses[i], options_));
+  }
+
+ private:
+  std::shared_ptr<const TypedModel<BV, D>> a_, b_;
+  typename S::Options options_;
+};
+
+template <class BV, class D>
+struct TypedModel final : AnyTree::Model {
+  TypedModel(Tree<BV, D> built, double build_seconds, double annotate_seconds) : tree(std::move(built)) {
+    ModelInfo size;  // the runner's and `bvhlab info`'s one account of a tree's size
+    describe_tree_size(size, tree);
+    info.bv = BV::name();
+    info.density = D::name();
+    info.annotation = D::describe(tree.density);
+    info.triangles = size.triangles;
+    info.nodes = size.nodes;
+    info.depth = size.depth;
+    info.model_bytes = size.model_bytes;
+    info.build_seconds = build_seconds;
+    info.annotate_seconds = annotate_seconds;
+    info.polygons = tree.bvh.has_polygons();
+  }
+
+  [[nodiscard]] std::vector<std::byte> save_bytes(const std::string& source) const override {
+    return save_tree_to_buffer(tree, {}, source);
+  }
+
+  [[nodiscard]] std::unique_ptr<PreparedQuery> prepare(std::shared_ptr<const Model> self,
+                                                       std::shared_ptr<const Model> b,
+                                                       const StrategyVariant& variant) const override {
+    auto other = std::dynamic_pointer_cast<const TypedModel>(b);
+    if (!other)
+      throw std::invalid_argument("the two trees differ in BV or density (" + info.bv + ", " +
+                                  info.annotation + " vs " + b->info.bv + ", " + b->info.annotation + ")");
+    auto a = std::static_pointer_cast<const TypedModel>(std::move(self));
+    std::unique_ptr<PreparedQuery> out;
+    with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
+      if constexpr (S::template accepts<D>) {
+        if (S::needs_polygons && !(info.polygons && other->info.polygons))
+          throw std::invalid_argument("strategy " + variant.strategy +
+                                      " tests triangles, and a tree was loaded without polygons (load it "
+                                      "with its mesh)");
+        if constexpr (ProbabilityDensity<D>)  // refuses trees annotated with other parameters, before any
+                                              // pose
+          (void)D::estimator(tree.density, other->tree.density);
+        out = std::make_unique<TypedQuery<S, BV, D>>(a, other,
+                                                     strategy_options<S>(variant.values, variant.budget));
+      } else {
+        throw std::invalid_argument("strategy " + variant.strategy + " does not run on trees with density '" +
+                                    std::string(D::name()) + "' (it runs on: " +
+                                    registry_detail::joined(strategy_info(variant.strategy).densities) + ")");
+      }
+    });
+    return out;
+  }
+
+  Tree<BV, D> tree;
+};
+
+template <class BV, class D>
+std::shared_ptr<const AnyTree::Model> build_typed(const Mesh& mesh, const DensitySpec& density,
+                                                  const BuildOptions& options) {
+  Bvh<BV> bvh = Bvh<BV>::build(mesh, options);
+  const double build_seconds = bvh.stats().build_seconds;
+  if constexpr (std::is_same_v<D, NoDensity>) {
+    return std::make_shared<TypedModel<BV, D>>(Tree<BV, D>{std::move(bvh), {}}, build_seconds, 0.0);
+  } else {
+    AnnotationContext context;
+    context.threads = options.threads;
+    AnnotateStats stats;
+    Tree<BV, D> tree = annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &stats);
+    return std::make_shared<TypedModel<BV, D>>(std::move(tree), build_seconds, stats.seconds);
+  }
+}
+
+/// The saved tree with `mesh`'s polygons, checked as the tree cache checks its entries.
+template <class BV, class D>
+Tree<BV, D> with_polygons(const Tree<BV, D>& saved, const Mesh& mesh, const fs::path& file) {
+  try {
+    return tree_cache_detail::attach_polygons(saved, mesh);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument("saved tree '" + file.string() + "' does not fit mesh '" + mesh.name +
+                                "': " + e.what());
+  }
+}
+
+}  // namespace
+
+AnyTree AnyTree::build(const Mesh& mesh, const std::string& bv, const DensitySpec& density,
+                       const BuildOptions& options) {
+  std::shared_ptr<const Model> model;
+  with_volume(bv, [&]<class BV>(std::type_identity<BV>) {
+    with_density(density.name, [&]<class D>(std::type_identity<D>) {
+      if constexpr (DensityFor<D, BV>)
+        model = build_typed<BV, D>(mesh, density, options);
+      else
+        throw std::invalid_argument("density " + density.name + " cannot annotate " + bv + " trees");
+    });
+  });
+  return AnyTree(std::move(model));
+}
+
+AnyTree AnyTree::load(const fs::path& file, const Mesh* mesh) {
+  const std::vector<std::byte> bytes = saved_tree_detail::read_file(file);
+  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, file.string());
+  try {  // a name this build does not know is refused naming the file
+    with_volume(header.bv_name, [](auto) {});
+    with_density(header.density_name, [](auto) {});
+  } catch (const std::invalid_argument& e) {
+    throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
+  }
+  std::shared_ptr<const Model> model;
+  with_volume(header.bv_name, [&]<class BV>(std::type_identity<BV>) {
+    with_density(header.density_name, [&]<class D>(std::type_identity<D>) {
+      if constexpr (DensityFor<D, BV>) {
+        Tree<BV, D> tree = load_tree_from_buffer<BV, D>(bytes, file.string());
+        if (mesh) tree = with_polygons(tree, *mesh, file);
+        model = std::make_shared<TypedModel<BV, D>>(std::move(tree), 0.0, 0.0);
+      } else {
+        throw SavedTreeError("saved tree '" + file.string() + "': density " + header.density_name +
+                             " cannot annotate " + header.bv_name + " trees");
+      }
+    });
+  });
+  return AnyTree(std::move(model));
+}
+
+void AnyTree::save(const fs::path& file) const {
+  saved_tree_detail::write_file_atomically(file, model_->save_bytes(file.string()));
+}
+
+const TreeInfo& AnyTree::info() const {
+  return model_->info;
+}
+
+std::unique_ptr<PreparedQuery> AnyTree::prepare(const AnyTree& b, const StrategyVariant& variant) const {
+  return model_->prepare(model_, b.model_, variant);
+}
+
+DensitySpec density_spec(const std::string& name, const ParamValues& given) {
+  DensitySpec density;
+  density.name = name;
+  density.values = with_density(name, [&]<class D>(std::type_identity<D>) {
+    (void)density_params<D>(given);  // the density's own checks of the combination
+    return resolve_parameters(D::parameters(), given, D::name());
+  });
+  return density;
+}
+
+StrategyVariant strategy_variant(const std::string& name, const ParamValues& given, const Budget& budget) {
+  StrategyVariant variant;
+  variant.strategy = name;
+  variant.values = resolve_parameters(strategy_info(name).parameters, given, name);
+  variant.budget = budget;
+  with_strategy(name,
+                [&]<class S>(std::type_identity<S>) { (void)strategy_options<S>(variant.values, budget); });
+  return variant;
+}
+
+}  // namespace bvhlab::python

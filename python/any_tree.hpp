@@ -1,0 +1,75 @@
+// The C++ side of the Python module, free of Python: a tree of any registered bounding volume and density,
+// chosen by name at run time through the registry (bench/core/registry.hpp), and a query between two such
+// trees, dispatched and configured once so that it can run over many poses without the interpreter.
+#pragma once
+
+#include "bench/core/scene.hpp"
+#include "bvh/mesh.hpp"
+#include "bvh/topology.hpp"
+#include "traversal/result.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+
+namespace bvhlab::python {
+
+/// What a tree is and what it cost: the fields `bvhlab info` and results.json report.
+struct TreeInfo {
+  std::string bv, density;  ///< registered names
+  std::string annotation;   ///< the density's description: "none", "adb grid=2 tau=0.25"
+  std::uint64_t triangles = 0, nodes = 0, depth = 0;
+  double model_bytes = 0;  ///< nodes, volumes and density data (what a query reads; no polygons)
+  double build_seconds = 0, annotate_seconds = 0;
+  bool polygons = false;  ///< built from a mesh, or loaded with one: exact strategies can run on it
+};
+
+/// Receives each pose's result, by the pose's index.
+using ResultSink = std::function<void(std::size_t, const Result&)>;
+
+/// A query between two trees with one strategy variant, checked and configured: running it cannot fail.
+class PreparedQuery {
+ public:
+  virtual ~PreparedQuery() = default;
+  /// Queries every pose in order (poses already validated as rigid), handing each result to `sink`.
+  virtual void run(std::span<const RigidTransform> poses, const ResultSink& sink) const = 0;
+};
+
+class AnyTree {
+ public:
+  /// Builds `mesh`'s tree of volume `bv` (and annotates it with `density`, if that is not "none"). Throws
+  /// std::invalid_argument for an unknown name, bad parameters or a density that cannot annotate `bv`.
+  static AnyTree build(const Mesh& mesh, const std::string& bv, const DensitySpec& density,
+                       const BuildOptions& options);
+  /// Reads a saved tree (adb/saved_tree.hpp), typed by the names in its header; with `mesh`, re-attaches
+  /// its polygons after checking that they fit (the tree cache's check). Throws SavedTreeError naming the
+  /// file, std::invalid_argument when `mesh` does not fit.
+  static AnyTree load(const std::filesystem::path& file, const Mesh* mesh = nullptr);
+
+  /// Saves without polygons, atomically. Throws SavedTreeError naming the file.
+  void save(const std::filesystem::path& file) const;
+  [[nodiscard]] const TreeInfo& info() const;
+
+  /// The query of `variant` with this tree as A (fixed) and `b` as B (moved by the poses). Throws
+  /// std::invalid_argument when the trees differ in volume or density, the strategy does not run on the
+  /// density, needs polygons a tree lacks, or its parameters or budget are refused.
+  [[nodiscard]] std::unique_ptr<PreparedQuery> prepare(const AnyTree& b,
+                                                       const StrategyVariant& variant) const;
+
+  struct Model;  ///< the typed tree behind the handle
+
+ private:
+  explicit AnyTree(std::shared_ptr<const Model> model) : model_(std::move(model)) {}
+  std::shared_ptr<const Model> model_;
+};
+
+/// `given` checked against the density's parameter table, defaults filled in. Throws std::invalid_argument.
+DensitySpec density_spec(const std::string& name, const ParamValues& given);
+/// A strategy variant from its name, given parameters and budget, checked as `bvhlab query` checks them.
+/// Throws std::invalid_argument.
+StrategyVariant strategy_variant(const std::string& name, const ParamValues& given, const Budget& budget);
+
+}  // namespace bvhlab::python

@@ -1,0 +1,241 @@
+// bvhlab.query and bvhlab.query_batch: one strategy variant between two trees, at one pose or over an array
+// of poses (checked first, then queried without the GIL, answered as numpy arrays); the protocol's poses.
+#include "bench/core/protocol.hpp"
+#include "python/any_tree.hpp"
+#include "python/bindings.hpp"
+
+#include <cmath>
+
+namespace bvhlab::python {
+
+namespace {
+
+StrategyVariant variant_from(const std::string& strategy, long long bv_tests, double deadline_us,
+                             const py::kwargs& parameters) {
+  if (bv_tests < 0) throw py::value_error("bv_tests must be >= 0 (0: no budget of BV tests)");
+  if (!std::isfinite(deadline_us) || deadline_us < 0)
+    throw py::value_error("deadline_us must be finite and >= 0 (0: no deadline)");
+  Budget budget;
+  budget.max_bv_tests = static_cast<std::uint64_t>(bv_tests);
+  budget.deadline_us = deadline_us;
+  return strategy_variant(strategy, parameter_values(parameters), budget);
+}
+
+/// Poses from a (K, 4, 4) array, or from rotations (K, 3, 3; default: identities) and translations (K, 3).
+std::vector<RigidTransform> poses_from(const py::object& poses, const py::object& rotations,
+                                       const py::object& translations) {
+  std::vector<RigidTransform> out;
+  if (!poses.is_none()) {
+    if (!rotations.is_none() || !translations.is_none())
+      throw py::value_error("give poses, or rotations and translations, not both");
+    const auto m = real_array(poses, "poses", {-1, 4, 4}, "(K, 4, 4)");
+    for (py::ssize_t k = 0; k < m.shape(0); ++k)
+      out.push_back(rigid_from_matrix(m.data(k, 0, 0), "poses[" + std::to_string(k) + "]"));
+    return out;
+  }
+  if (translations.is_none())
+    throw py::value_error("give poses (K, 4, 4), or translations (K, 3) and rotations");
+  const auto t = real_array(translations, "translations", {-1, 3}, "(K, 3)");
+  const py::ssize_t count = t.shape(0);
+  const auto r = rotations.is_none() ? py::array_t<double, py::array::c_style>()
+                                     : real_array(rotations, "rotations", {count, 3, 3},
+                                                  "(K, 3, 3) with K = " + std::to_string(count));
+  const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  for (py::ssize_t k = 0; k < count; ++k)
+    out.push_back(
+        rigid_from_parts(rotations.is_none() ? identity : r.data(k, 0, 0), t.data(k, 0),
+                         "rotations[" + std::to_string(k) + "], translations[" + std::to_string(k) + "]"));
+  return out;
+}
+
+/// One pose: a 4 x 4 matrix, or a rotation (default: identity) and a translation (default: zero).
+RigidTransform pose_from(const py::object& pose, const py::object& rotation, const py::object& translation) {
+  if (!pose.is_none()) {
+    if (!rotation.is_none() || !translation.is_none())
+      throw py::value_error("give pose, or rotation and translation, not both");
+    return rigid_from_matrix(real_array(pose, "pose", {4, 4}, "(4, 4)").data(), "pose");
+  }
+  const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[3] = {0, 0, 0};
+  const auto r = rotation.is_none() ? py::array_t<double, py::array::c_style>()
+                                    : real_array(rotation, "rotation", {3, 3}, "(3, 3)");
+  const auto t = translation.is_none() ? py::array_t<double, py::array::c_style>()
+                                       : real_array(translation, "translation", {3}, "(3,)");
+  return rigid_from_parts(rotation.is_none() ? identity : r.data(), translation.is_none() ? zero : t.data(),
+                          "pose");
+}
+
+struct QueryResult {
+  Result result;
+  py::object witness() const {
+    if (!result.witness) return py::none();
+    return py::make_tuple(result.witness->a, result.witness->b);
+  }
+  py::array_t<std::int64_t> contacts() const {
+    py::array_t<std::int64_t> out({static_cast<py::ssize_t>(result.contacts.size()), py::ssize_t{2}});
+    for (std::size_t i = 0; i < result.contacts.size(); ++i) {
+      out.mutable_at(i, 0) = result.contacts[i].a;
+      out.mutable_at(i, 1) = result.contacts[i].b;
+    }
+    return out;
+  }
+  py::dict counters() const {
+    const Counters& c = result.counters;
+    return py::dict(py::arg("bv_tests") = c.bv_tests, py::arg("triangle_tests") = c.triangle_tests,
+                    py::arg("nodes_visited") = c.nodes_visited,
+                    py::arg("probability_evaluations") = c.probability_evaluations);
+  }
+};
+
+QueryResult query(const AnyTree& a, const AnyTree& b, const py::object& pose, const py::object& rotation,
+                  const py::object& translation, const std::string& strategy, long long bv_tests,
+                  double deadline_us, const py::kwargs& parameters) {
+  const StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
+  const RigidTransform checked = pose_from(pose, rotation, translation);
+  const std::unique_ptr<PreparedQuery> prepared = a.prepare(b, variant);
+  QueryResult out;
+  py::gil_scoped_release release;
+  prepared->run({&checked, 1}, [&](std::size_t, const Result& r) { out.result = r; });
+  return out;
+}
+
+/// The batch's answers, one numpy array per field, each of length K.
+struct BatchColumns {
+  explicit BatchColumns(py::ssize_t k)
+      : collides(k),
+        exact(k),
+        budget_exhausted(k),
+        probability(k),
+        witness_a(k),
+        witness_b(k),
+        contacts(k),
+        bv_tests(k),
+        triangle_tests(k),
+        nodes_visited(k),
+        probability_evaluations(k) {}
+  py::array_t<bool> collides, exact, budget_exhausted;
+  py::array_t<double> probability;
+  py::array_t<std::int64_t> witness_a, witness_b, contacts, bv_tests, triangle_tests, nodes_visited,
+      probability_evaluations;
+
+  /// Writes result `i` (called without the GIL: raw pointers into arrays this object keeps alive).
+  ResultSink sink() {
+    return [c = collides.mutable_data(), e = exact.mutable_data(), x = budget_exhausted.mutable_data(),
+            p = probability.mutable_data(), wa = witness_a.mutable_data(), wb = witness_b.mutable_data(),
+            n = contacts.mutable_data(), bv = bv_tests.mutable_data(), tri = triangle_tests.mutable_data(),
+            nodes = nodes_visited.mutable_data(),
+            est = probability_evaluations.mutable_data()](std::size_t i, const Result& r) {
+      c[i] = r.collides;
+      e[i] = r.exact;
+      x[i] = r.budget_exhausted;
+      p[i] = r.probability;
+      wa[i] = r.witness ? std::int64_t{r.witness->a} : -1;
+      wb[i] = r.witness ? std::int64_t{r.witness->b} : -1;
+      n[i] = static_cast<std::int64_t>(r.contacts.size());
+      bv[i] = static_cast<std::int64_t>(r.counters.bv_tests);
+      tri[i] = static_cast<std::int64_t>(r.counters.triangle_tests);
+      nodes[i] = static_cast<std::int64_t>(r.counters.nodes_visited);
+      est[i] = static_cast<std::int64_t>(r.counters.probability_evaluations);
+    };
+  }
+  py::dict dict() const {
+    return py::dict(py::arg("collides") = collides, py::arg("probability") = probability,
+                    py::arg("exact") = exact, py::arg("budget_exhausted") = budget_exhausted,
+                    py::arg("witness_a") = witness_a, py::arg("witness_b") = witness_b,
+                    py::arg("contact_count") = contacts, py::arg("bv_tests") = bv_tests,
+                    py::arg("triangle_tests") = triangle_tests, py::arg("nodes_visited") = nodes_visited,
+                    py::arg("probability_evaluations") = probability_evaluations);
+  }
+};
+
+py::dict query_batch(const AnyTree& a, const AnyTree& b, const py::object& poses, const py::object& rotations,
+                     const py::object& translations, const std::string& strategy, long long bv_tests,
+                     double deadline_us, const py::kwargs& parameters) {
+  const StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
+  const std::vector<RigidTransform> checked = poses_from(poses, rotations, translations);
+  const std::unique_ptr<PreparedQuery> prepared = a.prepare(b, variant);
+  BatchColumns columns(static_cast<py::ssize_t>(checked.size()));
+  const ResultSink sink = columns.sink();
+  {
+    py::gil_scoped_release release;
+    prepared->run(checked, sink);
+  }
+  return columns.dict();
+}
+
+py::array_t<double> protocol_matrices(double distance, int first, int count, int steps) {
+  if (!std::isfinite(distance)) throw py::value_error("distance must be finite");
+  if (steps < 1) throw py::value_error("steps must be >= 1");
+  py::array_t<double> out({py::ssize_t{count}, py::ssize_t{4}, py::ssize_t{4}});
+  for (int k = 0; k < count; ++k)
+    matrix_from_rigid(protocol_pose(distance, first + k, steps), out.mutable_data(k));
+  return out;
+}
+
+}  // namespace
+
+void bind_queries(py::module_& m) {
+  py::class_<QueryResult>(m, "Result", "The answer of one query.")
+      .def_property_readonly("collides", [](const QueryResult& q) { return q.result.collides; })
+      .def_property_readonly(
+          "probability", [](const QueryResult& q) { return q.result.probability; },
+          "estimated probability of collision; exactly 0 or 1 when exact")
+      .def_property_readonly(
+          "exact", [](const QueryResult& q) { return q.result.exact; },
+          "decided by exact triangle tests (or by exhausting all overlapping pairs)")
+      .def_property_readonly(
+          "budget_exhausted", [](const QueryResult& q) { return q.result.budget_exhausted; },
+          "a budget ran out: the answer is a best effort")
+      .def_property_readonly("witness", &QueryResult::witness,
+                             "(triangle of A, triangle of B) that intersect, as mesh indices, or None")
+      .def_property_readonly("contacts", &QueryResult::contacts,
+                             "(K, 2) array of intersecting triangle pairs (strategy all_contacts)")
+      .def_property_readonly("counters", &QueryResult::counters)
+      .def("__repr__", [](const QueryResult& q) {
+        return std::string("<bvhlab.Result collides=") + (q.result.collides ? "True" : "False") +
+               " probability=" + std::to_string(q.result.probability) +
+               " exact=" + (q.result.exact ? "True" : "False") + ">";
+      });
+
+  const char* strategy_help =
+      " strategy: a name of bvhlab.strategies(), its parameters as keyword arguments (p_min=0.9); bv_tests "
+      "and "
+      "deadline_us: the budget of a strategy that takes one (0: none). B is moved by the pose into A's "
+      "frame.";
+  m.def("query", &query, py::arg("a"), py::arg("b"), py::arg("pose") = py::none(), py::kw_only(),
+        py::arg("rotation") = py::none(), py::arg("translation") = py::none(), py::arg("strategy") = "exact",
+        py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0,
+        (std::string(
+             "One query between trees a and b at one pose: a 4 x 4 rigid matrix, or rotation (3 x 3) and "
+             "translation (3).") +
+         strategy_help)
+            .c_str());
+  m.def("query_batch", &query_batch, py::arg("a"), py::arg("b"), py::arg("poses") = py::none(), py::kw_only(),
+        py::arg("rotations") = py::none(), py::arg("translations") = py::none(),
+        py::arg("strategy") = "exact", py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0,
+        (std::string(
+             "Queries every pose of poses (K, 4, 4), or of rotations (K, 3, 3; default identities) and "
+             "translations (K, 3), without holding the GIL. Every pose is checked before the first query. "
+             "Returns a dict of arrays of length K: collides, probability, exact, budget_exhausted, "
+             "witness_a and witness_b (-1: none), contact_count and the counters.") +
+         strategy_help)
+            .c_str());
+  m.def(
+      "protocol_poses",
+      [](double distance, int steps) {
+        if (steps < 1) throw py::value_error("steps must be >= 1");
+        return protocol_matrices(distance, 0, steps, steps);
+      },
+      py::arg("distance"), py::arg("steps"),
+      "The benchmark protocol's poses of B at one distance: (steps, 4, 4), one full turn (adb/README.md, "
+      "section 4).");
+  m.def(
+      "protocol_pose",
+      [](double distance, int step, int steps) {
+        if (step < 0 || step >= steps) throw py::value_error("step must lie in [0, steps)");
+        return protocol_matrices(distance, step, 1, steps).attr("reshape")(4, 4);
+      },
+      py::arg("distance"), py::arg("step"), py::arg("steps"),
+      "Step `step` of protocol_poses(distance, steps).");
+}
+
+}  // namespace bvhlab::python

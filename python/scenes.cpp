@@ -1,0 +1,68 @@
+// bvhlab.run_scene: the scene runner (bench/run.hpp) with its results as results.json holds them; the
+// policies' tables.
+#include "bench/core/policies.hpp"
+#include "bench/core/registry.hpp"
+#include "bench/run.hpp"
+#include "bench/write.hpp"
+#include "python/bindings.hpp"
+
+#include <pybind11/stl.h>
+#include <nlohmann/json.hpp>
+
+#include <iostream>
+
+namespace bvhlab::python {
+
+namespace {
+
+py::object from_json(const nlohmann::json& document) {
+  return py::module_::import("json").attr("loads")(document.dump());
+}
+
+/// A scene file's path, or a dict in the scene format (its relative paths taken from the working folder).
+Scene scene_from(const py::object& scene) {
+  if (py::isinstance<py::dict>(scene)) {
+    const std::string text = py::str(py::module_::import("json").attr("dumps")(scene));
+    return parse_scene(text, std::filesystem::current_path(), "<dict>");
+  }
+  const std::filesystem::path file = path_argument(scene, "run_scene (a scene file or a dict)");
+  require_file(file, "run_scene");
+  return load_scene(file);
+}
+
+py::object run(const py::object& scene_argument, const py::object& cache, int threads, bool quiet) {
+  if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
+  const Scene scene = scene_from(scene_argument);
+  RunOptions options;
+  if (!cache.is_none()) options.cache_dir = path_argument(cache, "cache");
+  options.threads = static_cast<unsigned>(threads);
+  options.log = [quiet](const std::string& line) {
+    if (!quiet) std::cerr << line << '\n';
+  };
+  nlohmann::json document;
+  {
+    py::gil_scoped_release release;
+    document = results_document(run_scene(scene, options));
+  }
+  return from_json(document);
+}
+
+}  // namespace
+
+void bind_scenes(py::module_& m) {
+  m.def("run_scene", &run, py::arg("scene"), py::kw_only(), py::arg("cache") = py::none(),
+        py::arg("threads") = 0, py::arg("quiet") = true,
+        "Runs a scene (a scene file, or a dict in the same format: bench/scenes/README.md) and returns what "
+        "results.json holds: a dict with its rows (one per mesh pair, hierarchy, strategy variant and "
+        "distance, keyed like the columns of results.csv), models, stats, ground truth and calibration. "
+        "cache: a "
+        "folder for trees and ground truth (default: none); quiet=False prints the runner's messages.");
+  m.def(
+      "policies", [] { return from_json(policies_json()); },
+      "The registered densities and strategies with their parameters (what `bvhlab policies` prints).");
+  m.def("volumes", &volume_names, "The registered bounding volumes.");
+  m.def("densities", &density_names, "The registered densities.");
+  m.def("strategies", &strategy_names, "The registered traversal strategies.");
+}
+
+}  // namespace bvhlab::python

@@ -1,0 +1,81 @@
+// bvhlab.Tree: a tree of any registered bounding volume and density, built from a mesh, saved and loaded.
+#include "bench/core/registry.hpp"
+#include "python/any_tree.hpp"
+#include "python/bindings.hpp"
+
+namespace bvhlab::python {
+
+namespace {
+
+AnyTree build(const Mesh& mesh, const std::string& bv, const std::string& density, const std::string& split,
+              int leaf, int threads, const py::kwargs& parameters) {
+  if (leaf < 1 || leaf > 255) throw py::value_error("leaf: triangles per leaf must lie in [1, 255]");
+  if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
+  (void)with_volume(bv, [](auto) { return 0; });  // an unknown name fails before the density's checks
+  const DensitySpec spec = density_spec(density, parameter_values(parameters));
+  BuildOptions options;
+  options.split = split_method_from_string(split);
+  options.max_leaf_triangles = static_cast<std::uint32_t>(leaf);
+  options.threads = static_cast<unsigned>(threads);
+  py::gil_scoped_release release;
+  return AnyTree::build(mesh, bv, spec, options);
+}
+
+AnyTree load(const py::object& file, const Mesh* mesh) {
+  const std::filesystem::path path = path_argument(file, "Tree.load");
+  require_file(path, "Tree.load");
+  py::gil_scoped_release release;
+  return AnyTree::load(path, mesh);
+}
+
+void save(const AnyTree& tree, const py::object& file) {
+  const std::filesystem::path path = path_argument(file, "Tree.save");
+  const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
+  if (!std::filesystem::is_directory(folder)) {
+    const std::string message = "Tree.save: no such folder: '" + folder.string() + "'";
+    PyErr_SetString(PyExc_FileNotFoundError, message.c_str());
+    throw py::error_already_set();
+  }
+  py::gil_scoped_release release;
+  tree.save(path);
+}
+
+std::string repr(const AnyTree& tree) {
+  const TreeInfo& i = tree.info();
+  return "<bvhlab.Tree " + i.bv + ", " + i.annotation + ": " + std::to_string(i.triangles) + " triangles, " +
+         std::to_string(i.nodes) + " nodes" + (i.polygons ? "" : ", without polygons") + ">";
+}
+
+}  // namespace
+
+void bind_trees(py::module_& m) {
+  auto info = [](auto member) { return [member](const AnyTree& t) { return t.info().*member; }; };
+  py::class_<AnyTree>(m, "Tree",
+                      "A bounding-volume hierarchy of one mesh, of any registered bounding volume, with or "
+                      "without a density annotation.")
+      .def(py::init(&build), py::arg("mesh"), py::arg("bv") = "aabb", py::arg("density") = "none",
+           py::kw_only(), py::arg("split") = "sah", py::arg("leaf") = 1, py::arg("threads") = 0,
+           "Builds the tree of `mesh` with bounding volume `bv` (bvhlab.volumes()) and annotates it with "
+           "`density` (bvhlab.policies()), whose parameters are keyword arguments (grid=2, tau=0.25). split: "
+           "'sah' or 'median'; leaf: triangles per leaf at most; threads: 0 for all cores.")
+      .def_static(
+          "load", &load, py::arg("path"), py::arg("mesh") = nullptr,
+          "Reads a saved tree. Saved trees carry no polygons: give the mesh it was built from to run the "
+          "strategies that test triangles (it is checked against the tree).")
+      .def("save", &save, py::arg("path"),
+           "Saves the tree without polygons (the format `bvhlab build` writes).")
+      .def_property_readonly("bv", info(&TreeInfo::bv))
+      .def_property_readonly("density", info(&TreeInfo::density))
+      .def_property_readonly("annotation", info(&TreeInfo::annotation), "the density and its parameters")
+      .def_property_readonly("triangles", info(&TreeInfo::triangles))
+      .def_property_readonly("nodes", info(&TreeInfo::nodes))
+      .def_property_readonly("depth", info(&TreeInfo::depth))
+      .def_property_readonly("model_bytes", info(&TreeInfo::model_bytes),
+                             "bytes of nodes, volumes and density data (what a query reads, no polygons)")
+      .def_property_readonly("build_seconds", info(&TreeInfo::build_seconds))
+      .def_property_readonly("annotate_seconds", info(&TreeInfo::annotate_seconds))
+      .def_property_readonly("has_polygons", info(&TreeInfo::polygons))
+      .def("__repr__", &repr);
+}
+
+}  // namespace bvhlab::python

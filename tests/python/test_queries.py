@@ -1,0 +1,211 @@
+"""Queries: exact answers against geometry, the batch against single queries, both against the bvhlab CLI."""
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import bvhlab
+from conftest import box_mesh, matrix, rotation_z
+
+STRATEGIES = [  # (strategy, its parameters, density the trees need)
+    ("exact", {}, "none"),
+    ("all_contacts", {}, "none"),
+    ("guided_exact", {}, "adb"),
+    ("adb", {"p_min": 0.5}, "adb"),
+    ("adb", {"p_min": 0.95}, "adb"),
+    ("time_critical", {"p_min": 0.9, "bv_tests": 40}, "adb"),
+]
+EXACT = [("exact", "none"), ("all_contacts", "none"), ("guided_exact", "adb")]
+
+
+@pytest.fixture(scope="module")
+def cube_trees():
+    """Unit cubes (side 1, centred) of every registered volume, with and without the ADB density."""
+    cube = box_mesh()
+    return {(bv, d): bvhlab.Tree(cube, bv, d) for bv in bvhlab.volumes() for d in ("none", "adb")}
+
+
+@pytest.mark.parametrize("strategy,density", EXACT)
+def test_exact_answers_follow_the_geometry(cube_trees, strategy, density):
+    # B translated by d along x: the cubes touch at d = 1 (closed triangles: touching collides)
+    distances = [0.5, 1.0, 1.0 + 1e-9, 1.5]
+    expected = [True, True, False, False]
+    # rotated 45 degrees about z, B reaches sqrt(1/2) along x: contact up to d = 1/2 + sqrt(1/2)
+    reach = 0.5 + np.sqrt(0.5)
+    turned = [reach - 1e-6, reach + 1e-6]
+    for bv in bvhlab.volumes():
+        tree = cube_trees[(bv, density)]
+        for d, want in zip(distances, expected):
+            r = bvhlab.query(tree, tree, translation=[d, 0, 0], strategy=strategy)
+            assert (r.collides, r.exact, r.probability) == (want, True, float(want)), (bv, d)
+        for d, want in zip(turned, [True, False]):
+            r = bvhlab.query(tree, tree, matrix(rotation_z(45), [d, 0, 0]), strategy=strategy)
+            assert r.collides == want, (bv, d)
+
+
+@pytest.fixture(scope="module")
+def stick_scene():
+    """A: a small cube at (0, 1.5, 0). B: a stick along +x from the origin, length 2."""
+    a = bvhlab.Tree(box_mesh(center=(0, 1.5, 0), half=(0.2, 0.2, 0.2)))
+    b = bvhlab.Tree(box_mesh(center=(1, 0, 0), half=(1, 0.05, 0.05)))
+    # (rotation about z, translation) -> whether the turned stick reaches A
+    cases = [(90, [0, 0, 0], True), (-90, [0, 0, 0], False), (90, [0, -1, 0], False), (90, [0, 0.2, 0], True),
+             (180, [0, 1.5, 0], True), (0, [-3, 1.5, 0], False)]
+    return a, b, cases
+
+
+def test_pose_layout_single_and_batch(stick_scene):
+    """x -> R x + t with R row-major as numpy holds it: a transposed R would turn the stick the other way."""
+    a, b, cases = stick_scene
+    rotations = np.array([rotation_z(deg) for deg, _, _ in cases])
+    translations = np.array([t for _, t, _ in cases], float)
+    expected = [want for _, _, want in cases]
+    for (deg, t, want), r in zip(cases, rotations):
+        assert bvhlab.query(a, b, matrix(r, t)).collides == want, (deg, t)
+        assert bvhlab.query(a, b, rotation=r, translation=t).collides == want, (deg, t)
+    matrices = np.array([matrix(r, t) for r, t in zip(rotations, translations)])
+    assert list(bvhlab.query_batch(a, b, matrices)["collides"]) == expected
+    both = bvhlab.query_batch(a, b, rotations=rotations, translations=translations)
+    assert list(both["collides"]) == expected
+    # rotations default to identities: the stick along +x at y = 1.5 passes through A when moved left
+    moved = bvhlab.query_batch(a, b, translations=[[-1, 1.5, 0], [-1, 3, 0]])
+    assert list(moved["collides"]) == [True, False]
+
+
+def test_witness_and_contacts(cube_trees):
+    tree = cube_trees[("aabb", "none")]
+    pose = matrix(rotation_z(30), [0.8, 0.1, 0])
+    exact = bvhlab.query(tree, tree, pose)
+    everything = bvhlab.query(tree, tree, pose, strategy="all_contacts")
+    assert exact.collides and everything.collides
+    contacts = {tuple(c) for c in everything.contacts}
+    assert everything.contacts.shape[1] == 2 and len(contacts) == len(everything.contacts) > 1
+    assert exact.witness in contacts
+    assert all(0 <= a < 12 and 0 <= b < 12 for a, b in contacts)
+    batch = bvhlab.query_batch(tree, tree, pose[None], strategy="all_contacts")
+    assert batch["contact_count"][0] == len(contacts)
+    apart = bvhlab.query(tree, tree, translation=[3, 0, 0], strategy="all_contacts")
+    assert apart.witness is None and apart.contacts.shape == (0, 2)
+    assert bvhlab.query_batch(tree, tree, translations=[[3, 0, 0]])["witness_a"][0] == -1
+
+
+@pytest.fixture(scope="module")
+def gear_trees(gear):
+    return {d: bvhlab.Tree(gear, "aabb", d) for d in ("none", "adb")}
+
+
+@pytest.mark.parametrize("strategy,params,density", STRATEGIES)
+def test_batch_equals_single_queries(gear_trees, strategy, params, density):
+    tree = gear_trees[density]
+    poses = np.concatenate([bvhlab.protocol_poses(d, 24) for d in (0.8, 1.4, 2.0)])
+    batch = bvhlab.query_batch(tree, tree, poses, strategy=strategy, **params)
+    assert all(len(v) == len(poses) for v in batch.values())
+    for k, pose in enumerate(poses):
+        r = bvhlab.query(tree, tree, rotation=pose[:3, :3], translation=pose[:3, 3], strategy=strategy,
+                         **params)
+        single = {"collides": r.collides, "probability": r.probability, "exact": r.exact,
+                  "budget_exhausted": r.budget_exhausted, "contact_count": len(r.contacts),
+                  "witness_a": r.witness[0] if r.witness else -1,
+                  "witness_b": r.witness[1] if r.witness else -1,
+                  **r.counters}
+        assert single == {key: batch[key][k].item() for key in single}, k
+    if strategy in ("exact", "all_contacts", "guided_exact"):
+        np.testing.assert_array_equal(batch["probability"], batch["collides"].astype(float))
+        assert batch["exact"].all()
+    else:
+        assert ((batch["probability"] >= 0) & (batch["probability"] <= 1)).all()
+
+
+@pytest.mark.parametrize("strategy,params,density", STRATEGIES)
+def test_queries_equal_the_cli(cli, gear_file, gear_trees, strategy, params, density):
+    """The same query through `bvhlab query` (trees built by the runner)."""
+    tree = gear_trees[density]
+    options = ["--strategy", strategy, "--density", density, "--no-cache", "--json"]
+    if strategy == "all_contacts":
+        options.append("--all-contacts")  # the CLI prints the contacts for this flag only
+    for name, value in params.items():
+        options += ["--" + name.replace("_", "-"), value]
+    for step in (0, 7, 23):
+        expected = cli("query", gear_file, gear_file, "--protocol", f"1.2,{step},50", *options)
+        r = bvhlab.query(tree, tree, bvhlab.protocol_pose(1.2, step, 50), strategy=strategy, **params)
+        got = {"collides": r.collides, "probability": r.probability, "exact": r.exact,
+               "budget_exhausted": r.budget_exhausted, **r.counters}
+        assert got == {key: expected[key] for key in got}, step
+        assert list(r.witness) == expected["witness"] if r.witness else "witness" not in expected
+        if strategy == "all_contacts":
+            assert sorted(map(list, r.contacts.tolist())) == sorted(expected["contacts"])
+
+
+@pytest.mark.parametrize("bv", ["obb", "rbox", "sphere", "dop24"])
+def test_every_volume_equals_the_cli(cli, gear_file, gear, bv):
+    tree = bvhlab.Tree(gear, bv)
+    expected = cli("query", gear_file, gear_file, "--protocol", "1.5,11,50", "--bv", bv, "--no-cache",
+                   "--json")
+    r = bvhlab.query(tree, tree, bvhlab.protocol_pose(1.5, 11, 50))
+    assert (r.collides, r.counters["bv_tests"], r.counters["triangle_tests"]) == (
+        expected["collides"], expected["bv_tests"], expected["triangle_tests"])
+
+
+def test_budget_is_kept(gear_trees):
+    tree = gear_trees["adb"]
+    poses = bvhlab.protocol_poses(1.6, 40)
+    out = bvhlab.query_batch(tree, tree, poses, strategy="time_critical", bv_tests=15)
+    assert (out["bv_tests"] <= 15).all()
+    assert out["budget_exhausted"].any()
+    assert not out["exact"][out["budget_exhausted"]].any()
+
+
+def test_protocol_poses_are_the_protocol():
+    poses = bvhlab.protocol_poses(1.5, 8)
+    assert poses.shape == (8, 4, 4)
+    for k, pose in enumerate(poses):
+        theta = 2 * np.pi * k / 8
+        c, s = np.cos(theta), np.sin(theta)
+        rz = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+        rx = np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+        np.testing.assert_allclose(pose, matrix(rz @ rx, [1.5, 0, 0]), atol=1e-15)
+        np.testing.assert_array_equal(bvhlab.protocol_pose(1.5, k, 8), pose)
+
+
+def test_concurrent_batches_answer_as_one(gear_trees):
+    """Batches run without the GIL: two threads at once give what one thread gives."""
+    tree = gear_trees["adb"]
+    poses = np.concatenate([bvhlab.protocol_poses(d, 200) for d in (1.0, 1.6)])
+    expected = {s: bvhlab.query_batch(tree, tree, poses, strategy=s) for s in ("exact", "adb")}
+    results = {}
+
+    def work(strategy):
+        results[strategy] = bvhlab.query_batch(tree, tree, poses, strategy=strategy)
+
+    threads = [threading.Thread(target=work, args=(s,)) for s in expected]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for s in expected:
+        for key in expected[s]:
+            np.testing.assert_array_equal(results[s][key], expected[s][key], err_msg=f"{s} {key}")
+
+
+def test_batch_releases_the_gil(gear_trees):
+    """While one thread runs a batch, another runs Python: the GIL is released around the loop (held
+    throughout, it would keep this thread from waking up between the batch's start and its end)."""
+    tree = gear_trees["none"]
+    poses = bvhlab.protocol_poses(0.9, 1000)
+    while True:  # a batch long enough to look into its middle
+        start = time.perf_counter()
+        bvhlab.query_batch(tree, tree, poses)
+        if time.perf_counter() - start > 0.3:
+            break
+        poses = np.concatenate([poses, poses])
+    worker = threading.Thread(target=bvhlab.query_batch, args=(tree, tree, poses))
+    stamps = []
+    begin = time.perf_counter()
+    worker.start()
+    while worker.is_alive():
+        stamps.append(time.perf_counter())
+        time.sleep(0.001)
+    end = time.perf_counter()
+    low, high = begin + 0.3 * (end - begin), begin + 0.7 * (end - begin)
+    assert any(low < s < high for s in stamps)

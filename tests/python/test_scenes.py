@@ -1,0 +1,80 @@
+"""Scenes: the rows run_scene returns are the CLI's results.csv, and each row is what the batch query answers
+on the same trees and poses."""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import bvhlab
+
+DISTANCES, STEPS = [0.8, 1.4, 2.0], 24
+
+
+def scene(gear_file):
+    return {
+        "name": "python",
+        "objects": [{"mesh": str(gear_file), "name": "gear"}],
+        "hierarchies": [{"bv": "aabb"}, {"bv": "obb"}],
+        "annotation": {"type": "adb", "grid": 2, "tau": 0.25},
+        "strategies": [{"type": "exact"}, {"type": "adb", "p_min": [0.5, 0.9]}],
+        "workload": {"type": "protocol", "distances": DISTANCES, "steps": STEPS},
+        "report": {"cgal_sample": 4},
+    }
+
+
+@pytest.fixture(scope="module")
+def run(gear_file):
+    return bvhlab.run_scene(scene(gear_file))
+
+
+# Columns that do not depend on timing.
+DETERMINED = ["mesh", "hierarchy", "bv", "annotation", "strategy", "label", "budget", "queries", "distance",
+              "truth_colliding_rate", "answer_colliding_rate", "fp_rate", "fn_rate", "inexact_rate",
+              "bv_tests_per_query", "triangle_tests_per_query", "nodes_visited_per_query", "model_bytes"]
+
+
+def test_rows_are_the_clis(tmp_path, cli, gear_file, run):
+    scene_file = tmp_path / "scene.json"
+    scene_file.write_text(json.dumps(scene(gear_file)))
+    cli("run", scene_file, "-o", tmp_path / "out", "--no-cache", "-q", parse_json=False)
+    with open(tmp_path / "out" / "results.csv") as f:
+        expected = list(csv.DictReader(f))
+    assert len(run["rows"]) == len(expected) == 2 * 3 * len(DISTANCES)
+    for row, want in zip(run["rows"], expected):
+        for column in DETERMINED:
+            value = row[column]
+            if isinstance(value, str):
+                assert value == want[column], column
+            else:  # results.csv prints 6 significant digits
+                assert value == pytest.approx(float(want[column]), rel=1e-5, abs=1e-12), column
+    # and a scene file runs like the dict
+    again = bvhlab.run_scene(scene_file)
+    assert [{c: r[c] for c in DETERMINED} for r in again["rows"]] == [{c: r[c] for c in DETERMINED}
+                                                                        for r in run["rows"]]
+
+
+def test_rows_agree_with_batch_queries(gear, run):
+    trees = {bv: bvhlab.Tree(gear, bv, "adb") for bv in ("aabb", "obb")}
+    for row in run["rows"]:
+        tree = trees[row["bv"]]
+        params = {"p_min": row["p_min"]} if row["strategy"] == "adb" else {}
+        out = bvhlab.query_batch(tree, tree, bvhlab.protocol_poses(row["distance"], STEPS),
+                                 strategy=row["strategy"], **params)
+        assert row["queries"] == STEPS
+        assert row["answer_colliding_rate"] == pytest.approx(out["collides"].mean()), row["label"]
+        assert row["bv_tests_per_query"] == pytest.approx(out["bv_tests"].mean()), row["label"]
+        if row["strategy"] == "exact":
+            assert row["truth_colliding_rate"] == pytest.approx(out["collides"].mean())
+    rates = [r["truth_colliding_rate"] for r in run["rows"]]
+    assert min(rates) < 1 and max(rates) > 0, "the distances should span colliding and separated poses"
+
+
+def test_the_rest_of_results_json(run):
+    assert run["scene"]["name"] == "python"
+    assert run["stats"]["queries"] == len(run["rows"]) * STEPS
+    assert run["stats"]["cgal_mismatches"] == 0 and run["stats"]["cgal_checked"] > 0
+    assert {m["bv"] for m in run["models"]} == {"aabb", "obb"}
+    assert [s["name"] for s in run["policies"]["strategies"]] == bvhlab.strategies()
+    assert [d["name"] for d in bvhlab.policies()["densities"]] == bvhlab.densities()
+    assert np.isfinite([c["bin_low"] for c in run["calibration"]]).all()
