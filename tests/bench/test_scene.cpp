@@ -167,8 +167,8 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
        "/annotation/grid: grid must be an integer in [2, 4], got 7"},
       // Parameters come from the policies' tables: ranges, fields a policy does not take, combinations.
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "adb", "p_min": 0.9}])",
-                  R"("annotation": {"type": "adb", "tau": 0})"),
-       "/annotation/tau: tau must be a number in (0, 1], got 0"},
+                  R"("annotation": {"type": "adb", "tau": 1.5})"),
+       "/annotation/tau: tau must be a number in [0, 1], got 1.5"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
                   R"("annotation": {"type": "none", "grid": 2})"),
        "/annotation/grid: unknown field; expected one of type"},
