@@ -21,8 +21,7 @@ constexpr ParamSpec kAdbParameters[] = {
      .description = "area threshold of a possible collision cell, as a fraction of the cell's mean face area",
      .min = 0,
      .max = 1,
-     .default_value = kDefaultAdbTau,
-     .exclusive_min = true},
+     .default_value = kDefaultAdbTau},
 };
 
 // Saved bytes, version 1: grid (u32 LE), tau (IEEE double bits, u64 LE), then one pc byte per node.

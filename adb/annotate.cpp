@@ -243,8 +243,8 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
   const auto start = std::chrono::steady_clock::now();
   if (grid < 1 || grid > kMaxGrid)
     throw std::invalid_argument("annotate: grid must be 1..6 cells per axis, got " + std::to_string(grid));
-  if (!std::isfinite(options.tau) || !(options.tau > 0))
-    throw std::invalid_argument("annotate: tau must be finite and > 0, got " + std::to_string(options.tau));
+  if (!std::isfinite(options.tau) || !(options.tau >= 0))  // tau = 0: every cell with some area counts
+    throw std::invalid_argument("annotate: tau must be finite and >= 0, got " + std::to_string(options.tau));
   if (node_boxes.size() != node_ranges.size())
     throw std::invalid_argument("annotate: " + std::to_string(node_boxes.size()) + " node boxes but " +
                                 std::to_string(node_ranges.size()) + " node ranges");

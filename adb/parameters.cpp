@@ -23,7 +23,9 @@ std::string ParamSpec::range_text() const {
 }
 
 std::string ParamSpec::problem(double value) const {
-  const bool below = exclusive_min ? !(value > min) : !(value >= min);
+  // -0 lies below a range that starts at 0: one value, one encoding (saved trees must save back identically).
+  const bool below =
+      exclusive_min ? !(value > min) : !(value >= min) || (min == 0 && value == 0 && std::signbit(value));
   if (!std::isfinite(value) || below || !(value <= max) || (integer && value != std::floor(value)))
     return "must be " + std::string(integer ? "" : "a number in ") + range_text() + ", got " +
            parameter_text(value);

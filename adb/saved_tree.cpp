@@ -7,6 +7,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -17,15 +18,16 @@ static_assert(sizeof(TreeNode) == 8 && std::is_trivially_copyable_v<TreeNode>);
 
 constexpr std::array<char, 8> kMagic = {'B', 'V', 'H', 'L', 'T', 'R', 'E', 'E'};
 constexpr std::uint32_t kByteOrderMark = 0x01020304;
-constexpr std::uint32_t kFlagTriangleIds = 1;
+constexpr std::uint32_t kFlagTriangleIds = 1, kFlagNormalized = 2;
 constexpr std::size_t kNameField = 32, kDensityNameField = 16;
-constexpr std::size_t kChecksumOffset = 120;
+constexpr std::size_t kChecksumOffset = kSavedTreeChecksumOffset;
 
 // Header field offsets.
 constexpr std::size_t kVersionAt = 8, kByteOrderAt = 12, kHeaderSizeAt = 16, kFlagsAt = 20, kNameAt = 24,
                       kVolumeSizeAt = 56, kRootSizeAt = 60, kDensityNameAt = 64, kDensityVersionAt = 80,
                       kReservedAt = 84, kNodesAt = 88, kTrianglesAt = 96, kDensityBytesAt = 104,
-                      kPayloadAt = 112;
+                      kPayloadAt = 112, kScaleAt = 120, kCentreAt = 128;
+static_assert(kCentreAt + 24 == kChecksumOffset && kChecksumOffset + 8 == kSavedTreeHeaderSize);
 
 [[noreturn]] void fail(std::string_view source, const std::string& problem) {
   throw SavedTreeError("saved tree '" + std::string(source) + "': " + problem);
@@ -127,6 +129,26 @@ std::string_view name_field(const std::byte* at, std::size_t size) {
   return {field, length};
 }
 
+/// "" when `units` can be recorded: raw units are exactly scale 1 and centre 0 (one encoding per tree, so
+/// a loaded tree saves back to the same bytes), normalised ones finite with a positive scale.
+std::string units_problem(const TreeUnits& units) {
+  if (!units.normalized)
+    return units.scale == 1 && units.centre == Vec3::Zero() && !std::signbit(units.centre.x()) &&
+                   !std::signbit(units.centre.y()) && !std::signbit(units.centre.z())
+               ? ""
+               : "units not normalised but with a scale or centre";
+  if (!std::isfinite(units.scale) || !(units.scale > 0) || !units.centre.allFinite())
+    return "normalisation with a scale that is not finite and positive, or a centre that is not finite";
+  return "";
+}
+
+void put_double(std::byte* at, double value) {
+  put_le(at, std::bit_cast<std::uint64_t>(value), 8);
+}
+double get_double(const std::byte* at) {
+  return std::bit_cast<double>(get_le(at, 8));
+}
+
 }  // namespace
 
 std::uint64_t fnv1a64(std::span<const std::byte> bytes, std::uint64_t hash) {
@@ -154,6 +176,8 @@ std::vector<std::byte> encode(const View& view, std::string_view source) {
   if (!view.triangle_ids.empty() && view.triangle_ids.size() != view.triangle_count)
     fail(source, "cannot save: " + std::to_string(view.triangle_ids.size()) + " triangle ids for " +
                      std::to_string(view.triangle_count) + " triangles");
+  if (const std::string problem = units_problem(view.units); !problem.empty())
+    fail(source, "cannot save: " + problem);
 
   const std::size_t payload = layout.root_volume_size + n * sizeof(TreeNode) + view.volumes.size() +
                               view.triangle_ids.size() * sizeof(std::uint32_t) + view.density.size();
@@ -163,7 +187,9 @@ std::vector<std::byte> encode(const View& view, std::string_view source) {
   put_le(h + kVersionAt, kSavedTreeVersion, 4);
   std::memcpy(h + kByteOrderAt, &kByteOrderMark, 4);  // native on purpose: it tells the arrays' byte order
   put_le(h + kHeaderSizeAt, kSavedTreeHeaderSize, 4);
-  put_le(h + kFlagsAt, view.triangle_ids.empty() ? 0 : kFlagTriangleIds, 4);
+  put_le(h + kFlagsAt,
+         (view.triangle_ids.empty() ? 0 : kFlagTriangleIds) | (view.units.normalized ? kFlagNormalized : 0),
+         4);
   std::memcpy(h + kNameAt, layout.bv_name.data(), layout.bv_name.size());
   put_le(h + kVolumeSizeAt, layout.volume_size, 4);
   put_le(h + kRootSizeAt, layout.root_volume_size, 4);
@@ -173,6 +199,8 @@ std::vector<std::byte> encode(const View& view, std::string_view source) {
   put_le(h + kTrianglesAt, view.triangle_count, 8);
   put_le(h + kDensityBytesAt, view.density.size(), 8);
   put_le(h + kPayloadAt, payload, 8);
+  put_double(h + kScaleAt, view.units.scale);
+  for (int k = 0; k < 3; ++k) put_double(h + kCentreAt + 8 * k, view.units.centre[k]);
 
   std::byte* at = out.data() + kSavedTreeHeaderSize;
   auto append = [&](std::span<const std::byte> bytes) {
@@ -197,15 +225,20 @@ Header read_header(std::span<const std::byte> buffer, std::string_view source, b
     fail(source, "not a bvhlab saved tree (bad magic bytes)");
   const std::uint64_t version = get_le(h + kVersionAt, 4);
   if (version != kSavedTreeVersion)
-    fail(source, "format version " + std::to_string(version) + ", this build reads version " +
-                     std::to_string(kSavedTreeVersion) + " (build the tree again)");
+    fail(source,
+         "format version " + std::to_string(version) + ", this build reads version " +
+             std::to_string(kSavedTreeVersion) +
+             (version < kSavedTreeVersion ? " (older versions do not record the tree's units: build it "
+                                            "again with bvhlab build)"
+                                          : " (written by a newer bvhlab)"));
   std::uint32_t byte_order = 0;
   std::memcpy(&byte_order, h + kByteOrderAt, 4);
   if (byte_order != kByteOrderMark) fail(source, "written on a machine of another byte order (or corrupted)");
   if (get_le(h + kHeaderSizeAt, 4) != kSavedTreeHeaderSize)
     fail(source, "corrupted header (bad header size)");
   const std::uint64_t flags = get_le(h + kFlagsAt, 4);
-  if ((flags & ~std::uint64_t{kFlagTriangleIds}) != 0) fail(source, "unknown flags " + std::to_string(flags));
+  if ((flags & ~std::uint64_t{kFlagTriangleIds | kFlagNormalized}) != 0)
+    fail(source, "unknown flags " + std::to_string(flags));
   if (get_le(h + kReservedAt, 4) != 0) fail(source, "corrupted header (reserved bytes are not zero)");
 
   Header header;
@@ -221,6 +254,11 @@ Header read_header(std::span<const std::byte> buffer, std::string_view source, b
   header.triangles = get_le(h + kTrianglesAt, 8);
   header.density_bytes = get_le(h + kDensityBytesAt, 8);
   header.payload = get_le(h + kPayloadAt, 8);
+  header.units.normalized = (flags & kFlagNormalized) != 0;
+  header.units.scale = get_double(h + kScaleAt);
+  for (int k = 0; k < 3; ++k) header.units.centre[k] = get_double(h + kCentreAt + 8 * k);
+  if (const std::string problem = units_problem(header.units); !problem.empty())
+    fail(source, "corrupted header (" + problem + ")");
 
   // Sizes, against each other and the buffer's real length, before any allocation.
   const std::uint64_t n = header.nodes, triangles = header.triangles;
@@ -309,3 +347,19 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
 }
 
 }  // namespace bvhlab::saved_tree_detail
+
+namespace bvhlab {
+
+std::string TreeUnits::describe() const {
+  if (!normalized) return "the mesh file's units";
+  char text[160];
+  std::snprintf(text, sizeof text, "normalised: scale %.6g, centre (%.6g, %.6g, %.6g)", scale, centre.x(),
+                centre.y(), centre.z());
+  return text;
+}
+
+TreeUnits saved_tree_units(std::span<const std::byte> buffer, std::string_view source) {
+  return saved_tree_detail::read_header(buffer, source).units;
+}
+
+}  // namespace bvhlab

@@ -1,14 +1,14 @@
 // Saved trees: a Tree<BV, D> without polygons, in a versioned, checksummed binary file.
 //
-// Format version 2 (every header integer little-endian; the arrays are raw native bytes, so the header also
+// Format version 3 (every header integer little-endian; the arrays are raw native bytes, so the header also
 // records the writer's byte order and a reader on the other order refuses the file):
 //
 //   offset size
 //        0    8  magic "BVHLTREE"
-//        8    4  format version (2)
+//        8    4  format version (3)
 //       12    4  byte-order mark 0x01020304 as written by the machine (raw arrays are in that order)
-//       16    4  header size (128)
-//       20    4  flags: bit 0 = triangle ids present; other bits must be 0
+//       16    4  header size (160)
+//       20    4  flags: bit 0 = triangle ids present, bit 1 = normalised coordinates; other bits must be 0
 //       24   32  BV::name(), NUL-padded (at most 31 characters)
 //       56    4  sizeof(BV) (a stored node volume)
 //       60    4  size of the stored root volume: sizeof(BV::Decoded) for volumes stored relative to their
@@ -20,9 +20,16 @@
 //       96    8  triangle count T (what the leaves cover, stored even when the ids are not)
 //      104    8  density block size D
 //      112    8  payload size in bytes
-//      120    8  checksum: FNV-1a 64 over bytes [0, 120) and the payload
-//      128       payload: root volume | N nodes (first, count: 2 x u32) | N volumes | T triangle ids (u32, if
+//      120    8  normalisation scale s (IEEE double bits): finite and > 0 when normalised, else exactly 1
+//      128   24  normalisation centre c (3 IEEE doubles): finite when normalised, else exactly 0
+//      152    8  checksum: FNV-1a 64 over bytes [0, 152) and the payload
+//      160       payload: root volume | N nodes (first, count: 2 x u32) | N volumes | T triangle ids (u32, if
 //                flagged) | D bytes of density data (D::encode: its parameters and per-node data)
+//
+// Units: a tree's coordinates are the mesh file's own, or, when normalised (the benchmark protocol's
+// normalisation, adb/README.md section 4), x' = (x - c) * s for every vertex x of the file. (The runner's
+// tree cache also stores trees of scene objects scaled or placed after that; its key records those.) Version
+// 2 did not record the units, and is refused by name (build the tree again).
 //
 // A density the reader does not know, or whose data version differs from the reader's, is refused by name;
 // the density validates its own block (D::decode).
@@ -61,12 +68,26 @@ class SavedTreeError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-struct SaveOptions {
-  bool triangle_ids = true;  ///< keep tree order -> mesh triangle (4 bytes per triangle)
+/// How a tree's coordinates relate to its mesh file's: the file's own units, or the protocol normalisation
+/// x' = (x - centre) * scale (bounding-box centre to the origin, longest side 2).
+struct TreeUnits {
+  bool normalized = false;
+  double scale = 1;            ///< 1 unless normalised
+  Vec3 centre = Vec3::Zero();  ///< zero unless normalised
+  [[nodiscard]] bool operator==(const TreeUnits&) const = default;
+  /// "the mesh file's units", or "normalised: scale 0.0123, centre (1, 2, 3)".
+  [[nodiscard]] std::string describe() const;
 };
 
-inline constexpr std::uint32_t kSavedTreeVersion = 2;
-inline constexpr std::size_t kSavedTreeHeaderSize = 128;
+struct SaveOptions {
+  bool triangle_ids = true;  ///< keep tree order -> mesh triangle (4 bytes per triangle)
+  TreeUnits units{};         ///< recorded in the header; the tree's coordinates must already be in them
+};
+
+inline constexpr std::uint32_t kSavedTreeVersion = 3;
+inline constexpr std::size_t kSavedTreeHeaderSize = 160;
+/// Where the checksum sits in the header: it covers the bytes before it and the payload.
+inline constexpr std::size_t kSavedTreeChecksumOffset = 152;
 
 namespace saved_tree_detail {
 
@@ -88,6 +109,7 @@ struct View {
   std::span<const std::byte> volumes;           ///< nodes.size() * layout.volume_size bytes
   std::span<const std::uint32_t> triangle_ids;  ///< empty, or triangle_count ids
   std::span<const std::byte> density;           ///< the density's encoded block
+  TreeUnits units;
 };
 
 /// A decoded tree. The volume spans point into the buffer that was decoded.
@@ -107,9 +129,11 @@ struct Header {
   std::uint32_t volume_size = 0, root_volume_size = 0;
   bool has_triangle_ids = false;
   std::uint64_t nodes = 0, triangles = 0, density_bytes = 0, payload = 0;
+  TreeUnits units;
 };
-/// Reads the header of a saved-tree image: magic, version, byte order, reserved bytes, names, and sizes that
-/// agree with each other and with `buffer`'s length (so a corrupt count cannot cause a giant allocation).
+/// Reads the header of a saved-tree image: magic, version, byte order, reserved bytes, names, units, and
+/// sizes that agree with each other and with `buffer`'s length (so a corrupt count cannot cause a giant
+/// allocation).
 /// `buffer` may hold only the header when `whole` is false (then lengths are not checked). Throws
 /// SavedTreeError naming `source`.
 Header read_header(std::span<const std::byte> buffer, std::string_view source, bool whole = true);
@@ -166,6 +190,7 @@ std::vector<std::byte> save_tree_to_buffer(const Tree<BV, D>& tree, const SaveOp
   view.nodes = bvh.nodes();
   view.volumes = saved_tree_detail::bytes_of(std::span<const BV>(bvh.volumes()));
   if (options.triangle_ids) view.triangle_ids = bvh.triangle_ids();
+  view.units = options.units;
   const std::vector<std::byte> density = D::encode(tree.density);
   try {  // what is saved must load: the density checks its bytes against the node count as a reader would
     (void)D::decode(density, bvh.nodes().size());
@@ -229,5 +254,8 @@ Tree<BV, D> load_tree(const std::filesystem::path& path) {
   const std::vector<std::byte> bytes = saved_tree_detail::read_file(path);
   return load_tree_from_buffer<BV, D>(bytes, path.string());
 }
+
+/// The units a saved-tree image records (its header, checked). Throws SavedTreeError naming `source`.
+TreeUnits saved_tree_units(std::span<const std::byte> buffer, std::string_view source = "<buffer>");
 
 }  // namespace bvhlab

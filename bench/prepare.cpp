@@ -153,7 +153,7 @@ class TreeStore {
     const bool from_cache = tree.has_value();
     if (!tree) {
       tree.emplace(make_tree<BV, D>(object, h, density, times));
-      cache_.store(key, *tree, times);
+      cache_.store(key, *tree, times, object.units);
     }
     auto shared = std::make_shared<const T>(std::move(*tree));
     remember(key, shared, describe(*shared, object, h, annotation, times, from_cache), info);
@@ -186,6 +186,7 @@ class TreeStore {
     m.hierarchy = h.name;
     m.bv = h.bv;
     m.annotation = "none";
+    m.units = object.units;
     m.triangles = object.mesh.triangle_count();
     m.nodes = static_cast<std::size_t>(model->getNumBVs());
     m.model_bytes = double(m.nodes) * double(sizeof(fcl::BVNode<FclBV>));
@@ -256,6 +257,7 @@ class TreeStore {
     m.hierarchy = h.name;
     m.bv = h.bv;
     m.annotation = annotation;
+    m.units = object.units;
     describe_tree_size(m, tree);
     m.build_seconds = times.build_seconds;
     m.annotate_seconds = times.annotate_seconds;
@@ -283,18 +285,33 @@ class TreeStore {
 // ---------------------------------------------------------------------------------------------------------
 // Objects.
 
-Mesh load_scene_object(const SceneObject& object) {
+namespace {
+
+/// The object's mesh, normalised (if asked), scaled and placed; `units` receives the normalisation.
+Mesh load_scene_mesh(const SceneObject& object, TreeUnits& units) {
   if (object.path.empty()) throw MeshError(object.mesh + ": mesh not found");
   Mesh mesh = load_mesh(object.path).mesh;
-  if (object.normalize) normalize_to_unit_cube(mesh);
+  units = {};
+  if (object.normalize) {
+    units.centre = mesh.bounds().center();  // what normalize_to_unit_cube moves to the origin
+    units.scale = normalize_to_unit_cube(mesh);
+    units.normalized = true;
+  }
   for (Vec3& v : mesh.vertices) v = object.placement.apply(v * object.scale);
   return mesh;
+}
+
+}  // namespace
+
+Mesh load_scene_object(const SceneObject& object) {
+  TreeUnits units;
+  return load_scene_mesh(object, units);
 }
 
 ObjectData load_object(const SceneObject& spec) {
   ObjectData out;
   out.spec = &spec;
-  out.mesh = load_scene_object(spec);
+  out.mesh = load_scene_mesh(spec, out.units);
   const RigidTransform& p = spec.placement;
   std::string key = "mesh=" + ContentHash::to_hex(hash_file(spec.path)) +
                     "|normalize=" + (spec.normalize ? "1" : "0") + "|scale=" + g17(spec.scale) +
@@ -310,7 +327,9 @@ ObjectData load_object(const SceneObject& spec) {
 // The stage: objects once per run, trees through the store.
 
 Preparation::Preparation(const std::filesystem::path& cache_dir, RunStats& stats, LogFn log, unsigned threads)
-    : store_(std::make_unique<TreeStore>(cache_dir, stats, std::move(log), threads)), stats_(stats) {}
+    : store_(std::make_unique<TreeStore>(cache_dir, stats, log, threads)),
+      stats_(stats),
+      log_(std::move(log)) {}
 
 Preparation::~Preparation() = default;
 
@@ -319,6 +338,7 @@ const ObjectData& Preparation::object(const SceneObject& spec) {
   if (it == objects_.end()) {
     const auto start = Clock::now();
     it = objects_.emplace(spec.name, load_object(spec)).first;
+    if (it->second.units.normalized) log_(spec.name + ": " + it->second.units.describe());
     ++stats_.meshes_loaded;
     stats_.preprocess_seconds += seconds_since(start);
   }
@@ -406,7 +426,8 @@ BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hie
   with_volume(hierarchy.bv, [&]<class BV>(std::type_identity<BV>) {
     with_density(density.name, [&]<class D>(std::type_identity<D>) {
       if constexpr (DensityFor<D, BV>)
-        bytes = save_tree_to_buffer(*store.tree<BV, D>(data, hierarchy, density, &outcome.model));
+        bytes = save_tree_to_buffer(*store.tree<BV, D>(data, hierarchy, density, &outcome.model),
+                                    {.units = data.units});
       else
         throw std::invalid_argument("density " + density.name + " cannot annotate " + hierarchy.bv +
                                     " trees");

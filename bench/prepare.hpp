@@ -3,6 +3,7 @@
 // this run's memory, else the disk cache, else built and annotated. Internal to the runner (bench/run.cpp).
 #pragma once
 
+#include "adb/saved_tree.hpp"
 #include "adb/tree.hpp"
 #include "bench/plan.hpp"
 #include "bench/run.hpp"
@@ -32,6 +33,7 @@ std::string g17(double v);
 struct ObjectData {
   const SceneObject* spec = nullptr;
   Mesh mesh;
+  TreeUnits units;  ///< the normalisation applied to the file's coordinates, if any (saved with its trees)
   std::string key;  ///< mesh checksum and every transform applied to it
 };
 /// Loads the object's mesh and computes its key. Throws MeshError.
@@ -109,6 +111,7 @@ class Preparation {
   std::unique_ptr<TreeStore> store_;
   std::map<std::string, ObjectData> objects_;
   RunStats& stats_;
+  LogFn log_;
 };
 
 }  // namespace bvhlab

@@ -125,7 +125,9 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
 }
 
 QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRequest& request,
-                       const RigidTransform& pose, const RunOptions& options) {
+                       std::span<const RigidTransform> poses, const RunOptions& options) {
+  if (poses.empty()) throw std::invalid_argument("query: no pose given");
+  if (request.repeat < 0) throw std::invalid_argument("query: a negative repeat count");
   QueryOutcome outcome;
   Scene scene;  // a one-hierarchy, one-strategy scene, so the plan decides the density as for a run
   scene.hierarchies = {request.hierarchy};
@@ -148,9 +150,20 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
       scene.needs_density(scene.hierarchies.front()) ? scene.density : DensitySpec{},
       {request.strategy}};
   auto hierarchy = preparation.hierarchy(planned, object_a, ob);
-  const auto start = Clock::now();
-  outcome.result = hierarchy->query(request.strategy, pose);
-  outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+  const double overhead = request.repeat ? clock_overhead_us() : 0;
+  std::vector<QueryRecord> records;
+  for (const RigidTransform& pose : poses) {
+    PoseAnswer answer;
+    const auto start = Clock::now();
+    answer.result = hierarchy->query(request.strategy, pose);
+    answer.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+    if (request.repeat) {
+      hierarchy->run(request.strategy, std::vector<RigidTransform>(std::size_t(request.repeat), pose), 0,
+                     records);
+      for (const QueryRecord& r : records) answer.warm_micros.push_back(std::max(0.0, r.micros - overhead));
+    }
+    outcome.answers.push_back(std::move(answer));
+  }
   const auto models = preparation.models();
   outcome.model_a = hierarchy->model;
   outcome.model_b = models.back();

@@ -3,11 +3,13 @@
 // (mesh pair, hierarchy, strategy variant, distance).
 #pragma once
 
+#include "adb/saved_tree.hpp"
 #include "bench/core/scene.hpp"
 
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -79,6 +81,7 @@ struct CalibrationBin {
 /// A tree (or FCL model) the run used, with its preprocessing cost.
 struct ModelInfo {
   std::string object, hierarchy, bv, annotation;
+  TreeUnits units;  ///< the normalisation of the mesh's coordinates, if any
   std::size_t triangles = 0, nodes = 0, depth = 0;
   double model_bytes = 0, bytes_per_triangle = 0;
   double density_bytes = 0;  ///< what the density adds to model_bytes (a strategy without one reads less)
@@ -118,21 +121,33 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options);
 /// An object's mesh as a run loads it: normalised (if asked), scaled and placed. Throws MeshError.
 Mesh load_scene_object(const SceneObject& object);
 
-/// One query between two objects, with the trees a scene with this one hierarchy would use (and the same
+/// Queries between two objects, with the trees a scene with this one hierarchy would use (and the same
 /// cache).
 struct QueryRequest {
   HierarchySpec hierarchy;
   DensitySpec density;  ///< what the trees carry; a strategy that needs a density must accept it
   StrategyVariant strategy;
+  int repeat = 0;  ///< warm queries timed after the first one at each pose (0: none)
+};
+/// One pose's answer: the first query's full result and time (cold: right after the trees were made or the
+/// previous pose was answered), then the times of `repeat` more, timed as the runner times its series.
+struct PoseAnswer {
+  Result result;
+  double micros = 0;
+  std::vector<double> warm_micros;  ///< each less the clock's own overhead (clamped at 0), as in results.csv
 };
 struct QueryOutcome {
-  Result result;
-  double micros = 0;  ///< the query alone, trees already built
+  std::vector<PoseAnswer> answers;  ///< one per pose, in order
   ModelInfo model_a, model_b;
   RunStats stats;
 };
+/// Throws std::invalid_argument for an empty list of poses or a strategy that cannot run on the trees.
 QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRequest& request,
-                       const RigidTransform& pose, const RunOptions& options);
+                       std::span<const RigidTransform> poses, const RunOptions& options);
+inline QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRequest& request,
+                              const RigidTransform& pose, const RunOptions& options) {
+  return run_query(a, b, request, std::span<const RigidTransform>(&pose, 1), options);
+}
 
 /// What a saved-tree file's header says about its tree.
 struct SavedTreeInfo {
@@ -140,6 +155,7 @@ struct SavedTreeInfo {
   std::string density;     ///< the density's name
   std::string annotation;  ///< its description: "none", "adb grid=2 tau=0.25"
   std::uint64_t nodes = 0, triangles = 0;
+  TreeUnits units;
 };
 /// Reads a saved tree (adb/saved_tree.hpp) and describes it. Throws SavedTreeError naming the file for
 /// anything that is not one, or names a BV or density this build does not know.
@@ -147,10 +163,16 @@ SavedTreeInfo peek_saved_tree(const std::filesystem::path& file);
 /// Whether `file` starts like a saved tree (so the CLI can take trees and meshes alike).
 bool is_saved_tree(const std::filesystem::path& file);
 
-/// One query between two saved trees (no polygons). Both must have the same BV and density, and the strategy
-/// must run on it without polygons. Throws std::invalid_argument otherwise.
+/// Queries between two saved trees (no polygons), `repeat` as in QueryRequest. Both must have the same BV and
+/// density, the same kind of units (both normalised or both in their files' units), and the strategy must
+/// run on them without polygons. Throws std::invalid_argument otherwise.
 QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
-                                const StrategyVariant& strategy, const RigidTransform& pose);
+                                const StrategyVariant& strategy, std::span<const RigidTransform> poses,
+                                int repeat = 0);
+inline QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
+                                       const StrategyVariant& strategy, const RigidTransform& pose) {
+  return run_query_on_trees(a, b, strategy, std::span<const RigidTransform>(&pose, 1));
+}
 
 /// Builds (and annotates with the density, if any) one object's tree and saves it, without polygons, in the
 /// saved-tree format.

@@ -4,15 +4,16 @@
 #include "adb/saved_tree.hpp"
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
+#include "bench/measure.hpp"
 #include "bench/prepare.hpp"
 #include "traversal/strategies.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <utility>
 
 namespace bvhlab {
-
-using Clock = std::chrono::steady_clock;
 
 bool is_saved_tree(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -22,20 +23,32 @@ bool is_saved_tree(const std::filesystem::path& file) {
 
 namespace {
 
-/// Calls f(tree) with the saved tree in `file`, typed by the BV and density its header names.
-template <class F>
-void with_saved_tree(const std::filesystem::path& file, F&& f) {
-  const std::vector<std::byte> bytes = saved_tree_detail::read_file(file);
-  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, file.string());
-  try {  // a name this build does not know is refused naming the file; f's own errors pass unchanged
-    with_volume(header.bv_name, [](auto) {});
-    with_density(header.density_name, [](auto) {});
+/// The file's bytes and its checked header, with a BV or density this build does not know refused by name.
+struct SavedTreeFile {
+  std::vector<std::byte> bytes;
+  saved_tree_detail::Header header;
+};
+
+SavedTreeFile read_saved_tree(const std::filesystem::path& file) {
+  SavedTreeFile out;
+  out.bytes = saved_tree_detail::read_file(file);
+  out.header = saved_tree_detail::read_header(out.bytes, file.string());
+  try {
+    with_volume(out.header.bv_name, [](auto) {});
+    with_density(out.header.density_name, [](auto) {});
   } catch (const std::invalid_argument& e) {
     throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
   }
-  with_volume(header.bv_name, [&]<class BV>(std::type_identity<BV>) {
-    with_density(header.density_name, [&]<class D>(std::type_identity<D>) {
-      f(load_tree_from_buffer<BV, D>(bytes, file.string()));
+  return out;
+}
+
+/// Calls f(tree, header) with the saved tree in `file`, typed by the BV and density its header names.
+template <class F>
+void with_saved_tree(const std::filesystem::path& file, F&& f) {
+  const SavedTreeFile saved = read_saved_tree(file);
+  with_volume(saved.header.bv_name, [&]<class BV>(std::type_identity<BV>) {
+    with_density(saved.header.density_name, [&]<class D>(std::type_identity<D>) {
+      f(load_tree_from_buffer<BV, D>(saved.bytes, file.string()), saved.header);
     });
   });
 }
@@ -44,68 +57,100 @@ void with_saved_tree(const std::filesystem::path& file, F&& f) {
 
 SavedTreeInfo peek_saved_tree(const std::filesystem::path& file) {
   SavedTreeInfo info;
-  with_saved_tree(file, [&]<class BV, class D>(const Tree<BV, D>& tree) {
+  with_saved_tree(file, [&]<class BV, class D>(const Tree<BV, D>& tree, const saved_tree_detail::Header& h) {
     info.bv = BV::name();
     info.density = D::name();
     info.annotation = D::describe(tree.density);
     info.nodes = tree.bvh.nodes().size();
     const BvhStats stats = tree.bvh.stats();
     info.triangles = stats.triangles;
+    info.units = h.units;
   });
   return info;
 }
 
 namespace {
 
+/// Refuses to query a normalised tree against one in its file's units: a pose cannot be in both units.
+void check_same_kind_of_units(const std::filesystem::path& a, const TreeUnits& units_a,
+                              const std::filesystem::path& b, const TreeUnits& units_b) {
+  if (units_a.normalized == units_b.normalized) return;
+  const auto& [normalized, raw] = units_a.normalized ? std::pair(a, b) : std::pair(b, a);
+  throw std::invalid_argument("saved trees in different units: " + normalized.string() + " is " +
+                              (units_a.normalized ? units_a : units_b).describe() + ", " + raw.string() +
+                              " is in its mesh file's units; build both with --normalize, or both without");
+}
+
 /// B's tree typed as A's: its header must name the same BV and density (else the error describes both).
 template <class BV, class D>
-Tree<BV, D> load_matching(const Tree<BV, D>& tree_a, const std::filesystem::path& b) {
-  const std::vector<std::byte> bytes = saved_tree_detail::read_file(b);
-  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, b.string());
-  if (header.bv_name != BV::name() || header.density_name != D::name()) {
+Tree<BV, D> load_matching(const Tree<BV, D>& tree_a, const std::filesystem::path& b,
+                          const SavedTreeFile& saved_b) {
+  if (saved_b.header.bv_name != BV::name() || saved_b.header.density_name != D::name()) {
     const SavedTreeInfo other = peek_saved_tree(b);
     throw std::invalid_argument("the two trees differ in BV or density (" + std::string(BV::name()) + ", " +
                                 D::describe(tree_a.density) + " vs " + other.bv + ", " + other.annotation +
                                 ")");
   }
-  return load_tree_from_buffer<BV, D>(bytes, b.string());
+  return load_tree_from_buffer<BV, D>(saved_b.bytes, b.string());
 }
 
 template <class BV, class D>
-void describe_saved(ModelInfo& model, const Tree<BV, D>& tree, const std::filesystem::path& file) {
+void describe_saved(ModelInfo& model, const Tree<BV, D>& tree, const std::filesystem::path& file,
+                    const TreeUnits& units) {
   model.object = file.filename().string();
   model.hierarchy = model.bv = BV::name();
   model.annotation = D::describe(tree.density);
+  model.units = units;
   describe_tree_size(model, tree);
   model.from_cache = true;
+}
+
+/// The first query at `pose` with its full result, then `repeat` more timed as the runner times a series.
+template <class S, class BV, class D>
+PoseAnswer answer_pose(const Tree<BV, D>& a, const Tree<BV, D>& b, const typename S::Options& options,
+                       const RigidTransform& pose, int repeat, double clock_overhead) {
+  PoseAnswer answer;
+  const auto start = Clock::now();
+  answer.result = S::query(a, b, pose, options);
+  answer.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+  if (repeat <= 0) return answer;
+  std::vector<QueryRecord> records;
+  timed_series(std::vector<RigidTransform>(std::size_t(repeat), pose), 0, records,
+               [&](const RigidTransform& p) { return S::query(a, b, p, options); });
+  for (const QueryRecord& r : records) answer.warm_micros.push_back(std::max(0.0, r.micros - clock_overhead));
+  return answer;
 }
 
 }  // namespace
 
 QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::filesystem::path& b,
-                                const StrategyVariant& strategy, const RigidTransform& pose) {
+                                const StrategyVariant& strategy, std::span<const RigidTransform> poses,
+                                int repeat) {
+  if (poses.empty()) throw std::invalid_argument("query: no pose given");
   const StrategyInfo& info = strategy_info(strategy.strategy);
   if (info.needs_polygons)
     throw std::invalid_argument("saved trees carry no polygons, and strategy " + strategy.strategy +
                                 " tests triangles; give the meshes instead");
+  const SavedTreeFile saved_b = read_saved_tree(b);
   QueryOutcome outcome;
+  const double overhead = repeat > 0 ? clock_overhead_us() : 0;
   // One dispatch on A's header; B is loaded as the same type (a nested dispatch would instantiate every
   // pair of types, nearly all of them only to refuse).
-  with_saved_tree(a, [&]<class BV, class D>(const Tree<BV, D>& tree_a) {
-    const Tree<BV, D> tree_b = load_matching(tree_a, b);
+  with_saved_tree(a, [&]<class BV, class D>(const Tree<BV, D>& tree_a, const saved_tree_detail::Header& h) {
+    check_same_kind_of_units(a, h.units, b, saved_b.header.units);
+    const Tree<BV, D> tree_b = load_matching(tree_a, b, saved_b);
     with_strategy(strategy.strategy, [&]<class S>(std::type_identity<S>) {
       if constexpr (S::template accepts<D>) {
         const auto options = strategy_options<S>(strategy.values, strategy.budget);
-        const auto start = Clock::now();
-        outcome.result = S::query(tree_a, tree_b, pose, options);
-        outcome.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+        for (const RigidTransform& pose : poses)
+          outcome.answers.push_back(answer_pose<S>(tree_a, tree_b, options, pose, repeat, overhead));
       } else {
         throw std::invalid_argument("strategy " + strategy.strategy +
                                     " does not run on trees with density '" + std::string(D::name()) + "'");
       }
     });
-    describe_saved(outcome.model_a, tree_a, a);
-    describe_saved(outcome.model_b, tree_b, b);
+    describe_saved(outcome.model_a, tree_a, a, h.units);
+    describe_saved(outcome.model_b, tree_b, b, saved_b.header.units);
   });
   return outcome;
 }

@@ -40,7 +40,7 @@ std::string join(const std::vector<std::string>& items);
 std::filesystem::path mesh_cache_dir();
 /// A mesh argument: an existing file, else a name in the mesh catalog (bundled or fetched meshes).
 std::filesystem::path resolve_mesh_argument(const std::string& argument);
-/// The scene object a mesh argument names, normalised by the protocol or not.
+/// The scene object a mesh argument names, in its file's units or normalised by the protocol.
 SceneObject object_for(const std::string& argument, bool normalize);
 /// The runner's options: the cache at `cache` (default below the build folder) or none, quiet or not.
 RunOptions run_options(const std::string& cache, bool no_cache, bool quiet);

@@ -29,13 +29,18 @@ void print_saved_tree(const std::string& file, bool json) {
                         {"density", t.density},
                         {"annotation", t.annotation},
                         {"nodes", t.nodes},
-                        {"triangles", t.triangles}};
+                        {"triangles", t.triangles},
+                        {"normalized", t.units.normalized}};
+    if (t.units.normalized)
+      j["normalization"] = {{"scale", t.units.scale},
+                            {"centre", {t.units.centre.x(), t.units.centre.y(), t.units.centre.z()}}};
     std::cout << j.dump(2) << '\n';
     return;
   }
   std::printf("%s (saved tree)\n  bv              %s\n  nodes           %ju\n  triangles       %ju\n",
               file.c_str(), t.bv.c_str(), std::uintmax_t(t.nodes), std::uintmax_t(t.triangles));
   std::printf("  annotation      %s\n", t.annotation.c_str());
+  std::printf("  units           %s\n", t.units.describe().c_str());
 }
 
 void print_mesh_json(const fs::path& path, const LoadedMesh& loaded, const std::string& checksum) {

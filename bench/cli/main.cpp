@@ -16,12 +16,15 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  bvhlab info jeep1.ms3d\n"
       "  bvhlab build teapot.obj --bv aabb --adb --grid 2 --tau 0.25 -o teapot.tree\n"
-      "  bvhlab query jeep1.ms3d jeep1.ms3d --protocol 1.4,100,5000 --strategy adb --p-min 0.9\n"
-      "  bvhlab query teapot.tree teapot.tree --pose 1.2,0,0,0,0,1,45 --strategy adb\n"
+      "  bvhlab query jeep1.ms3d jeep1.ms3d --normalize --protocol 1.4,100,5000 --strategy adb --p-min 0.9\n"
+      "  bvhlab query teapot.tree teapot.tree --pose 1.2,0,0,0,0,1,45 --strategy adb --repeat 1000\n"
       "  bvhlab run bench/scenes/smoke.json -o results/smoke\n"
       "  bvhlab report bench/scenes/demo.json -o report/demo\n"
       "  bvhlab demo --build-dir build/release\n"
-      "Meshes are files, or names of bundled (meshes/) and fetched (meshes/fetch.sh) meshes.\n"
+      "Meshes are files, or names of bundled (meshes/) and fetched (meshes/fetch.sh) meshes, in their "
+      "files'\n"
+      "own units unless --normalize applies the protocol normalisation (centre to the origin, longest side "
+      "2).\n"
       "Run `bvhlab SUBCOMMAND --help` for a subcommand's options.");
   // The order here is the order of the subcommands in the help.
   const std::vector<Command> commands = {

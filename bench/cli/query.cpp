@@ -1,10 +1,12 @@
-// bvhlab query: one query between two meshes, or two saved trees, at one pose; prints the full result.
+// bvhlab query: queries between two meshes, or two saved trees, at one pose or a list of poses; prints the
+// full result.
 #include "bench/cli/cli.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -19,13 +21,15 @@ namespace {
 namespace fs = std::filesystem;
 
 struct QueryArgs {
-  std::string a, b, pose, protocol, bv = "aabb", strategy = "exact", cache, density;
-  double deadline = 0;
-  std::uint64_t bv_tests = 0;
-  bool all = false, json = false, raw = false, no_cache = false;
+  std::string a, b, pose, protocol, poses_file, bv = "aabb", strategy = "exact", cache, density;
+  double deadline = 0, bv_tests = 0;
+  int repeat = 0;
+  bool all = false, json = false, normalize = false, no_cache = false;
   ParameterOptions parameters;
+  const CLI::Option* bv_option = nullptr;
   const CLI::Option* bv_tests_option = nullptr;
   const CLI::Option* deadline_option = nullptr;
+  const CLI::Option* cache_option = nullptr;
   [[nodiscard]] bool budget_given() const { return bv_tests_option->count() || deadline_option->count(); }
 };
 
@@ -44,26 +48,39 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& wh
   return out;
 }
 
-RigidTransform parse_pose(const std::string& pose, const std::string& protocol) {
-  if (!protocol.empty()) {
-    const auto v = parse_numbers(protocol, "--protocol");
-    if (v.size() != 3 || v[2] < 1 || v[1] < 0 || v[1] != std::floor(v[1]) || v[2] != std::floor(v[2]))
-      throw CLI::ValidationError("--protocol",
-                                 "expected DISTANCE,STEP,STEPS with integer 0 <= STEP, 1 <= STEPS");
-    return protocol_pose(v[0], static_cast<int>(v[1]), static_cast<int>(v[2]));
+/// Throws CLI::ValidationError for `value` outside `spec`'s range (the range the scene parser checks too).
+void check_value(const ParamSpec& spec, double value, const std::string& option) {
+  if (const std::string problem = spec.problem(value); !problem.empty())
+    throw CLI::ValidationError(option, std::string(spec.name) + " " + problem);
+}
+
+RigidTransform protocol_pose_argument(const std::string& protocol) {
+  const auto v = parse_numbers(protocol, "--protocol");
+  if (v.size() != 3) throw CLI::ValidationError("--protocol", "expected DISTANCE,STEP,STEPS");
+  check_value(limits::kDistance, v[0], "--protocol");
+  check_value(limits::kSteps, v[2], "--protocol");
+  if (!(v[1] >= 0 && v[1] < v[2] && v[1] == std::floor(v[1])))
+    throw CLI::ValidationError("--protocol", "STEP must be an integer in [0, STEPS - 1], got " +
+                                                 parameter_text(v[1]) + " with STEPS " +
+                                                 parameter_text(v[2]));
+  return protocol_pose(v[0], static_cast<int>(v[1]), static_cast<int>(v[2]));
+}
+
+/// The poses to query, each with the line of the pose list it came from (0 for --pose and --protocol).
+std::vector<ListedPose> poses_of(const QueryArgs& args) {
+  if (!args.poses_file.empty()) {
+    try {
+      return load_pose_list(args.poses_file);
+    } catch (const SceneError& e) {
+      throw CLI::ValidationError("--poses", e.what());
+    }
   }
-  const auto v = parse_numbers(pose, "--pose");
-  if (v.size() != 3 && v.size() != 7)
-    throw CLI::ValidationError("--pose", "expected TX,TY,TZ or TX,TY,TZ,AX,AY,AZ,DEGREES");
-  RigidTransform out;
-  out.translation = Vec3(v[0], v[1], v[2]);
-  if (v.size() == 7) {
-    const Vec3 axis(v[3], v[4], v[5]);
-    if (axis.norm() == 0) throw CLI::ValidationError("--pose", "the rotation axis has zero length");
-    out.rotation = Eigen::AngleAxisd(v[6] * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+  if (!args.protocol.empty()) return {{protocol_pose_argument(args.protocol), 0}};
+  try {
+    return {{pose_from_numbers(parse_numbers(args.pose, "--pose")), 0}};
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--pose", e.what());
   }
-  if (!out.translation.allFinite()) throw CLI::ValidationError("--pose", "the translation is not finite");
-  return out;
 }
 
 /// Whether A and B are saved trees (else meshes); refuses one of each.
@@ -75,12 +92,23 @@ bool saved_trees(const QueryArgs& args) {
   return tree_a;
 }
 
+/// Options that shape trees built from meshes: a saved tree already has its BV, units and density.
+void refuse_tree_building_options(const QueryArgs& args) {
+  const std::string why = "saved trees carry their own ";
+  if (args.bv_option->count()) throw CLI::ValidationError("--bv", why + "BV; it does not apply");
+  if (args.normalize) throw CLI::ValidationError("--normalize", why + "units; it does not apply");
+  if (!args.density.empty()) throw CLI::ValidationError("--density", why + "density; it does not apply");
+  if (args.cache_option->count() || args.no_cache)
+    throw CLI::ValidationError("--cache/--no-cache",
+                               "saved trees are read as they are; the cache does not apply");
+}
+
 /// The strategy and density names a query runs with: --all-contacts and the default density applied.
 struct QueryPolicies {
   std::string strategy, density;
 };
 
-QueryPolicies query_policies(const QueryArgs& args, bool trees) {
+QueryPolicies query_policies(const QueryArgs& args) {
   QueryPolicies out{args.strategy, args.density};
   if (args.all) {
     if (out.strategy != ExactStrategy::name() && out.strategy != AllContactsStrategy::name())
@@ -94,14 +122,31 @@ QueryPolicies query_policies(const QueryArgs& args, bool trees) {
   if (!strategy.accepts(out.density))
     throw CLI::ValidationError("--density",
                                "strategy " + out.strategy + " does not run on density " + out.density);
-  if (trees && !args.density.empty())
-    throw CLI::ValidationError("--density", "saved trees carry their own density; it does not apply");
   return out;
+}
+
+/// The budget given, checked against the ranges a scene's budgets have.
+Budget budget_of(const QueryArgs& args, const StrategyInfo& strategy) {
+  if (strategy.budget == BudgetUse::None && args.budget_given())
+    throw CLI::ValidationError("--bv-tests/--deadline-us", "strategy " + strategy.name + " takes no budget");
+  Budget budget;
+  if (args.bv_tests_option->count()) {
+    check_value(limits::kBvTests, args.bv_tests, "--bv-tests");
+    budget.max_bv_tests = static_cast<std::uint64_t>(args.bv_tests);
+  }
+  if (args.deadline_option->count()) {
+    check_value(limits::kDeadlineUs, args.deadline, "--deadline-us");
+    budget.deadline_us = args.deadline;
+  }
+  if (strategy.budget == BudgetUse::Required && budget.unlimited())
+    throw CLI::ValidationError("--strategy " + strategy.name, "needs --bv-tests and/or --deadline-us");
+  return budget;
 }
 
 /// The checked request: hierarchy, density (for meshes) and strategy with its parameters and budget.
 QueryRequest query_request(const QueryArgs& args, bool trees) {
-  const QueryPolicies names = query_policies(args, trees);
+  if (trees) refuse_tree_building_options(args);
+  const QueryPolicies names = query_policies(args);
   const StrategyInfo& strategy = strategy_info(names.strategy);
   const auto& density_parameters = density_info(names.density).parameters;
   if (trees)
@@ -115,73 +160,126 @@ QueryRequest query_request(const QueryArgs& args, bool trees) {
   request.strategy.values =
       resolve_parameters(strategy.parameters, args.parameters.pick(strategy.parameters), names.strategy);
   if (!trees) request.density = density_from(names.density, args.parameters);
-  request.strategy.budget.max_bv_tests = args.bv_tests;
-  request.strategy.budget.deadline_us = args.deadline;
-  if (strategy.budget == BudgetUse::None && args.budget_given())
-    throw CLI::ValidationError("--bv-tests/--deadline-us", "strategy " + names.strategy + " takes no budget");
-  if (strategy.budget == BudgetUse::Required && request.strategy.budget.unlimited())
-    throw CLI::ValidationError("--strategy " + names.strategy, "needs --bv-tests and/or --deadline-us");
+  request.strategy.budget = budget_of(args, strategy);
+  request.repeat = args.repeat;
   return request;
 }
 
-/// A query's outcome, and the names and BV to print it under.
+/// The queries' outcome, and the names and BV to print it under.
 struct QueryRun {
   QueryOutcome outcome;
+  std::vector<ListedPose> poses;
   std::string name_a, name_b, bv;
 };
 
+/// Says on stderr in which units the poses are read, when they are not the mesh files' own.
+void report_units(const QueryRun& run, bool trees) {
+  const ModelInfo* models[] = {&run.outcome.model_a, &run.outcome.model_b};
+  const std::string names[] = {run.name_a, run.name_b};
+  for (int k = 0; k < (run.name_a == run.name_b ? 1 : 2); ++k)
+    if (models[k]->units.normalized)
+      std::fprintf(stderr, "bvhlab: %s %s %s\n", names[k].c_str(), trees ? "is" : "was",
+                   models[k]->units.describe().c_str());
+  if (models[0]->units.normalized)
+    std::fprintf(stderr, "bvhlab: poses are read in normalised units (both objects' longest side is 2)\n");
+}
+
 QueryRun execute_query(const QueryArgs& args, bool trees, const QueryRequest& request,
-                       const RigidTransform& pose) {
+                       std::vector<ListedPose> listed) {
   QueryRun out;
-  if (trees) {  // saved trees: ADB without polygons; BV, grid and tau come from the files
-    out.outcome = run_query_on_trees(args.a, args.b, request.strategy, pose);
+  out.poses = std::move(listed);
+  std::vector<RigidTransform> poses;
+  for (const ListedPose& p : out.poses) poses.push_back(p.pose);
+  if (trees) {  // saved trees: ADB without polygons; BV, grid, tau and units come from the files
+    out.outcome = run_query_on_trees(args.a, args.b, request.strategy, poses, request.repeat);
     out.name_a = args.a;
     out.name_b = args.b;
     out.bv = out.outcome.model_a.bv;
-    return out;
+  } else {
+    const SceneObject a = object_for(args.a, args.normalize);
+    const SceneObject b_separate = object_for(args.b, args.normalize);
+    const bool same = a.path == b_separate.path;
+    const RunOptions options = run_options(args.cache, args.no_cache, true);
+    out.outcome = run_query(a, same ? a : b_separate, request, poses, options);
+    out.name_a = a.name;
+    out.name_b = b_separate.name;
+    out.bv = args.bv;
   }
-  const SceneObject a = object_for(args.a, !args.raw);
-  const SceneObject b_separate = object_for(args.b, !args.raw);
-  const bool same = a.path == b_separate.path;
-  const RunOptions options = run_options(args.cache, args.no_cache, true);
-  out.outcome = run_query(a, same ? a : b_separate, request, pose, options);
-  out.name_a = a.name;
-  out.name_b = b_separate.name;
-  out.bv = args.bv;
+  report_units(out, trees);
   return out;
 }
 
-void print_json(const QueryOutcome& outcome, bool all_contacts) {
-  const Result& r = outcome.result;
+/// Median, min and max of the warm times.
+struct Spread {
+  double median = 0, min = 0, max = 0;
+};
+
+Spread spread_of(std::vector<double> times) {
+  std::sort(times.begin(), times.end());
+  const std::size_t n = times.size();
+  return {n % 2 ? times[n / 2] : 0.5 * (times[n / 2 - 1] + times[n / 2]), times.front(), times.back()};
+}
+
+nlohmann::json answer_json(const PoseAnswer& answer, bool all_contacts) {
+  const Result& r = answer.result;
   nlohmann::json j = {{"collides", r.collides},
                       {"probability", r.probability},
                       {"exact", r.exact},
                       {"budget_exhausted", r.budget_exhausted},
-                      {"time_us", outcome.micros},
+                      {"time_us", answer.micros},
                       {"bv_tests", r.counters.bv_tests},
                       {"triangle_tests", r.counters.triangle_tests},
                       {"nodes_visited", r.counters.nodes_visited},
                       {"probability_evaluations", r.counters.probability_evaluations}};
+  if (!answer.warm_micros.empty()) {
+    const Spread s = spread_of(answer.warm_micros);
+    j["warm_time_us"] = {
+        {"queries", answer.warm_micros.size()}, {"median", s.median}, {"min", s.min}, {"max", s.max}};
+  }
   if (r.witness) j["witness"] = {r.witness->a, r.witness->b};
   if (all_contacts) {
     j["contacts"] = nlohmann::json::array();
     for (const auto& c : r.contacts) j["contacts"].push_back({c.a, c.b});
   }
-  std::cout << j.dump(2) << '\n';
+  return j;
 }
 
-void print_text(const QueryRun& run, const QueryRequest& request, bool all_contacts) {
-  const Result& r = run.outcome.result;
-  std::printf("%s vs %s, %s on %s\n", run.name_a.c_str(), run.name_b.c_str(),
-              request.strategy.label().c_str(), run.bv.c_str());
+void print_json(const QueryRun& run, bool all_contacts, bool batch) {
+  if (!batch) {
+    std::cout << answer_json(run.outcome.answers.front(), all_contacts).dump(2) << '\n';
+    return;
+  }
+  nlohmann::json results = nlohmann::json::array();
+  for (std::size_t k = 0; k < run.poses.size(); ++k) {
+    nlohmann::json j = answer_json(run.outcome.answers[k], all_contacts);
+    j["line"] = run.poses[k].line;
+    results.push_back(std::move(j));
+  }
+  std::cout << nlohmann::json{{"results", results}}.dump(2) << '\n';
+}
+
+void print_times(const PoseAnswer& answer) {
+  std::printf("  time              %.2f us (one query, no warm-up)\n", answer.micros);
+  if (answer.warm_micros.empty()) return;
+  const Spread s = spread_of(answer.warm_micros);
+  std::printf("  warm time         median %.3f us, min %.3f us, max %.3f us over %zu queries\n", s.median,
+              s.min, s.max, answer.warm_micros.size());
+}
+
+void print_answer(const PoseAnswer& answer, bool all_contacts, bool counters) {
+  const Result& r = answer.result;
   std::printf("  collides          %s\n  probability       %g\n  exact             %s\n",
               r.collides ? "yes" : "no", r.probability, r.exact ? "yes" : "no");
   if (r.budget_exhausted) std::printf("  budget            exhausted (best-effort answer)\n");
   if (r.witness)
     std::printf("  witness           triangle %u of A, triangle %u of B\n", r.witness->a, r.witness->b);
-  if (all_contacts) std::printf("  contacts          %zu triangle pairs\n", r.contacts.size());
-  std::printf("  time              %.2f us\n", run.outcome.micros);
-  if (!request.hierarchy.is_fcl())
+  if (all_contacts) {
+    std::printf("  contacts          %zu triangle pairs%s\n", r.contacts.size(),
+                r.contacts.empty() ? "" : " (triangle of A, triangle of B):");
+    for (const auto& c : r.contacts) std::printf("    %u %u\n", c.a, c.b);
+  }
+  print_times(answer);
+  if (counters)
     std::printf("  BV tests          %ju\n  triangle tests    %ju\n  nodes visited     %ju\n",
                 std::uintmax_t(r.counters.bv_tests), std::uintmax_t(r.counters.triangle_tests),
                 std::uintmax_t(r.counters.nodes_visited));
@@ -189,25 +287,56 @@ void print_text(const QueryRun& run, const QueryRequest& request, bool all_conta
     std::printf("  estimates         %ju\n", std::uintmax_t(r.counters.probability_evaluations));
 }
 
+/// A pose list: one row per pose; --json (or a single --pose) has every detail.
+void print_table(const QueryRun& run, bool all_contacts, bool repeat) {
+  std::printf("  %6s  %-8s  %11s  %-5s  %10s  %10s  %14s%s%s\n", "line", "collides", "probability", "exact",
+              "time_us", "bv_tests", "triangle_tests", repeat ? "  warm_median_us" : "",
+              all_contacts ? "  contacts" : "");
+  for (std::size_t k = 0; k < run.poses.size(); ++k) {
+    const PoseAnswer& answer = run.outcome.answers[k];
+    const Result& r = answer.result;
+    std::printf("  %6zu  %-8s  %11.6g  %-5s  %10.2f  %10ju  %14ju", run.poses[k].line,
+                r.collides ? "yes" : "no", r.probability, r.exact ? "yes" : "no", answer.micros,
+                std::uintmax_t(r.counters.bv_tests), std::uintmax_t(r.counters.triangle_tests));
+    if (repeat) std::printf("  %14.3f", spread_of(answer.warm_micros).median);
+    if (all_contacts) std::printf("  %8zu", r.contacts.size());
+    std::printf("\n");
+  }
+}
+
+void print_text(const QueryRun& run, const QueryRequest& request, bool all_contacts, bool batch) {
+  std::printf("%s vs %s, %s on %s", run.name_a.c_str(), run.name_b.c_str(), request.strategy.label().c_str(),
+              run.bv.c_str());
+  if (!batch) {
+    std::printf("\n");
+    print_answer(run.outcome.answers.front(), all_contacts, !request.hierarchy.is_fcl());
+    return;
+  }
+  std::printf(", %zu poses\n", run.poses.size());
+  print_table(run, all_contacts, request.repeat > 0);
+}
+
 int query_command(const QueryArgs& args) {
-  if (args.pose.empty() && args.protocol.empty())
-    throw CLI::ValidationError("query", "give B's pose with --pose or --protocol");
+  const int sources = int(!args.pose.empty()) + int(!args.protocol.empty()) + int(!args.poses_file.empty());
+  if (sources != 1)
+    throw CLI::ValidationError("query", "give B's pose with one of --pose, --protocol, --poses");
   const bool trees = saved_trees(args);
   const QueryRequest request = query_request(args, trees);
-  const RigidTransform pose = parse_pose(args.pose, args.protocol);
-  const QueryRun result = execute_query(args, trees, request, pose);
+  std::vector<ListedPose> poses = poses_of(args);
+  const QueryRun run = execute_query(args, trees, request, std::move(poses));
+  const bool batch = !args.poses_file.empty();
   if (args.json)
-    print_json(result.outcome, args.all);
+    print_json(run, args.all, batch);
   else
-    print_text(result, request, args.all);
+    print_text(run, request, args.all, batch);
   return 0;
 }
 
 /// The policies' options: the strategies' and densities' parameters, and the budget.
 void add_policy_options(CLI::App* query, QueryArgs& args) {
-  query->add_option("--bv", args.bv, "Hierarchy: a bvhlab BV, or fcl_obb / fcl_obbrss")
-      ->check(CLI::IsMember(hierarchy_bv_names()))
-      ->capture_default_str();
+  args.bv_option = query->add_option("--bv", args.bv, "Hierarchy: a bvhlab BV, or fcl_obb / fcl_obbrss")
+                       ->check(CLI::IsMember(hierarchy_bv_names()))
+                       ->capture_default_str();
   query->add_option("--strategy", args.strategy, "Strategy (`bvhlab policies`)")
       ->check(CLI::IsMember(strategy_names()))
       ->capture_default_str();
@@ -221,35 +350,47 @@ void add_policy_options(CLI::App* query, QueryArgs& args) {
   for (const DensityInfo& d : density_table()) args.parameters.add(query, d.parameters, "density " + d.name);
   args.parameters.finish_help();
   args.bv_tests_option =
-      query->add_option("--bv-tests", args.bv_tests, "Budget of BV tests (strategies with a budget)");
-  args.deadline_option =
-      query->add_option("--deadline-us", args.deadline, "Deadline in microseconds (strategies with a budget)")
-          ->check(CLI::PositiveNumber);
+      query->add_option("--bv-tests", args.bv_tests,
+                        "Budget of BV tests (strategies with a budget); " + limits::kBvTests.range_text());
+  args.deadline_option = query->add_option(
+      "--deadline-us", args.deadline,
+      "Deadline in microseconds (strategies with a budget); " + limits::kDeadlineUs.range_text());
 }
 
 }  // namespace
 
 Command add_query_command(CLI::App& app) {
   auto args = std::make_shared<QueryArgs>();
-  auto* query = app.add_subcommand("query", "One query between two meshes; prints the full result");
+  auto* query = app.add_subcommand("query", "Queries between two meshes at one pose or a list of poses");
   query->add_option("A", args->a, "Mesh A (stays at the origin), or a saved tree")->required();
   query->add_option("B", args->b, "Mesh B (moved by the pose), or a saved tree")->required();
-  auto* pose_option =
-      query->add_option("--pose", args->pose, "B's pose: TX,TY,TZ or TX,TY,TZ,AX,AY,AZ,DEGREES");
-  query->add_option("--protocol", args->protocol, "B's pose from the protocol: DISTANCE,STEP,STEPS")
-      ->excludes(pose_option);
+  query->add_option(
+      "--pose", args->pose,
+      "B's pose: TX,TY,TZ or TX,TY,TZ,AX,AY,AZ,DEGREES, or the 12 numbers of [R | t] row by row");
+  query->add_option("--protocol", args->protocol,
+                    "B's pose from the protocol: DISTANCE,STEP,STEPS (its distances assume --normalize)");
+  query->add_option("--poses", args->poses_file,
+                    "A pose list: one pose per line, as --pose takes it (blanks or commas between numbers; "
+                    "'#' starts a comment line)");
   add_policy_options(query, *args);
   query->add_flag("--all-contacts", args->all,
-                  "Short for --strategy all_contacts: every intersecting triangle pair");
-  query->add_flag("--no-normalize", args->raw, "Keep the meshes' coordinates");
+                  "Short for --strategy all_contacts: every intersecting triangle pair, listed");
+  query->add_flag("--normalize", args->normalize,
+                  "Apply the protocol normalisation to each mesh (centre to the origin, longest side 2); "
+                  "default: the mesh files' own units");
+  query->add_option("--repeat", args->repeat, "Also time N warm queries at each pose: median, min and max")
+      ->check(CLI::Range(1, 10'000'000));
   query->add_flag("--json", args->json, "Print JSON");
-  query->add_option("--cache", args->cache, "Tree cache directory (default: <build>/cache)");
+  args->cache_option =
+      query->add_option("--cache", args->cache, "Tree cache directory (default: <build>/cache)");
   query->add_flag("--no-cache", args->no_cache, "Neither read nor write the tree cache");
   query->footer(
+      "Poses are in the meshes' units (the files' own, or normalised with --normalize).\n"
       "Examples:\n"
-      "  bvhlab query jeep1.ms3d jeep1.ms3d --pose 1.5,0,0,0,0,1,30\n"
-      "  bvhlab query injector_pipes.stl injector_pipes.stl --protocol 1.6,42,5000 --strategy time_critical "
-      "--bv-tests 200");
+      "  bvhlab query jeep1.ms3d jeep1.ms3d --pose 12,0,0,0,0,1,30\n"
+      "  bvhlab query injector_pipes.stl injector_pipes.stl --normalize --protocol 1.6,42,5000 "
+      "--strategy time_critical --bv-tests 200 --repeat 100\n"
+      "  bvhlab query pinion.off pinion.off --normalize --poses bench/scenes/example_poses.txt --json");
   return {query, [args] { return query_command(*args); }};
 }
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -152,6 +153,15 @@ std::string read_text(const std::filesystem::path& file, const std::string& what
   return buffer.str();
 }
 
+/// The rotation by `degrees` about `axis`; nullopt for an axis that is zero or not finite.
+std::optional<Mat3> axis_angle_rotation(const Vec3& axis, double degrees) {
+  // Scale by the largest component before normalising: the norm of [1e200, 1e200, 0] overflows and
+  // that of [1e-200, 1e-200, 0] underflows, and either would silently give a matrix that is no rotation.
+  const double largest = axis.cwiseAbs().maxCoeff();
+  if (!(largest > 0) || !std::isfinite(largest)) return std::nullopt;
+  return Eigen::AngleAxisd(degrees * M_PI / 180.0, (axis / largest).normalized()).toRotationMatrix();
+}
+
 RigidTransform parse_transform(const Node& node) {
   node.expect_object({"translation", "rotation", "axis_angle_deg", "group"});
   Vec3 translation = Vec3::Zero();
@@ -178,15 +188,10 @@ RigidTransform parse_transform(const Node& node) {
   if (node.has("axis_angle_deg")) {
     const Node aa = node.child("axis_angle_deg");
     const auto v = aa.numbers(4);
-    Vec3 axis(v[0], v[1], v[2]);
-    // Scale by the largest component before normalising: the norm of [1e200, 1e200, 0] overflows and
-    // that of [1e-200, 1e-200, 0] underflows, and either would silently give a matrix that is no rotation.
-    const double largest = axis.cwiseAbs().maxCoeff();
-    if (!(largest > 0) || !std::isfinite(largest)) aa.fail("the rotation axis must be finite and not zero");
-    axis = (axis / largest).normalized();
-    rotation = Eigen::AngleAxisd(v[3] * M_PI / 180.0, axis).toRotationMatrix();
+    const std::optional<Mat3> r = axis_angle_rotation(Vec3(v[0], v[1], v[2]), v[3]);
+    if (!r) aa.fail("the rotation axis must be finite and not zero");
     try {
-      return RigidTransform::checked(rotation, translation, 1e-9);
+      return RigidTransform::checked(*r, translation, 1e-9);
     } catch (const std::invalid_argument& e) {
       aa.fail(std::string("not a rotation: ") + e.what());
     }
@@ -246,9 +251,12 @@ std::vector<Budget> parse_budgets(const Node& budgets) {
     b.expect_object({"bv_tests", "deadline_us"});
     Budget budget;
     if (b.has("bv_tests"))
-      budget.max_bv_tests = static_cast<std::uint64_t>(b.child("bv_tests").integer(1, 1LL << 40));
+      budget.max_bv_tests =
+          static_cast<std::uint64_t>(b.child("bv_tests")
+                                         .integer(static_cast<long long>(limits::kBvTests.min),
+                                                  static_cast<long long>(limits::kBvTests.max)));
     if (b.has("deadline_us")) {
-      budget.deadline_us = b.child("deadline_us").number(0, 1e9);
+      budget.deadline_us = b.child("deadline_us").number(limits::kDeadlineUs.min, limits::kDeadlineUs.max);
       if (!(budget.deadline_us > 0))
         b.child("deadline_us").fail("expected a positive number of microseconds");
     }
@@ -487,6 +495,91 @@ std::vector<PoseGroup> load_pose_file(const std::filesystem::path& file) {
   return parse_poses(parse_json(read_text(file, "pose"), source), source);
 }
 
+RigidTransform pose_from_numbers(std::span<const double> v) {
+  if (v.size() != 3 && v.size() != 7 && v.size() != 12)
+    throw std::invalid_argument(
+        "expected 3 numbers (TX TY TZ), 7 (TX TY TZ AX AY AZ DEGREES) or 12 (the 3 x 4 "
+        "matrix [R | t] row by row); got " +
+        std::to_string(v.size()));
+  for (double x : v)
+    if (!std::isfinite(x)) throw std::invalid_argument("expected finite numbers; got " + number_text(x));
+  if (v.size() == 12) {
+    Mat3 rotation;
+    Vec3 translation;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) rotation(i, j) = v[std::size_t(4 * i + j)];
+      translation[i] = v[std::size_t(4 * i + 3)];
+    }
+    try {
+      return RigidTransform::checked(rotation, translation, 1e-6);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("not a rotation: ") + e.what());
+    }
+  }
+  RigidTransform pose;
+  pose.translation = Vec3(v[0], v[1], v[2]);
+  if (v.size() == 7) {
+    const std::optional<Mat3> r = axis_angle_rotation(Vec3(v[3], v[4], v[5]), v[6]);
+    if (!r) throw std::invalid_argument("the rotation axis must be finite and not zero");
+    pose.rotation = *r;
+  }
+  return pose;
+}
+
+namespace {
+
+/// The numbers of one pose-list line, separated by blanks or commas; throws std::invalid_argument.
+std::vector<double> line_numbers(std::string_view line) {
+  std::vector<double> out;
+  std::size_t at = 0;
+  const auto separator = [](char c) { return c == ' ' || c == '\t' || c == ',' || c == '\r'; };
+  while (at < line.size()) {
+    if (separator(line[at])) {
+      ++at;
+      continue;
+    }
+    std::size_t end = at;
+    while (end < line.size() && !separator(line[end])) ++end;
+    const std::string_view item = line.substr(at, end - at);
+    double value = 0;
+    const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
+    if (ec == std::errc::result_out_of_range)
+      throw std::invalid_argument("'" + std::string(item) + "' is beyond the range of a double");
+    if (ec != std::errc() || ptr != item.data() + item.size())
+      throw std::invalid_argument("'" + std::string(item) + "' is not a number");
+    out.push_back(value);
+    at = end;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<ListedPose> parse_pose_list(std::string_view text, const std::string& source) {
+  std::vector<ListedPose> out;
+  std::size_t line_number = 0;
+  for (std::size_t at = 0; at <= text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string_view line = text.substr(at, end - at);
+    ++line_number;
+    at = end + 1;
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string_view::npos || line[first] == '#') continue;
+    try {
+      out.push_back({pose_from_numbers(line_numbers(line)), line_number});
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(source + ":" + std::to_string(line_number) + ": " + e.what());
+    }
+  }
+  if (out.empty())
+    throw SceneError(source + ": no pose (one per line: TX TY TZ [AX AY AZ DEGREES], or 12 numbers)");
+  return out;
+}
+
+std::vector<ListedPose> load_pose_list(const std::filesystem::path& file) {
+  return parse_pose_list(read_text(file, "pose"), file.string());
+}
+
 namespace {
 
 void parse_objects(const Node& root, const std::filesystem::path& base_dir, Scene& scene) {
@@ -663,10 +756,12 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
     if (protocol) {
       w.expect_object({"type", "distances", "steps"});
       if (w.has("distances")) {
-        workload.distances = w.child("distances").numbers(0, 0, 1e6);
+        workload.distances = w.child("distances").numbers(0, limits::kDistance.min, limits::kDistance.max);
         if (workload.distances.empty()) w.child("distances").fail("expected at least one distance");
       }
-      if (w.has("steps")) workload.steps = static_cast<int>(w.child("steps").integer(1, 10'000'000));
+      if (w.has("steps"))
+        workload.steps = static_cast<int>(w.child("steps").integer(
+            static_cast<long long>(limits::kSteps.min), static_cast<long long>(limits::kSteps.max)));
     } else {
       parse_pose_file(w, base_dir, workload);
     }

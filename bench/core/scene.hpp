@@ -4,7 +4,7 @@
 // Format (JSON; every field except "objects", "hierarchies" and "strategies" is optional):
 //   {
 //     "name": "demo",
-//     "objects": [ {"mesh": "jeep1.ms3d", "name": "jeep", "optional": false, "normalize": true,
+//     "objects": [ {"mesh": "jeep1.ms3d", "name": "jeep", "optional": false, "normalize": false,
 //                   "scale": 1.0, "placement": {"translation": [0,0,0], "axis_angle_deg": [0,0,1, 0]}} ],
 //     "pairs": [["jeep", "jeep"]],                  // default: every object against a copy of itself
 //     "hierarchies": [ {"bv": "aabb", "name": "aabb", "split": "sah", "max_leaf_triangles": 1},
@@ -26,6 +26,11 @@
 // ones listed in their "hierarchies" field. A pose file holds {"poses": [{"translation": [x,y,z],
 // "rotation": [[...],[...],[...]] or "axis_angle_deg": [ax,ay,az,deg], "group": d}, ...]}; "group" (default:
 // the length of the translation) is the value the report files the pose under in its "distance" column.
+// Objects keep their mesh file's units unless "normalize" is true (the protocol normalisation, which the
+// protocol's distances assume).
+//
+// A pose list (`bvhlab query --poses FILE`) is plain text: one pose per line as pose_from_numbers takes it,
+// numbers separated by blanks or commas; blank lines and lines starting with '#' are skipped.
 #pragma once
 
 #include "adb/parameters.hpp"
@@ -36,6 +41,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -55,7 +61,7 @@ struct SceneObject {
   std::string mesh;            ///< as written in the scene
   std::filesystem::path path;  ///< resolved file; empty when not found (then `optional` must be true)
   bool optional = false;       ///< a missing mesh skips the object (with a message) instead of failing
-  bool normalize = true;       ///< the protocol normalisation: centre to origin, longest side 2
+  bool normalize = false;      ///< the protocol normalisation: centre to origin, longest side 2
   double scale = 1;            ///< uniform scale applied after normalisation
   RigidTransform placement;    ///< applied to the vertices after scaling
 };
@@ -152,6 +158,41 @@ struct Scene {
   /// Whether any strategy on `h` needs a density: only then are `h`'s trees annotated.
   [[nodiscard]] bool needs_density(const HierarchySpec& h) const;
 };
+
+/// Ranges of the workload's and the budgets' values, checked against these by the scene parser and the CLI
+/// alike (the policies' own parameters have theirs in the policy tables).
+namespace limits {
+inline constexpr ParamSpec kDistance{
+    .name = "distance", .description = "protocol distance", .min = 0, .max = 1e6};
+inline constexpr ParamSpec kSteps{
+    .name = "steps", .description = "protocol poses per distance", .min = 1, .max = 1e7, .integer = true};
+inline constexpr ParamSpec kBvTests{.name = "bv_tests",
+                                    .description = "budget of BV-pair tests",
+                                    .min = 1,
+                                    .max = 1099511627776.0,  // 2^40
+                                    .integer = true};
+inline constexpr ParamSpec kDeadlineUs{.name = "deadline_us",
+                                       .description = "deadline in microseconds",
+                                       .min = 0,
+                                       .max = 1e9,
+                                       .exclusive_min = true};
+}  // namespace limits
+
+/// A pose from numbers: TX TY TZ (a translation), TX TY TZ AX AY AZ DEGREES (and a rotation by DEGREES
+/// about the axis), or the 3 x 4 matrix [R | t] row by row (12 numbers; R orthonormal within 1e-6, det +1).
+/// Throws std::invalid_argument naming the problem.
+RigidTransform pose_from_numbers(std::span<const double> numbers);
+
+/// One pose of a pose list, and the line it was read from (1-based).
+struct ListedPose {
+  RigidTransform pose;
+  std::size_t line = 0;
+};
+/// Parses a pose list (format above). Throws SceneError "SOURCE:LINE: problem" for a malformed line, and for
+/// a list without poses.
+std::vector<ListedPose> parse_pose_list(std::string_view text, const std::string& source);
+/// Reads a pose list file. Throws SceneError naming the file (and the line).
+std::vector<ListedPose> load_pose_list(const std::filesystem::path& file);
 
 /// Names a scene may use for "bv": the registered volumes, then fcl_obb and fcl_obbrss.
 std::vector<std::string> hierarchy_bv_names();

@@ -1,12 +1,14 @@
-// On-disk cache of preprocessed trees, keyed by the mesh's checksum and every option that shapes the tree.
+// On-disk cache of preprocessed trees, keyed by the mesh's checksum, what was applied to its coordinates
+// (normalisation, scale, placement: bench/prepare.cpp, load_object) and every option that shapes the tree.
 //
 // Each entry is two files: `<bv>-<key hash>.tree`, a tree in the saved-tree format (adb/saved_tree.hpp,
-// without polygons, so `bvhlab query` can read it too), and `<same>.meta.json`, which records the full key,
-// the payload's size and checksum, and how long the tree took to build and annotate. An entry is trusted only
-// if the meta file names the same key, the payload has the recorded size and checksum, the saved-tree reader
-// accepts it, and the decoded tree passes structural checks against the mesh (triangle ids a permutation,
-// node ranges consistent, every leaf volume containing its triangles, annotation sized and in range).
-// Anything else is a stale or corrupt entry: it is reported, rebuilt by the caller and overwritten.
+// without polygons, so `bvhlab query` can read it too; it records the normalisation), and `<same>.meta.json`,
+// which records the full key, the payload's size and checksum, and how long the tree took to build and
+// annotate. An entry is trusted only if the meta file names the same key, the payload has the recorded size
+// and checksum, the saved-tree reader accepts it, and the decoded tree passes structural checks against the
+// mesh (triangle ids a permutation, node ranges consistent, every leaf volume containing its triangles,
+// annotation sized and in range). Anything else is a stale or corrupt entry: it is reported, rebuilt by the
+// caller and overwritten.
 #pragma once
 
 #include "adb/saved_tree.hpp"
@@ -128,13 +130,15 @@ class TreeCache {
     }
   }
 
-  /// Saves `tree` (without polygons) under `key`. A failure to write is logged, never fatal.
+  /// Saves `tree` (without polygons) under `key`, recording its `units`. A failure to write is logged, never
+  /// fatal.
   template <class BV, Density D>
-  void store(const std::string& key, const Tree<BV, D>& tree, const CachedTreeTimes& times) {
+  void store(const std::string& key, const Tree<BV, D>& tree, const CachedTreeTimes& times,
+             const TreeUnits& units = {}) {
     if (!enabled()) return;
     const auto file = tree_file(key, BV::name());
     try {
-      const std::vector<std::byte> payload = save_tree_to_buffer(tree);
+      const std::vector<std::byte> payload = save_tree_to_buffer(tree, {.units = units});
       write_entry(key, file, payload, times);
       ++counts_.stored;
     } catch (const std::exception& e) {

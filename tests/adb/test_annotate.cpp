@@ -195,6 +195,7 @@ TEST(PossibleCollisionCells, SquareOnTheSharedFaceCountsInBothLayers) {
   // A sliver along the cell edge x = y = 0.5 (zero area) counts nowhere.
   const std::vector<TrianglePoints> sliver{{Vec3(0.5, 0.5, 0.1), Vec3(0.5, 0.5, 0.9), Vec3(0.5, 0.5, 0.5)}};
   EXPECT_EQ(pc_of(sliver, box, 2, 0.01), 0);
+  EXPECT_EQ(pc_of(sliver, box, 2, 0.0), 0);  // not even at tau = 0: zero area never counts
 }
 
 TEST(PossibleCollisionCells, FlatNodeBoxCountsEveryLayer) {
@@ -202,6 +203,7 @@ TEST(PossibleCollisionCells, FlatNodeBoxCountsEveryLayer) {
   // corner cell, 1/8 for its two neighbours, 0 for the opposite one; each counts in both (identical) layers.
   const std::vector<TrianglePoints> t{{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}};
   const Box box = box_of(Vec3(0, 0, 0), Vec3(1, 1, 0));
+  EXPECT_EQ(pc_of(t, box, 2, 0.0), 6);  // tau = 0: every cell with some area; the empty one still not
   EXPECT_EQ(pc_of(t, box, 2, 0.5), 6);
   EXPECT_EQ(pc_of(t, box, 2, 1.5), 6);  // 1/8 == 1.5 / 12: a tie, counted
   EXPECT_EQ(pc_of(t, box, 2, 1.6), 2);
@@ -239,7 +241,7 @@ TEST(Annotate, CountsAreAtMostGCubedAndMonotoneInTau) {
   std::vector<std::uint8_t> previous;
   // The density takes tau where the LB table has values; the counting alone (annotate_counts) takes any.
   EXPECT_THROW(annotate_adb(bvh, 3, 1.5), std::invalid_argument);
-  for (const double tau : {1.0, 0.75, 0.5, 0.25, 0.1}) {
+  for (const double tau : {1.0, 0.75, 0.5, 0.25, 0.1, 0.0}) {  // 0: the LB table's first row
     AnnotateOptions options;
     options.tau = tau;
     const auto tree3 = annotate_adb(bvh, 3, options);
@@ -360,7 +362,7 @@ TEST(Annotate, RejectsBadInputWithAClearMessage) {
   AnnotateOptions options;
   expect_error([&] { annotate_counts(boxes, ranges, t, 0, options); }, "grid");
   expect_error([&] { annotate_counts(boxes, ranges, t, 7, options); }, "grid");
-  for (const double tau : {0.0, -1.0, std::nan("")}) {
+  for (const double tau : {-1e-300, -1.0, std::nan("")}) {
     AnnotateOptions bad;
     bad.tau = tau;
     expect_error([&] { annotate_counts(boxes, ranges, t, 2, bad); }, "tau");

@@ -73,8 +73,10 @@ void put_u64(Bytes& b, std::size_t at, std::uint64_t v) {
 }
 /// Re-seals a crafted file so that only the structure checks can catch it.
 void reseal(Bytes& b) {
-  const std::uint64_t head = saved_tree_detail::fnv1a64(std::span<const std::byte>(b).first(120));
-  put_u64(b, 120, saved_tree_detail::fnv1a64(std::span<const std::byte>(b).subspan(128), head));
+  const std::uint64_t head =
+      saved_tree_detail::fnv1a64(std::span<const std::byte>(b).first(kSavedTreeChecksumOffset));
+  put_u64(b, kSavedTreeChecksumOffset,
+          saved_tree_detail::fnv1a64(std::span<const std::byte>(b).subspan(kSavedTreeHeaderSize), head));
 }
 std::size_t nodes_offset() {
   return kSavedTreeHeaderSize;
@@ -106,6 +108,49 @@ TEST(SavedTree, TriangleIdsCanBeLeftOut) {
   EXPECT_TRUE(loaded.bvh.triangle_ids().empty());
   EXPECT_TRUE(same_nodes(loaded.bvh.nodes(), tree.bvh.nodes()));
   EXPECT_EQ(loaded.density.possible_collision_cells, tree.density.possible_collision_cells);
+}
+
+// Version 3 records the tree's units: the mesh file's own, or the protocol normalisation with its scale and
+// centre, read back exactly.
+TEST(SavedTree, UnitsRoundTrip) {
+  const auto& tree = annotated_torus();
+  const Bytes raw = save_tree_to_buffer(tree);
+  EXPECT_EQ(saved_tree_units(raw), TreeUnits{});
+  const TreeUnits normalized{.normalized = true, .scale = 0.0123, .centre = Vec3(1.5, -2, 1e-300)};
+  const Bytes bytes = save_tree_to_buffer(tree, {.units = normalized});
+  EXPECT_EQ(saved_tree_units(bytes, "n.tree"), normalized);
+  EXPECT_EQ(saved_tree_detail::read_header(bytes, "n.tree").units, normalized);
+  EXPECT_EQ(save_tree_to_buffer(load_adb(bytes), {.units = normalized}), bytes);
+  EXPECT_NE(bytes, raw);  // the units are part of the file, not only of the caller's memory
+  EXPECT_EQ(normalized.describe(), "normalised: scale 0.0123, centre (1.5, -2, 1e-300)");
+  EXPECT_EQ(TreeUnits{}.describe(), "the mesh file's units");
+}
+
+TEST(SavedTree, UnitsThatCannotBeRecordedAreRefused) {
+  const auto& tree = annotated_torus();
+  for (const TreeUnits& units :
+       {TreeUnits{.normalized = false, .scale = 2}, TreeUnits{.normalized = false, .centre = Vec3(0, 1, 0)},
+        TreeUnits{.normalized = false, .centre = Vec3(-0.0, 0, 0)}, TreeUnits{.normalized = true, .scale = 0},
+        TreeUnits{.normalized = true, .scale = -1},
+        TreeUnits{.normalized = true, .scale = std::numeric_limits<double>::infinity()},
+        TreeUnits{.normalized = true, .centre = Vec3(std::nan(""), 0, 0)}})
+    expect_rejected([&] { (void)save_tree_to_buffer(tree, {.units = units}, "u.tree"); }, "u.tree");
+  // And in a file, behind a valid checksum: a raw tree with a scale, a normalised one with a zero scale.
+  const Bytes bytes = save_tree_to_buffer(tree);
+  Bytes bad = bytes;
+  put_u64(bad, 120, std::bit_cast<std::uint64_t>(2.0));
+  reseal(bad);
+  expect_rejected([&] { load_adb(bad); },
+                  "corrupted header (units not normalised but with a scale or centre)");
+  bad = bytes;
+  put_u32(bad, 20, 1 | 2);  // flags: triangle ids, normalised
+  put_u64(bad, 120, std::bit_cast<std::uint64_t>(0.0));
+  reseal(bad);
+  expect_rejected([&] { load_adb(bad); }, "scale that is not finite and positive");
+  bad = bytes;
+  put_u32(bad, 20, 1 | 4);  // an unknown flag
+  reseal(bad);
+  expect_rejected([&] { load_adb(bad); }, "unknown flags 5");
 }
 
 TEST(SavedTree, PlainAndHierarchicalTreesRoundTrip) {
@@ -208,8 +253,10 @@ TEST(SavedTree, RejectsForeignFilesAndTypes) {
   bad[0] = std::byte{'X'};
   expect_rejected([&] { load_adb(bad); }, "magic");
   bad = bytes;
-  put_u32(bad, 8, 1);
-  expect_rejected([&] { load_adb(bad); }, "format version 1, this build reads version 2");
+  put_u32(bad, 8, 2);
+  expect_rejected([&] { load_adb(bad); },
+                  "format version 2, this build reads version 3 (older versions do not "
+                  "record the tree's units");
   // Another BV type, another volume size, another density, another density version.
   expect_rejected([&] { load_tree_from_buffer<Obb, AdbDensity>(bytes); }, "'aabb' volumes, expected 'obb'");
   bad = bytes;
@@ -305,11 +352,11 @@ TEST(SavedTree, RejectsBadStructureEvenWithAValidChecksum) {
   reseal(bad);
   expect_rejected([&] { load_adb(bad); },
                   "bad 'adb' density data: adb: grid must be an integer in [2, 4], got 9");
-  for (const double tau : {1.5, 0.0, -0.0, std::numeric_limits<double>::quiet_NaN()}) {
+  for (const double tau : {1.5, -0.0, -0.01, std::numeric_limits<double>::quiet_NaN()}) {
     bad = bytes;
     put_u64(bad, density_at + 4, std::bit_cast<std::uint64_t>(tau));
     reseal(bad);
-    expect_rejected([&] { load_adb(bad); }, "adb: tau must be a number in (0, 1]");
+    expect_rejected([&] { load_adb(bad); }, "adb: tau must be a number in [0, 1]");
   }
   // Triangle ids that are not a permutation.
   bad = bytes;

@@ -91,7 +91,8 @@ inline std::vector<std::vector<std::string>> read_csv(const std::filesystem::pat
   return rows;
 }
 
-/// The scene object a scene entry {"mesh": file} gives (normalised, as scenes default to), named by its stem.
+/// The scene object a scene entry {"mesh": file} gives (in its file's units, as scenes default to), named by
+/// its stem.
 inline SceneObject object_from(const std::filesystem::path& file) {
   SceneObject object;
   object.mesh = file.filename().string();

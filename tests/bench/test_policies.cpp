@@ -96,10 +96,12 @@ TEST_F(TestPolicies, SavedTreesKeepTheDensityByName) {
   EXPECT_EQ(info.density, "tricount");
   EXPECT_EQ(info.annotation, "tricount cap=5");
   StrategyVariant root{"root_overlap", {}, {}};
-  EXPECT_TRUE(run_query_on_trees(dir / "torus.tree", dir / "torus.tree", root, {}).result.collides);
+  EXPECT_TRUE(run_query_on_trees(dir / "torus.tree", dir / "torus.tree", root, RigidTransform{})
+                  .answers[0]
+                  .result.collides);
   StrategyVariant adb{"adb", {{"p_min", 0.5}}, {}};
-  const QueryOutcome q = run_query_on_trees(dir / "torus.tree", dir / "torus.tree", adb, {});
-  EXPECT_GT(q.result.counters.probability_evaluations, 0u);
+  const QueryOutcome q = run_query_on_trees(dir / "torus.tree", dir / "torus.tree", adb, RigidTransform{});
+  EXPECT_GT(q.answers[0].result.counters.probability_evaluations, 0u);
   EXPECT_EQ(q.model_a.annotation, "tricount cap=5");
 }
 

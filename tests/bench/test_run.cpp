@@ -393,24 +393,120 @@ TEST_F(RunTest, SavedTreesAnswerLikeTheMeshesTheyWereBuiltFrom) {
     const QueryOutcome from_trees =
         run_query_on_trees(dir / "torus.tree", dir / "torus.tree", request.strategy, pose);
     const QueryOutcome from_meshes = run_query(torus, torus, request, pose, options);
-    EXPECT_EQ(from_trees.result.collides, from_meshes.result.collides) << step;
-    EXPECT_EQ(from_trees.result.probability, from_meshes.result.probability) << step;
-    EXPECT_EQ(from_trees.result.counters.bv_tests, from_meshes.result.counters.bv_tests) << step;
+    ASSERT_EQ(from_trees.answers.size(), 1u);
+    ASSERT_EQ(from_meshes.answers.size(), 1u);
+    const Result& t = from_trees.answers[0].result;
+    const Result& m = from_meshes.answers[0].result;
+    EXPECT_EQ(t.collides, m.collides) << step;
+    EXPECT_EQ(t.probability, m.probability) << step;
+    EXPECT_EQ(t.counters.bv_tests, m.counters.bv_tests) << step;
   }
   StrategyVariant exact;
-  EXPECT_THROW(run_query_on_trees(dir / "torus.tree", dir / "torus.tree", exact, {}), std::invalid_argument);
+  EXPECT_THROW(run_query_on_trees(dir / "torus.tree", dir / "torus.tree", exact, RigidTransform{}),
+               std::invalid_argument);
   // Trees of another volume or density cannot be paired; the error describes both.
   build_tree_file(torus, testing::hierarchy_of("obb"), annotation, dir / "torus_obb.tree", 2);
   build_tree_file(torus, aabb, DensitySpec{"adb", {{"grid", 3}, {"tau", 0.5}}}, dir / "torus_g3.tree", 2);
   for (const char* other : {"torus_obb.tree", "torus_g3.tree"}) {
     try {
-      run_query_on_trees(dir / "torus.tree", dir / other, request.strategy, {});
+      run_query_on_trees(dir / "torus.tree", dir / other, request.strategy, RigidTransform{});
       ADD_FAILURE() << other << " was paired with an AABB grid-2 tree";
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find("adb grid=2 tau=0.5"), std::string::npos) << e.what();
     }
   }
   EXPECT_THROW(peek_saved_tree(dir / "torus.obj"), std::runtime_error);
+}
+
+// Meshes keep their files' units unless normalised; a saved tree records which (and the normalisation), and
+// a query refuses to mix a normalised tree with a raw one, naming both files.
+TEST_F(RunTest, SavedTreesRecordTheirUnits) {
+  testing::write_obj(testing::make_torus(3.0, 1.0, 24, 12), dir / "big.obj");  // 8 x 8 x 2, centred at 0
+  SceneObject big = testing::object_from(dir / "big.obj");
+  const HierarchySpec aabb = testing::hierarchy_of("aabb");
+  const DensitySpec annotation{"adb", {{"grid", 2}, {"tau", 0.25}}};
+  build_tree_file(big, aabb, annotation, dir / "raw.tree", 1);
+  big.normalize = true;
+  const BuildOutcome normalised = build_tree_file(big, aabb, annotation, dir / "normalised.tree", 1);
+  EXPECT_TRUE(normalised.model.units.normalized);
+  const SavedTreeInfo raw_info = peek_saved_tree(dir / "raw.tree");
+  const SavedTreeInfo info = peek_saved_tree(dir / "normalised.tree");
+  EXPECT_EQ(raw_info.units, TreeUnits{});
+  ASSERT_TRUE(info.units.normalized);
+  EXPECT_NEAR(info.units.scale, 2.0 / 8.0, 1e-12);
+  EXPECT_LT(info.units.centre.norm(), 1e-12);
+  EXPECT_EQ(info.units, normalised.model.units);
+
+  // At x = 5 the raw torus (radius 4) overlaps its copy; normalised (radius 1) it is far from it.
+  StrategyVariant adb{"adb", {{"p_min", 0.9}}, {}};
+  const RigidTransform pose = RigidTransform::checked(Mat3::Identity(), Vec3(5, 0, 0));
+  EXPECT_TRUE(run_query_on_trees(dir / "raw.tree", dir / "raw.tree", adb, pose).answers[0].result.collides);
+  const QueryOutcome n = run_query_on_trees(dir / "normalised.tree", dir / "normalised.tree", adb, pose);
+  EXPECT_FALSE(n.answers[0].result.collides);
+  EXPECT_EQ(n.model_a.units, info.units);
+  for (const auto& [a, b] :
+       {std::pair("normalised.tree", "raw.tree"), std::pair("raw.tree", "normalised.tree")}) {
+    try {
+      run_query_on_trees(dir / a, dir / b, adb, pose);
+      ADD_FAILURE() << a << " and " << b << " were queried together";
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find((dir / "normalised.tree").string() + " is normalised: scale 0.25"),
+                std::string::npos)
+          << what;
+      EXPECT_NE(what.find((dir / "raw.tree").string() + " is in its mesh file's units"), std::string::npos)
+          << what;
+    }
+  }
+}
+
+// The tree cache keys trees by the normalisation too: a normalised tree is never served for a raw object.
+TEST_F(RunTest, TheTreeCacheKeepsNormalisedAndRawTreesApart) {
+  const auto with_normalize = [&](bool normalize) {
+    return parse_scene(std::string(R"({"objects": [{"mesh": "torus.obj", "normalize": )") +
+                           (normalize ? "true" : "false") +
+                           R"(}], "hierarchies": [{"bv": "aabb"}], "strategies": [{"type": "exact"}],
+                            "workload": {"distances": [1.0], "steps": 8}, "report": {"cgal_sample": 0}})",
+                       dir.path(), "t.json");
+  };
+  const RunOutput raw = run_scene(with_normalize(false), options);
+  EXPECT_EQ(raw.stats.trees_built, 1u);
+  const RunOutput normalised = run_scene(with_normalize(true), options);
+  EXPECT_EQ(normalised.stats.tree_cache_hits, 0u);
+  EXPECT_EQ(normalised.stats.trees_built, 1u);
+  EXPECT_TRUE(normalised.models.at(0).units.normalized);
+  EXPECT_FALSE(raw.models.at(0).units.normalized);
+  EXPECT_TRUE(std::any_of(messages.begin(), messages.end(),
+                          [](const std::string& m) { return m.rfind("torus: normalised: scale", 0) == 0; }));
+  const RunOutput again = run_scene(with_normalize(true), options);
+  EXPECT_EQ(again.stats.tree_cache_hits, 1u);
+  EXPECT_EQ(again.stats.trees_built, 0u);
+  EXPECT_TRUE(again.models.at(0).units.normalized);
+}
+
+// Several poses in one call, and warm repetitions: every answer is the one a single query gives.
+TEST_F(RunTest, QueriesAnswerEachPoseAndTimeWarmRepetitions) {
+  const SceneObject torus = testing::object_from(dir / "torus.obj");
+  QueryRequest request;
+  request.hierarchy = testing::hierarchy_of("aabb");
+  request.strategy.strategy = "exact";
+  request.repeat = 5;
+  options.cache_dir.clear();
+  std::vector<RigidTransform> poses;
+  for (int step = 0; step < 40; step += 5) poses.push_back(protocol_pose(0.9, step, 40));
+  const QueryOutcome batch = run_query(torus, torus, request, poses, options);
+  ASSERT_EQ(batch.answers.size(), poses.size());
+  request.repeat = 0;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const QueryOutcome single = run_query(torus, torus, request, poses[k], options);
+    EXPECT_EQ(batch.answers[k].result.collides, single.answers[0].result.collides) << k;
+    EXPECT_EQ(batch.answers[k].result.counters.bv_tests, single.answers[0].result.counters.bv_tests) << k;
+    EXPECT_EQ(batch.answers[k].warm_micros.size(), 5u);
+    for (double t : batch.answers[k].warm_micros) EXPECT_GE(t, 0.0);
+    EXPECT_TRUE(single.answers[0].warm_micros.empty());
+  }
+  EXPECT_THROW(run_query(torus, torus, request, std::span<const RigidTransform>(), options),
+               std::invalid_argument);
 }
 
 TEST_F(RunTest, PlotScriptDrawsAllFiveFigures) {

@@ -167,8 +167,8 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
        "/annotation/grid: grid must be an integer in [2, 4], got 7"},
       // Parameters come from the policies' tables: ranges, fields a policy does not take, combinations.
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "adb", "p_min": 0.9}])",
-                  R"("annotation": {"type": "adb", "tau": 0})"),
-       "/annotation/tau: tau must be a number in (0, 1], got 0"},
+                  R"("annotation": {"type": "adb", "tau": 1.5})"),
+       "/annotation/tau: tau must be a number in [0, 1], got 1.5"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
                   R"("annotation": {"type": "none", "grid": 2})"),
        "/annotation/grid: unknown field; expected one of type"},
@@ -244,6 +244,80 @@ TEST_F(SceneTest, PoseFileGroupsByDistance) {
   EXPECT_TRUE(
       groups[0].poses[0].rotation.isApprox(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix()));
   EXPECT_NE(scene.workload.identity.find("poses:"), std::string::npos);
+}
+
+// Objects are in their mesh files' units unless the scene asks for the protocol normalisation; the tau of
+// the LB table's first row (0: every cell with some area) is a value like any other.
+TEST_F(SceneTest, ObjectsKeepTheirFilesUnitsUnlessNormalised) {
+  const Scene raw = parse(scene_with());
+  EXPECT_FALSE(raw.objects[0].normalize);
+  const Scene normalised = parse(scene_with(R"([{"mesh": "torus.obj", "normalize": true}])"));
+  EXPECT_TRUE(normalised.objects[0].normalize);
+  const Scene tau0 = parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                                      R"([{"type": "adb"}])", R"("annotation": {"type": "adb", "tau": 0})"));
+  EXPECT_EQ(tau0.density.label(), "adb grid=2 tau=0");
+}
+
+// The protocol's distances assume normalised objects: every shipped scene that runs the protocol asks for
+// the normalisation on each object, explicitly (its results must not change with the default).
+TEST_F(SceneTest, ShippedProtocolScenesNormaliseEveryObject) {
+  const char* source = std::getenv("BVHLAB_SOURCE_DIR");
+  ASSERT_NE(source, nullptr) << "run through ctest, which sets BVHLAB_SOURCE_DIR";
+  int protocol_scenes = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::filesystem::path(source) / "bench" / "scenes")) {
+    if (entry.path().extension() != ".json" || entry.path().filename() == "example_poses.json") continue;
+    const Scene scene = load_scene(entry.path());
+    if (scene.workload.kind != WorkloadSpec::Kind::Protocol) continue;
+    ++protocol_scenes;
+    for (const SceneObject& o : scene.objects) EXPECT_TRUE(o.normalize) << entry.path() << ": " << o.name;
+  }
+  EXPECT_GE(protocol_scenes, 4);
+}
+
+TEST_F(SceneTest, PoseListsTakeThreeSevenOrTwelveNumbersPerLine) {
+  const auto poses = parse_pose_list(
+      "# x y z [axis degrees] or [R | t]\n"
+      "1 2 3\n"
+      "\n"
+      "  0.5,0,0, 0,0,1, 90\r\n"
+      "0 -1 0 4  1 0 0 5  0 0 1 6\n",
+      "p.txt");
+  ASSERT_EQ(poses.size(), 3u);
+  EXPECT_EQ(poses[0].line, 2u);
+  EXPECT_EQ(poses[0].pose.translation, Vec3(1, 2, 3));
+  EXPECT_EQ(poses[0].pose.rotation, Mat3::Identity());
+  EXPECT_EQ(poses[1].line, 4u);
+  EXPECT_TRUE(poses[1].pose.apply(Vec3(1, 0, 0)).isApprox(Vec3(0.5, 1, 0), 1e-15));
+  EXPECT_EQ(poses[2].line, 5u);
+  EXPECT_EQ(poses[2].pose.translation, Vec3(4, 5, 6));
+  EXPECT_EQ(poses[2].pose.apply(Vec3(1, 0, 0)), Vec3(4, 6, 6));  // R's first column is (0, 1, 0)
+  // The same numbers as --pose gives them (pose_from_numbers is the one reader of both).
+  const std::vector<double> seven{0.5, 0, 0, 0, 0, 1, 90};
+  EXPECT_EQ(pose_from_numbers(seven).rotation, poses[1].pose.rotation);
+}
+
+TEST_F(SceneTest, MalformedPoseListLinesAreNamedByFileAndLine) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"1 2 3\n1 2\n", "p.txt:2: expected 3 numbers (TX TY TZ), 7 (TX TY TZ AX AY AZ DEGREES) or 12"},
+      {"1 2 x\n", "p.txt:1: 'x' is not a number"},
+      {"1 2 3\n\n# c\n1 2 nan\n", "p.txt:4: expected finite numbers; got nan"},
+      {"1 2 1e999\n", "p.txt:1: '1e999' is beyond the range of a double"},
+      {"1 2 3 junk4\n", "p.txt:1: 'junk4' is not a number"},
+      {"0 0 0 0 0 0 90\n", "p.txt:1: the rotation axis must be finite and not zero"},
+      {"2 0 0 0 0 1 0 0 0 0 1 0\n", "p.txt:1: not a rotation"},
+      {"-1 0 0 0 0 1 0 0 0 0 1 0\n", "p.txt:1: not a rotation"},
+      {"# nothing\n\n", "p.txt: no pose"},
+  };
+  for (const auto& [text, expected] : cases) {
+    try {
+      parse_pose_list(text, "p.txt");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const SceneError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(expected, 0), 0u) << e.what() << "\nexpected: " << expected;
+    }
+  }
+  EXPECT_THROW(load_pose_list(dir / "absent.txt"), SceneError);
 }
 
 TEST_F(SceneTest, OptionalPartsAreSkippedWithANote) {

@@ -7,8 +7,8 @@
 // A SavedTreeError naming the source is the expected way to refuse. Anything else -- another exception, a
 // crash, a sanitizer report -- is a finding, and so is an accepted tree that does not save back to the same
 // bytes, or whose ADB query misbehaves (a probability outside [0, 1], a budget overrun).
-// The committed seeds are saved-tree format 2; the regress_* reproducers of format 1 are now refused at
-// the version field, and stay as reminders of what they once found.
+// The committed seeds are saved-tree format 3 (one of them normalised); the regress_* reproducers of format 1
+// are now refused at the version field, and stay as reminders of what they once found.
 //
 // Seeds: run with BVHLAB_FUZZ_WRITE_SEEDS=<dir> to write one saved tree per layout there (and exit).
 #include "adb/adb_density.hpp"
@@ -34,7 +34,7 @@ namespace {
 
 using namespace bvhlab;
 
-constexpr std::size_t kChecksumOffset = 120;
+constexpr std::size_t kChecksumOffset = kSavedTreeChecksumOffset;
 
 void fix_checksum(std::vector<std::byte>& file) {
   const std::span<const std::byte> all(file);
@@ -60,9 +60,10 @@ void load_and_check(std::span<const std::byte> file) {
     return;
   }
   // Accepted: the tree must save back to the bytes it came from (name fields included: the reader refuses
-  // anything but NULs after a name).
-  const std::vector<std::byte> again =
-      save_tree_to_buffer(tree, {.triangle_ids = !tree.bvh.triangle_ids().empty()}, "fuzz.tree");
+  // anything but NULs after a name; units included: raw ones have a single encoding).
+  const std::vector<std::byte> again = save_tree_to_buffer(
+      tree, {.triangle_ids = !tree.bvh.triangle_ids().empty(), .units = saved_tree_units(file, "fuzz.tree")},
+      "fuzz.tree");
   if (!std::equal(again.begin(), again.end(), file.begin(), file.end()))
     finding("an accepted tree does not save back to the same bytes");
   if constexpr (ProbabilityDensity<Density>) {
@@ -94,14 +95,15 @@ Mesh seed_mesh() {  // a small torus: enough nodes for every check to matter, fe
 
 /// grid 0: no density; else a stand-in ADB annotation (the reader checks only pc <= g^3).
 template <class BV>
-std::vector<std::byte> seed_tree(const Mesh& mesh, bool ids, int grid) {
+std::vector<std::byte> seed_tree(const Mesh& mesh, bool ids, int grid, const TreeUnits& units = {}) {
   Bvh<BV> bvh = Bvh<BV>::build(mesh, {.max_leaf_triangles = 2, .threads = 1});
-  if (grid == 0) return save_tree_to_buffer(Tree<BV>{std::move(bvh), {}}, {.triangle_ids = ids});
+  if (grid == 0)
+    return save_tree_to_buffer(Tree<BV>{std::move(bvh), {}}, {.triangle_ids = ids, .units = units});
   std::vector<std::uint8_t> counts;
   for (std::size_t i = 0; i < bvh.nodes().size(); ++i)
     counts.push_back(static_cast<std::uint8_t>(i % (grid * grid * grid + 1)));
   const Tree<BV, AdbDensity> tree{std::move(bvh), AdbDensity::make_storage({grid, 0.5}, std::move(counts))};
-  return save_tree_to_buffer(tree, {.triangle_ids = ids});
+  return save_tree_to_buffer(tree, {.triangle_ids = ids, .units = units});
 }
 
 void write_seeds(const std::filesystem::path& dir) {
@@ -109,7 +111,8 @@ void write_seeds(const std::filesystem::path& dir) {
   const Mesh mesh = seed_mesh();
   const std::vector<std::pair<std::string, std::vector<std::byte>>> seeds = {
       {"aabb_plain", seed_tree<Aabb>(mesh, true, 0)},
-      {"aabb_adb2", seed_tree<Aabb>(mesh, true, 2)},
+      {"aabb_adb2_normalized",
+       seed_tree<Aabb>(mesh, true, 2, {.normalized = true, .scale = 1.25, .centre = Vec3(0.5, -2, 3)})},
       {"rbox_plain", seed_tree<RestrictedBox>(mesh, true, 0)},
       {"rbox_adb2_no_ids", seed_tree<RestrictedBox>(mesh, false, 2)},
       {"obb_adb3", seed_tree<Obb>(mesh, true, 3)},

@@ -1,5 +1,6 @@
-// libFuzzer target: the scene-file parser and the pose-file reader (bench/core/scene.hpp). Input: JSON text,
-// parsed once as a scene and once, written to a temporary file, as a pose file.
+// libFuzzer target: the scene-file parser, the pose-file reader and the pose-list parser
+// (bench/core/scene.hpp). Input: text, parsed once as a scene, once, written to a temporary file, as a pose
+// file, and once as a pose list (`bvhlab query --poses`).
 //
 // A SceneError naming the source is the expected way to refuse. Anything else -- another exception, a crash,
 // a sanitizer report, or an accepted scene that breaks the parser's promises (every transform rigid and
@@ -96,6 +97,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       for (const auto& pose : group.poses) check_rigid(pose, "pose file");
   } catch (const bvhlab::SceneError& e) {
     expect_named_refusal(e, pose_file.string());
+  }
+  try {
+    for (const auto& listed : bvhlab::parse_pose_list(text, "fuzz.txt")) {
+      check_rigid(listed.pose, "pose list");
+      if (listed.line == 0) broken_promise("pose list: a pose without its line");
+    }
+  } catch (const bvhlab::SceneError& e) {
+    expect_named_refusal(e, "fuzz.txt");
   }
   return 0;
 }

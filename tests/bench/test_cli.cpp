@@ -1,0 +1,243 @@
+// The bvhlab CLI end to end, run as a user runs it: units (the mesh files' own unless --normalize, recorded
+// in saved trees), options that do not apply refused with a reason, values checked before any work, the
+// saved trees `build` writes queryable, and --repeat, --all-contacts and --poses.
+#include "adb/saved_tree.hpp"
+#include "scene_fixtures.hpp"
+#include "support/generated_meshes.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <string>
+
+namespace bvhlab {
+namespace {
+
+using testing::TempDir;
+
+struct Outcome {
+  int status = -1;
+  std::string out, err;
+};
+
+/// An axis-aligned cube of side `side` centred at the origin, as an OBJ file.
+void write_cube(const std::filesystem::path& file, double side) {
+  const double h = side / 2;
+  std::string text;
+  for (int k = 0; k < 8; ++k)
+    text += "v " + std::to_string(k & 1 ? h : -h) + " " + std::to_string(k & 2 ? h : -h) + " " +
+            std::to_string(k & 4 ? h : -h) + "\n";
+  text +=
+      "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\nf 2 4 6\n"
+      "f 4 8 6\n";
+  testing::write_text(file, text);
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    write_cube(dir / "big.obj", 10);   // [-5, 5]^3
+    write_cube(dir / "small.obj", 1);  // [-0.5, 0.5]^3
+  }
+
+  /// Runs `bvhlab ARGS` in the test's folder, without the tree cache of the build.
+  Outcome run(const std::string& args) const {
+    const std::string command = "cd '" + dir.path().string() + "' && BVHLAB_CACHE_DIR='" +
+                                (dir / "cache").string() + "' '" + BVHLAB_CLI + "' " + args +
+                                " > out.txt 2> err.txt";
+    const int raw = std::system(command.c_str());
+    return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, testing::read_text(dir / "out.txt"),
+            testing::read_text(dir / "err.txt")};
+  }
+  /// Runs and expects a refusal (a non-zero status) whose message contains `fragment`, and no output.
+  void expect_refused(const std::string& args, const std::string& fragment) const {
+    const Outcome o = run(args);
+    EXPECT_NE(o.status, 0) << args << "\n" << o.out;
+    EXPECT_NE(o.err.find(fragment), std::string::npos) << args << "\nstderr: " << o.err;
+    EXPECT_EQ(o.out, "") << args;
+  }
+  /// Runs and expects success.
+  Outcome ok(const std::string& args) const {
+    Outcome o = run(args);
+    EXPECT_EQ(o.status, 0) << args << "\nstderr: " << o.err;
+    return o;
+  }
+
+  TempDir dir;
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// Units
+
+// A pose is read in the meshes' own units: the small cube at x = 5.2 crosses the big cube's face at x = 5.
+// Normalised (both cubes 2 wide), it is far from it, and the CLI says that it normalised.
+TEST_F(Cli, PosesAreInTheMeshFilesUnitsUnlessNormalised) {
+  const Outcome raw = ok("query big.obj small.obj --pose 5.2,0,0 --json");
+  EXPECT_TRUE(nlohmann::json::parse(raw.out)["collides"].get<bool>()) << raw.out;
+  EXPECT_EQ(raw.err.find("normalised"), std::string::npos) << raw.err;
+  const Outcome normalised = ok("query big.obj small.obj --pose 5.2,0,0 --json --normalize");
+  EXPECT_FALSE(nlohmann::json::parse(normalised.out)["collides"].get<bool>()) << normalised.out;
+  EXPECT_NE(normalised.err.find("big was normalised: scale 0.2, centre (0, 0, 0)"), std::string::npos)
+      << normalised.err;
+  EXPECT_NE(normalised.err.find("small was normalised: scale 2, centre (0, 0, 0)"), std::string::npos)
+      << normalised.err;
+  expect_refused("query big.obj small.obj --pose 5.2,0,0 --no-normalize", "--no-normalize");
+}
+
+TEST_F(Cli, SavedTreesRecordTheirUnitsAndAreNotMixed) {
+  ok("build big.obj --adb -o big.tree");
+  const Outcome built = ok("build small.obj --adb --normalize -o small.tree");
+  EXPECT_NE(built.err.find("small normalised: scale 2"), std::string::npos) << built.err;
+  EXPECT_NE(built.out.find("units           normalised: scale 2, centre (0, 0, 0)"), std::string::npos)
+      << built.out;
+  const Outcome info = ok("info big.tree");
+  EXPECT_NE(info.out.find("units           the mesh file's units"), std::string::npos) << info.out;
+  const nlohmann::json j = nlohmann::json::parse(ok("info small.tree --json").out);
+  EXPECT_TRUE(j["normalized"].get<bool>());
+  EXPECT_EQ(j["normalization"]["scale"].get<double>(), 2.0);
+  // A normalised tree and a raw one: a pose cannot be in both units.
+  expect_refused("query big.tree small.tree --pose 5.2,0,0 --strategy adb",
+                 "saved trees in different units: small.tree is normalised: scale 2, centre (0, 0, 0), "
+                 "big.tree is in its mesh file's units");
+  // Trees answer in their units: a ring of radius 4 overlaps its copy at x = 5; normalised (radius 1) not.
+  testing::write_obj(testing::make_torus(3.0, 1.0, 24, 12), dir / "ring.obj");
+  ok("build ring.obj --adb -o ring.tree");
+  ok("build ring.obj --adb --normalize -o ring-normalised.tree");
+  const Outcome raw = ok("query ring.tree ring.tree --pose 5,0,0 --strategy adb --json");
+  EXPECT_TRUE(nlohmann::json::parse(raw.out)["collides"].get<bool>()) << raw.out;
+  const Outcome normalised =
+      ok("query ring-normalised.tree ring-normalised.tree --pose 5,0,0 --strategy adb --json");
+  EXPECT_FALSE(nlohmann::json::parse(normalised.out)["collides"].get<bool>()) << normalised.out;
+  EXPECT_NE(normalised.err.find("ring-normalised.tree is normalised: scale 0.25"), std::string::npos)
+      << normalised.err;
+}
+
+TEST_F(Cli, TreesOfAnOlderFormatAreRefusedByVersion) {
+  ok("build small.obj --adb -o small.tree");
+  std::vector<std::byte> bytes = saved_tree_detail::read_file(dir / "small.tree");
+  bytes[8] = std::byte{2};  // the format version
+  saved_tree_detail::write_file_atomically(dir / "old.tree", bytes);
+  expect_refused("info old.tree", "format version 2, this build reads version 3");
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Options that do not apply are refused with a reason
+
+TEST_F(Cli, OptionsThatDoNotApplyAreRefused) {
+  expect_refused("query small.obj small.obj --pose 0.5,0,0 --strategy adb --all-contacts",
+                 "--all-contacts: lists exact contacts; it does not apply to strategy adb");
+  expect_refused("query small.obj small.obj --pose 0.5,0,0 --strategy exact --bv-tests 5",
+                 "strategy exact takes no budget");
+  expect_refused("build small.obj --tau 0.5 --grid 3 -o x.tree", "does not apply to density none");
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.tree"));
+  ok("build small.obj --adb -o small.tree");
+  for (const char* option :
+       {"--bv obb", "--tau 0.5", "--grid 3", "--normalize", "--density adb", "--no-cache", "--cache c"})
+    expect_refused(std::string("query small.tree small.tree --pose 0.5,0,0 --strategy adb ") + option,
+                   "does not apply");
+}
+
+TEST_F(Cli, InfoOfASavedTreePrintsJson) {
+  ok("build small.obj --adb -o small.tree");
+  const nlohmann::json j = nlohmann::json::parse(ok("info small.tree --json").out);
+  EXPECT_EQ(j["annotation"], "adb grid=2 tau=0.25");
+  EXPECT_EQ(j["triangles"], 12);
+}
+
+// A saved tree has no polygons: without a density no shipped strategy could query it, so it is not built.
+TEST_F(Cli, BuildRefusesATreeNothingCouldQuery) {
+  expect_refused("build small.obj -o plain.tree",
+                 "a saved tree carries no polygons, and no strategy queries a tree with density none");
+  EXPECT_FALSE(std::filesystem::exists(dir / "plain.tree"));
+  ok("build small.obj --adb -o adb.tree");
+  ok("query adb.tree adb.tree --pose 0.5,0,0 --strategy adb");
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Values are checked before any work, with the ranges scenes use
+
+TEST_F(Cli, ValuesAreCheckedBeforeWorkStarts) {
+  expect_refused("build small.obj --adb --tau 1.5 -o x.tree", "tau must be a number in [0, 1], got 1.5");
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.tree"));
+  expect_refused("query small.obj small.obj --protocol -1,0,10", "distance must be a number in [0, 1e+06]");
+  expect_refused("query small.obj small.obj --protocol 1,10,10", "STEP must be an integer in [0, STEPS - 1]");
+  expect_refused("query small.obj small.obj --protocol 1,0,0", "steps must be an integer in [1, 1e+07]");
+  expect_refused("query small.obj small.obj --pose 1,0,0 --strategy time_critical --bv-tests 0",
+                 "bv_tests must be an integer in [1, 1099511627776]");
+  expect_refused("query small.obj small.obj --pose 1,0,0 --strategy time_critical --deadline-us 0",
+                 "deadline_us must be a number in (0, 1e+09]");
+  expect_refused("query small.obj small.obj --pose 1,0,0,0,0,0,90", "the rotation axis must be finite");
+  expect_refused("query small.obj small.obj --pose 1,0,0 --repeat 0", "--repeat");
+  ok("query small.obj small.obj --protocol 1,9,10");
+}
+
+// The LB table starts at tau = 0 (every cell with some area counts); it is a value like any other.
+TEST_F(Cli, TauZeroIsAccepted) {
+  const Outcome built = ok("build small.obj --adb --tau 0 -o zero.tree");
+  EXPECT_NE(built.out.find("adb grid=2 tau=0"), std::string::npos) << built.out;
+  ok("query zero.tree zero.tree --pose 0.5,0,0 --strategy adb");
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// --repeat, --all-contacts, --poses
+
+TEST_F(Cli, RepeatTimesWarmQueries) {
+  const Outcome text = ok("query small.obj small.obj --pose 0.5,0,0 --repeat 7");
+  EXPECT_NE(text.out.find("warm time         median "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("over 7 queries"), std::string::npos) << text.out;
+  const nlohmann::json j =
+      nlohmann::json::parse(ok("query small.obj small.obj --pose 0.5,0,0 --repeat 7 --json").out);
+  EXPECT_EQ(j["warm_time_us"]["queries"], 7);
+  EXPECT_LE(j["warm_time_us"]["min"].get<double>(), j["warm_time_us"]["median"].get<double>());
+  EXPECT_LE(j["warm_time_us"]["median"].get<double>(), j["warm_time_us"]["max"].get<double>());
+  ok("build small.obj --adb -o small.tree");
+  const nlohmann::json t = nlohmann::json::parse(
+      ok("query small.tree small.tree --pose 0.5,0,0 --strategy adb --repeat 3 --json").out);
+  EXPECT_EQ(t["warm_time_us"]["queries"], 3);
+}
+
+TEST_F(Cli, AllContactsListsThePairsInTextToo) {
+  const std::string args = "query small.obj small.obj --pose 0.5,0.2,0.1 --all-contacts";
+  const nlohmann::json j = nlohmann::json::parse(ok(args + " --json").out);
+  const auto contacts = j["contacts"];
+  ASSERT_GT(contacts.size(), 1u);
+  const std::string text = ok(args).out;
+  EXPECT_NE(text.find("contacts          " + std::to_string(contacts.size()) + " triangle pairs"),
+            std::string::npos)
+      << text;
+  for (const auto& c : contacts)
+    EXPECT_NE(
+        text.find("\n    " + std::to_string(c[0].get<int>()) + " " + std::to_string(c[1].get<int>()) + "\n"),
+        std::string::npos)
+        << c << "\n"
+        << text;
+}
+
+TEST_F(Cli, PoseListsAreQueriedInOrder) {
+  testing::write_text(dir / "poses.txt",
+                      "# a pose per line\n0.5 0 0\n\n3,0,0\n0.9 0 0 0 0 1 45\n1 0 0 0  0 1 0 0  0 0 1 0\n");
+  const nlohmann::json j =
+      nlohmann::json::parse(ok("query small.obj small.obj --poses poses.txt --json").out);
+  ASSERT_EQ(j["results"].size(), 4u);
+  const int lines[] = {2, 4, 5, 6};
+  const bool collides[] = {true, false, true, true};
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(j["results"][k]["line"], lines[k]);
+    EXPECT_EQ(j["results"][k]["collides"], collides[k]) << k;
+  }
+  const std::string text = ok("query small.obj small.obj --poses poses.txt --repeat 2").out;
+  EXPECT_NE(text.find("small vs small, exact on aabb, 4 poses\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("warm_median_us"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n       6  yes "), std::string::npos) << text;
+  EXPECT_NE(text.find("\n       4  no "), std::string::npos) << text;
+  testing::write_text(dir / "bad.txt", "0.5 0 0\n0.5 0\n");
+  expect_refused("query small.obj small.obj --poses bad.txt", "bad.txt:2: expected 3 numbers");
+  expect_refused("query small.obj small.obj --poses poses.txt --pose 1,0,0",
+                 "one of --pose, --protocol, --poses");
+}
+
+}  // namespace
+}  // namespace bvhlab
