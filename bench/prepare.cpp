@@ -291,17 +291,20 @@ namespace {
 Mesh load_scene_mesh(const SceneObject& object, TreeUnits& units) {
   if (object.path.empty()) throw MeshError(object.mesh + ": mesh not found");
   Mesh mesh = load_mesh(object.path).mesh;
-  units = {};
-  if (object.normalize) {
-    units.centre = mesh.bounds().center();  // what normalize_to_unit_cube moves to the origin
-    units.scale = normalize_to_unit_cube(mesh);
-    units.normalized = true;
-  }
+  units = object.normalize ? normalize_mesh(mesh) : TreeUnits{};
   for (Vec3& v : mesh.vertices) v = object.placement.apply(v * object.scale);
   return mesh;
 }
 
 }  // namespace
+
+TreeUnits normalize_mesh(Mesh& mesh) {
+  TreeUnits units;
+  units.centre = mesh.bounds().center();  // what normalize_to_unit_cube moves to the origin
+  units.scale = normalize_to_unit_cube(mesh);
+  units.normalized = true;
+  return units;
+}
 
 Mesh load_scene_object(const SceneObject& object) {
   TreeUnits units;

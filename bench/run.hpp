@@ -118,6 +118,9 @@ struct RunOutput {
 /// skipped (recorded in stats.skipped).
 RunOutput run_scene(const Scene& scene, const RunOptions& options);
 
+/// Applies the protocol normalisation to `mesh` (normalize_to_unit_cube) and returns the units it is then in,
+/// as saved trees record them. Throws MeshError as normalize_to_unit_cube does.
+TreeUnits normalize_mesh(Mesh& mesh);
 /// An object's mesh as a run loads it: normalised (if asked), scaled and placed. Throws MeshError.
 Mesh load_scene_object(const SceneObject& object);
 

@@ -7,6 +7,7 @@
 #include "bench/prepare.hpp"
 #include "traversal/strategies.hpp"
 
+#include <cstdio>
 #include <stdexcept>
 
 namespace bvhlab::python {
@@ -48,7 +49,8 @@ class TypedQuery final : public PreparedQuery {
 
 template <class BV, class D>
 struct TypedModel final : AnyTree::Model {
-  TypedModel(Tree<BV, D> built, double build_seconds, double annotate_seconds) : tree(std::move(built)) {
+  TypedModel(Tree<BV, D> built, const MeshUnits& units, double build_seconds, double annotate_seconds)
+      : tree(std::move(built)) {
     ModelInfo size;  // the runner's and `bvhlab info`'s one account of a tree's size
     describe_tree_size(size, tree);
     info.bv = BV::name();
@@ -61,10 +63,13 @@ struct TypedModel final : AnyTree::Model {
     info.build_seconds = build_seconds;
     info.annotate_seconds = annotate_seconds;
     info.polygons = tree.bvh.has_polygons();
+    info.units = units;
   }
 
   [[nodiscard]] std::vector<std::byte> save_bytes(const std::string& source) const override {
-    return save_tree_to_buffer(tree, {}, source);
+    SaveOptions options;
+    options.units = info.units.file;
+    return save_tree_to_buffer(tree, options, source);
   }
 
   [[nodiscard]] std::unique_ptr<PreparedQuery> prepare(std::shared_ptr<const Model> self,
@@ -100,18 +105,19 @@ struct TypedModel final : AnyTree::Model {
 };
 
 template <class BV, class D>
-std::shared_ptr<const AnyTree::Model> build_typed(const Mesh& mesh, const DensitySpec& density,
+std::shared_ptr<const AnyTree::Model> build_typed(const UnitMesh& mesh, const DensitySpec& density,
                                                   const BuildOptions& options) {
   Bvh<BV> bvh = Bvh<BV>::build(mesh, options);
   const double build_seconds = bvh.stats().build_seconds;
   if constexpr (std::is_same_v<D, NoDensity>) {
-    return std::make_shared<TypedModel<BV, D>>(Tree<BV, D>{std::move(bvh), {}}, build_seconds, 0.0);
+    return std::make_shared<TypedModel<BV, D>>(Tree<BV, D>{std::move(bvh), {}}, mesh.units, build_seconds,
+                                               0.0);
   } else {
     AnnotationContext context;
     context.threads = options.threads;
     AnnotateStats stats;
     Tree<BV, D> tree = annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &stats);
-    return std::make_shared<TypedModel<BV, D>>(std::move(tree), build_seconds, stats.seconds);
+    return std::make_shared<TypedModel<BV, D>>(std::move(tree), mesh.units, build_seconds, stats.seconds);
   }
 }
 
@@ -126,9 +132,33 @@ Tree<BV, D> with_polygons(const Tree<BV, D>& saved, const Mesh& mesh, const fs::
   }
 }
 
+/// Refuses a mesh in other units than the saved tree's: its polygons would not be where the tree's leaves
+/// are.
+void check_mesh_units(const MeshUnits& tree, const UnitMesh& mesh, const fs::path& file) {
+  if (mesh.units == tree) return;
+  throw std::invalid_argument("saved tree '" + file.string() + "' and mesh '" + mesh.name +
+                              "' differ in units (tree: " + tree.describe() +
+                              "; mesh: " + mesh.units.describe() +
+                              "); give the mesh as the tree was built (load_mesh(normalize=...))");
+}
+
+/// The CLI's rule for a query: both trees normalised or neither, as one pose cannot be in both units.
+void check_same_kind_of_units(const TreeInfo& a, const TreeInfo& b) {
+  if (a.units.file.normalized == b.units.file.normalized) return;
+  throw std::invalid_argument("the trees are in different units (a: " + a.units.describe() +
+                              "; b: " + b.units.describe() + "); normalise both meshes or neither");
+}
+
 }  // namespace
 
-AnyTree AnyTree::build(const Mesh& mesh, const std::string& bv, const DensitySpec& density,
+std::string MeshUnits::describe() const {
+  if (scaled_by == 1) return file.describe();
+  char factor[32];
+  std::snprintf(factor, sizeof factor, "%.6g", scaled_by);
+  return file.describe() + ", then scaled by " + factor;
+}
+
+AnyTree AnyTree::build(const UnitMesh& mesh, const std::string& bv, const DensitySpec& density,
                        const BuildOptions& options) {
   std::shared_ptr<const Model> model;
   with_volume(bv, [&]<class BV>(std::type_identity<BV>) {
@@ -142,7 +172,7 @@ AnyTree AnyTree::build(const Mesh& mesh, const std::string& bv, const DensitySpe
   return AnyTree(std::move(model));
 }
 
-AnyTree AnyTree::load(const fs::path& file, const Mesh* mesh) {
+AnyTree AnyTree::load(const fs::path& file, const UnitMesh* mesh) {
   const std::vector<std::byte> bytes = saved_tree_detail::read_file(file);
   const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, file.string());
   try {  // a name this build does not know is refused naming the file
@@ -151,13 +181,15 @@ AnyTree AnyTree::load(const fs::path& file, const Mesh* mesh) {
   } catch (const std::invalid_argument& e) {
     throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
   }
+  const MeshUnits units{header.units, 1};
+  if (mesh) check_mesh_units(units, *mesh, file);
   std::shared_ptr<const Model> model;
   with_volume(header.bv_name, [&]<class BV>(std::type_identity<BV>) {
     with_density(header.density_name, [&]<class D>(std::type_identity<D>) {
       if constexpr (DensityFor<D, BV>) {
         Tree<BV, D> tree = load_tree_from_buffer<BV, D>(bytes, file.string());
         if (mesh) tree = with_polygons(tree, *mesh, file);
-        model = std::make_shared<TypedModel<BV, D>>(std::move(tree), 0.0, 0.0);
+        model = std::make_shared<TypedModel<BV, D>>(std::move(tree), units, 0.0, 0.0);
       } else {
         throw SavedTreeError("saved tree '" + file.string() + "': density " + header.density_name +
                              " cannot annotate " + header.bv_name + " trees");
@@ -168,6 +200,11 @@ AnyTree AnyTree::load(const fs::path& file, const Mesh* mesh) {
 }
 
 void AnyTree::save(const fs::path& file) const {
+  const MeshUnits& units = model_->info.units;
+  if (units.scaled_by != 1)
+    throw std::invalid_argument("cannot save '" + file.string() + "': the tree's units (" + units.describe() +
+                                ") include load_mesh's scale, and a saved tree records only the mesh file's "
+                                "units or the normalisation; build it from a mesh loaded without scale=");
   saved_tree_detail::write_file_atomically(file, model_->save_bytes(file.string()));
 }
 
@@ -176,6 +213,7 @@ const TreeInfo& AnyTree::info() const {
 }
 
 std::unique_ptr<PreparedQuery> AnyTree::prepare(const AnyTree& b, const StrategyVariant& variant) const {
+  check_same_kind_of_units(info(), b.info());
   return model_->prepare(model_, b.model_, variant);
 }
 

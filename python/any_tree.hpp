@@ -3,6 +3,7 @@
 // trees, dispatched and configured once so that it can run over many poses without the interpreter.
 #pragma once
 
+#include "adb/saved_tree.hpp"
 #include "bench/core/scene.hpp"
 #include "bvh/mesh.hpp"
 #include "bvh/topology.hpp"
@@ -17,6 +18,22 @@
 
 namespace bvhlab::python {
 
+/// The units of a mesh's coordinates as this module tracks them: what a saved tree records (the mesh file's
+/// own units, or the protocol normalisation), then load_mesh's uniform scale, which a saved tree cannot
+/// record (the runner's tree cache keys it instead).
+struct MeshUnits {
+  TreeUnits file;        ///< relative to the mesh file (or to the arrays the mesh was made from)
+  double scaled_by = 1;  ///< applied after the normalisation, if any
+  [[nodiscard]] bool operator==(const MeshUnits&) const = default;
+  /// TreeUnits::describe(), then ", then scaled by 3" when scaled.
+  [[nodiscard]] std::string describe() const;
+};
+
+/// A mesh and the units of its coordinates: what bvhlab.Mesh holds.
+struct UnitMesh : Mesh {
+  MeshUnits units;
+};
+
 /// What a tree is and what it cost: the fields `bvhlab info` and results.json report.
 struct TreeInfo {
   std::string bv, density;  ///< registered names
@@ -25,6 +42,7 @@ struct TreeInfo {
   double model_bytes = 0;  ///< nodes, volumes and density data (what a query reads; no polygons)
   double build_seconds = 0, annotate_seconds = 0;
   bool polygons = false;  ///< built from a mesh, or loaded with one: exact strategies can run on it
+  MeshUnits units;        ///< its mesh's, or what its file records
 };
 
 /// Receives each pose's result, by the pose's index.
@@ -42,19 +60,21 @@ class AnyTree {
  public:
   /// Builds `mesh`'s tree of volume `bv` (and annotates it with `density`, if that is not "none"). Throws
   /// std::invalid_argument for an unknown name, bad parameters or a density that cannot annotate `bv`.
-  static AnyTree build(const Mesh& mesh, const std::string& bv, const DensitySpec& density,
+  static AnyTree build(const UnitMesh& mesh, const std::string& bv, const DensitySpec& density,
                        const BuildOptions& options);
-  /// Reads a saved tree (adb/saved_tree.hpp), typed by the names in its header; with `mesh`, re-attaches
-  /// its polygons after checking that they fit (the tree cache's check). Throws SavedTreeError naming the
-  /// file, std::invalid_argument when `mesh` does not fit.
-  static AnyTree load(const std::filesystem::path& file, const Mesh* mesh = nullptr);
+  /// Reads a saved tree (adb/saved_tree.hpp), typed by the names in its header, in the units it records;
+  /// with `mesh`, re-attaches its polygons after checking that they are in those units and fit (the tree
+  /// cache's check). Throws SavedTreeError naming the file, std::invalid_argument when `mesh` does not fit.
+  static AnyTree load(const std::filesystem::path& file, const UnitMesh* mesh = nullptr);
 
-  /// Saves without polygons, atomically. Throws SavedTreeError naming the file.
+  /// Saves without polygons, atomically, recording the tree's units. Throws std::invalid_argument for a tree
+  /// of a scaled mesh (the format cannot record the scale), SavedTreeError naming the file.
   void save(const std::filesystem::path& file) const;
   [[nodiscard]] const TreeInfo& info() const;
 
   /// The query of `variant` with this tree as A (fixed) and `b` as B (moved by the poses). Throws
-  /// std::invalid_argument when the trees differ in volume or density, the strategy does not run on the
+  /// std::invalid_argument when one tree is normalised and the other not (the CLI's rule: a pose cannot be in
+  /// both units), the trees differ in volume or density, the strategy does not run on the
   /// density, needs polygons a tree lacks, or its parameters or budget are refused.
   [[nodiscard]] std::unique_ptr<PreparedQuery> prepare(const AnyTree& b,
                                                        const StrategyVariant& variant) const;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "adb/parameters.hpp"
+#include "python/any_tree.hpp"
 #include "volumes/geometry.hpp"
 
 #include <pybind11/numpy.h>
@@ -42,6 +43,9 @@ void matrix_from_rigid(const RigidTransform& pose, double* out);
 /// Keyword arguments as policy parameters (p_min=0.9, grid=2): every value a real number (TypeError else);
 /// the policy's table checks the names and ranges.
 ParamValues parameter_values(const py::kwargs& kwargs);
+
+/// Units as Python sees them: {"normalized", "scale", "centre", "scaled_by", "description"}.
+py::dict units_dict(const MeshUnits& units);
 
 /// A str or os.PathLike as a path; TypeError otherwise.
 std::filesystem::path path_argument(const py::handle& value, const std::string& what);

@@ -1,5 +1,6 @@
 // bvhlab.Mesh: from numpy arrays (checked here) or from a file (the library's loader and its checks).
 #include "bench/core/mesh_catalog.hpp"
+#include "bench/run.hpp"
 #include "bvh/mesh_io.hpp"
 #include "python/bindings.hpp"
 
@@ -65,8 +66,8 @@ std::vector<TriangleIndices> triangles_from(const py::handle& value, std::size_t
                      : indices_from<std::uint64_t>(array, vertices);
 }
 
-Mesh mesh_from_arrays(const py::object& vertices, const py::object& triangles, const std::string& name) {
-  Mesh mesh;
+UnitMesh mesh_from_arrays(const py::object& vertices, const py::object& triangles, const std::string& name) {
+  UnitMesh mesh;  // in its own units
   mesh.name = name;
   mesh.vertices = vertices_from(vertices);
   mesh.triangles = triangles_from(triangles, mesh.vertices.size());
@@ -88,7 +89,7 @@ std::filesystem::path resolve_mesh(const py::handle& argument) {
   return path;
 }
 
-Mesh load(const py::object& argument, bool normalize, double scale) {
+UnitMesh load(const py::object& argument, bool normalize, double scale) {
   if (!std::isfinite(scale) || scale <= 0) throw py::value_error("scale must be finite and positive");
   const std::filesystem::path path = resolve_mesh(argument);
   LoadedMesh loaded = [&] {
@@ -98,14 +99,26 @@ Mesh load(const py::object& argument, bool normalize, double scale) {
   for (const std::string& warning : loaded.report.warnings)
     if (PyErr_WarnEx(PyExc_UserWarning, (path.string() + ": " + warning).c_str(), 1) != 0)
       throw py::error_already_set();
-  Mesh& mesh = loaded.mesh;
-  if (normalize) normalize_to_unit_cube(mesh);
+  UnitMesh mesh;
+  static_cast<Mesh&>(mesh) = std::move(loaded.mesh);
+  if (normalize) mesh.units.file = normalize_mesh(mesh);
   if (scale != 1)
     for (Vec3& v : mesh.vertices) v *= scale;
-  return std::move(mesh);
+  mesh.units.scaled_by = scale;
+  return mesh;
 }
 
-py::array_t<double> vertex_array(const Mesh& mesh) {
+/// Normalising twice changes nothing; a scaled mesh is refused, as its units would be neither the file's nor
+/// the normalisation.
+UnitMesh normalized(UnitMesh mesh) {
+  if (mesh.units.scaled_by != 1)
+    throw py::value_error("Mesh.normalized: the mesh is in " + mesh.units.describe() +
+                          "; normalise before scaling: load_mesh(path, normalize=True, scale=...)");
+  if (!mesh.units.file.normalized) mesh.units.file = normalize_mesh(mesh);
+  return mesh;
+}
+
+py::array_t<double> vertex_array(const UnitMesh& mesh) {
   py::array_t<double> out({static_cast<py::ssize_t>(mesh.vertices.size()), py::ssize_t{3}});
   double* data = out.mutable_data();
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
@@ -113,7 +126,7 @@ py::array_t<double> vertex_array(const Mesh& mesh) {
   return out;
 }
 
-py::array_t<std::int64_t> triangle_array(const Mesh& mesh) {
+py::array_t<std::int64_t> triangle_array(const UnitMesh& mesh) {
   py::array_t<std::int64_t> out({static_cast<py::ssize_t>(mesh.triangles.size()), py::ssize_t{3}});
   std::int64_t* data = out.mutable_data();
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
@@ -123,20 +136,32 @@ py::array_t<std::int64_t> triangle_array(const Mesh& mesh) {
 
 }  // namespace
 
+py::dict units_dict(const MeshUnits& units) {
+  const Vec3& c = units.file.centre;
+  return py::dict(py::arg("normalized") = units.file.normalized, py::arg("scale") = units.file.scale,
+                  py::arg("centre") = py::make_tuple(c.x(), c.y(), c.z()),
+                  py::arg("scaled_by") = units.scaled_by, py::arg("description") = units.describe());
+}
+
 void bind_meshes(py::module_& m) {
-  py::class_<Mesh>(m, "Mesh",
-                   "A triangle mesh: vertices (N x 3, float64) and triangles (M x 3 vertex indices).")
+  const char* units_help =
+      "The units of the coordinates, a dict: normalized (the protocol normalisation x' = (x - centre) * "
+      "scale "
+      "of the file's coordinates x), scale and centre (1 and 0 unless normalised), scaled_by (load_mesh's "
+      "scale, applied after; a saved tree cannot record it) and description.";
+  py::class_<UnitMesh>(m, "Mesh",
+                       "A triangle mesh: vertices (N x 3, float64) and triangles (M x 3 vertex indices).")
       .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("triangles"), py::arg("name") = "",
            "Checks the arrays: an (N, 3) array of finite real numbers and an (M, 3) integer array of indices "
            "below N, M >= 1, the triangles not all in one point.")
       .def_property_readonly("vertices", &vertex_array, "(N, 3) float64 array (a copy)")
       .def_property_readonly("triangles", &triangle_array, "(M, 3) int64 array (a copy)")
       .def_readwrite("name", &Mesh::name)
-      .def_property_readonly("vertex_count", [](const Mesh& mesh) { return mesh.vertices.size(); })
+      .def_property_readonly("vertex_count", [](const UnitMesh& mesh) { return mesh.vertices.size(); })
       .def_property_readonly("triangle_count", &Mesh::triangle_count)
       .def_property_readonly(
           "bounds",
-          [](const Mesh& mesh) {
+          [](const UnitMesh& mesh) {
             const Box b = mesh.bounds();
             py::array_t<double> out({2, 3});
             for (int k = 0; k < 3; ++k) {
@@ -146,14 +171,13 @@ void bind_meshes(py::module_& m) {
             return out;
           },
           "(2, 3) array: the bounding box's min and max corners")
-      .def(
-          "normalized",
-          [](Mesh mesh) {
-            normalize_to_unit_cube(mesh);
-            return mesh;
-          },
-          "A copy with the protocol normalisation: bounding-box centre at the origin, longest side 2.")
-      .def("__repr__", [](const Mesh& mesh) {
+      .def_property_readonly(
+          "units", [](const UnitMesh& mesh) { return units_dict(mesh.units); }, units_help)
+      .def("normalized", &normalized,
+           "A copy with the protocol normalisation (bounding-box centre at the origin, longest side 2), its "
+           "units "
+           "recorded; a mesh already normalised is returned as it is, a scaled one refused.")
+      .def("__repr__", [](const UnitMesh& mesh) {
         return "<bvhlab.Mesh '" + mesh.name + "': " + std::to_string(mesh.vertices.size()) + " vertices, " +
                std::to_string(mesh.triangles.size()) + " triangles>";
       });
@@ -164,7 +188,8 @@ void bind_meshes(py::module_& m) {
       "no "
       "file is looked up in the mesh catalog (bundled meshes/, the fetched-mesh cache). The file's own "
       "coordinates are kept unless normalize=True (the protocol normalisation: centre at the origin, longest "
-      "side 2); then the vertices are multiplied by scale. Raises bvhlab.MeshError for a file the loader "
+      "side 2); then the vertices are multiplied by scale. Both are recorded in the mesh's units. Raises "
+      "bvhlab.MeshError for a file the loader "
       "refuses.");
 }
 

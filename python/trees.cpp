@@ -7,8 +7,8 @@ namespace bvhlab::python {
 
 namespace {
 
-AnyTree build(const Mesh& mesh, const std::string& bv, const std::string& density, const std::string& split,
-              int leaf, int threads, const py::kwargs& parameters) {
+AnyTree build(const UnitMesh& mesh, const std::string& bv, const std::string& density,
+              const std::string& split, int leaf, int threads, const py::kwargs& parameters) {
   if (leaf < 1 || leaf > 255) throw py::value_error("leaf: triangles per leaf must lie in [1, 255]");
   if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
   (void)with_volume(bv, [](auto) { return 0; });  // an unknown name fails before the density's checks
@@ -21,7 +21,7 @@ AnyTree build(const Mesh& mesh, const std::string& bv, const std::string& densit
   return AnyTree::build(mesh, bv, spec, options);
 }
 
-AnyTree load(const py::object& file, const Mesh* mesh) {
+AnyTree load(const py::object& file, const UnitMesh* mesh) {
   const std::filesystem::path path = path_argument(file, "Tree.load");
   require_file(path, "Tree.load");
   py::gil_scoped_release release;
@@ -60,10 +60,17 @@ void bind_trees(py::module_& m) {
            "'sah' or 'median'; leaf: triangles per leaf at most; threads: 0 for all cores.")
       .def_static(
           "load", &load, py::arg("path"), py::arg("mesh") = nullptr,
-          "Reads a saved tree. Saved trees carry no polygons: give the mesh it was built from to run the "
-          "strategies that test triangles (it is checked against the tree).")
+          "Reads a saved tree, in the units it records. Saved trees carry no polygons: give the mesh it was "
+          "built from to run the strategies that test triangles (it is checked against the tree: its units "
+          "and its triangles).")
       .def("save", &save, py::arg("path"),
-           "Saves the tree without polygons (the format `bvhlab build` writes).")
+           "Saves the tree without polygons, with its units (the format `bvhlab build` writes). A tree of a "
+           "mesh loaded with scale= is refused: the format records only the file's units or the "
+           "normalisation.")
+      .def_property_readonly(
+          "units", [](const AnyTree& t) { return units_dict(t.info().units); },
+          "its mesh's units (Mesh.units), or those its file records; query refuses a normalised tree "
+          "against one in its file's units")
       .def_property_readonly("bv", info(&TreeInfo::bv))
       .def_property_readonly("density", info(&TreeInfo::density))
       .def_property_readonly("annotation", info(&TreeInfo::annotation), "the density and its parameters")

@@ -76,7 +76,7 @@ def test_saved_tree_is_the_clis(tmp_path, cli, gear_file, gear):
 def test_a_mesh_that_does_not_fit_is_refused(tmp_path, gear):
     path = tmp_path / "gear.tree"
     bvhlab.Tree(gear).save(path)
-    other = bvhlab.load_mesh("teapot.obj", normalize=True)
+    other = bvhlab.load_mesh("teapot.obj")
     with pytest.raises(ValueError, match="does not fit mesh"):
         bvhlab.Tree.load(path, mesh=other)
     # the same triangles moved: the leaves no longer contain them
