@@ -325,10 +325,12 @@ int query_command(const QueryArgs& args) {
   std::vector<ListedPose> poses = poses_of(args);
   const QueryRun run = execute_query(args, trees, request, std::move(poses));
   const bool batch = !args.poses_file.empty();
+  // The contacts are listed whether the strategy was named or given by --all-contacts.
+  const bool all_contacts = request.strategy.strategy == AllContactsStrategy::name();
   if (args.json)
-    print_json(run, args.all, batch);
+    print_json(run, all_contacts, batch);
   else
-    print_text(run, request, args.all, batch);
+    print_text(run, request, all_contacts, batch);
   return 0;
 }
 

@@ -214,6 +214,10 @@ TEST_F(Cli, AllContactsListsThePairsInTextToo) {
         std::string::npos)
         << c << "\n"
         << text;
+  // Naming the strategy lists them as the flag does.
+  const nlohmann::json named = nlohmann::json::parse(
+      ok("query small.obj small.obj --pose 0.5,0.2,0.1 --strategy all_contacts --json").out);
+  EXPECT_EQ(named["contacts"], contacts);
 }
 
 TEST_F(Cli, PoseListsAreQueriedInOrder) {
