@@ -80,7 +80,7 @@ void Aggregation::tally(const std::vector<QueryRecord>& records, const std::vect
     answer_yes += r.collides;
     inexact += !r.exact;
     exhausted += r.budget_exhausted;
-    const double micros = std::max(0.0, r.micros - clock_overhead_us_);
+    const double micros = net_micros(r.micros, clock_overhead_us_);
     sum_us += micros;
     max_us = std::max(max_us, micros);
     counters += r.counters;

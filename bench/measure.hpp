@@ -40,6 +40,27 @@ void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector
 /// What an empty timed region costs: the median of back-to-back clock reads. Subtracted from every query time
 /// (clamped at 0), so that sub-microsecond ADB answers are not inflated by the clock itself.
 double clock_overhead_us();
+/// A timed query's time less the clock's own overhead, clamped at 0: as results.csv and `query --repeat`
+/// report it.
+inline double net_micros(double micros, double clock_overhead_us) {
+  return std::max(0.0, micros - clock_overhead_us);
+}
+
+/// One pose's answer for a query with warm repeats: first(pose) once, timed (cold), with its full result;
+/// then series(poses, records) over `repeat` copies of the pose, each time net of the clock's overhead.
+template <class First, class Series>
+PoseAnswer answer_pose(const RigidTransform& pose, int repeat, double clock_overhead_us, First&& first,
+                       Series&& series) {
+  PoseAnswer answer;
+  const auto start = Clock::now();
+  answer.result = first(pose);
+  answer.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+  if (repeat <= 0) return answer;
+  std::vector<QueryRecord> records;
+  series(std::vector<RigidTransform>(std::size_t(repeat), pose), records);
+  for (const QueryRecord& r : records) answer.warm_micros.push_back(net_micros(r.micros, clock_overhead_us));
+  return answer;
+}
 
 using Truth = std::vector<std::vector<std::uint8_t>>;  // [group][pose] -> 0/1
 

@@ -151,19 +151,13 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
       {request.strategy}};
   auto hierarchy = preparation.hierarchy(planned, object_a, ob);
   const double overhead = request.repeat ? clock_overhead_us() : 0;
-  std::vector<QueryRecord> records;
-  for (const RigidTransform& pose : poses) {
-    PoseAnswer answer;
-    const auto start = Clock::now();
-    answer.result = hierarchy->query(request.strategy, pose);
-    answer.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
-    if (request.repeat) {
-      hierarchy->run(request.strategy, std::vector<RigidTransform>(std::size_t(request.repeat), pose), 0,
-                     records);
-      for (const QueryRecord& r : records) answer.warm_micros.push_back(std::max(0.0, r.micros - overhead));
-    }
-    outcome.answers.push_back(std::move(answer));
-  }
+  for (const RigidTransform& pose : poses)
+    outcome.answers.push_back(answer_pose(
+        pose, request.repeat, overhead,
+        [&](const RigidTransform& p) { return hierarchy->query(request.strategy, p); },
+        [&](const std::vector<RigidTransform>& copies, std::vector<QueryRecord>& records) {
+          hierarchy->run(request.strategy, copies, 0, records);
+        }));
   const auto models = preparation.models();
   outcome.model_a = hierarchy->model;
   outcome.model_b = models.back();

@@ -107,18 +107,13 @@ void describe_saved(ModelInfo& model, const Tree<BV, D>& tree, const std::filesy
 
 /// The first query at `pose` with its full result, then `repeat` more timed as the runner times a series.
 template <class S, class BV, class D>
-PoseAnswer answer_pose(const Tree<BV, D>& a, const Tree<BV, D>& b, const typename S::Options& options,
-                       const RigidTransform& pose, int repeat, double clock_overhead) {
-  PoseAnswer answer;
-  const auto start = Clock::now();
-  answer.result = S::query(a, b, pose, options);
-  answer.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
-  if (repeat <= 0) return answer;
-  std::vector<QueryRecord> records;
-  timed_series(std::vector<RigidTransform>(std::size_t(repeat), pose), 0, records,
-               [&](const RigidTransform& p) { return S::query(a, b, p, options); });
-  for (const QueryRecord& r : records) answer.warm_micros.push_back(std::max(0.0, r.micros - clock_overhead));
-  return answer;
+PoseAnswer answer_on_trees(const Tree<BV, D>& a, const Tree<BV, D>& b, const typename S::Options& options,
+                           const RigidTransform& pose, int repeat, double clock_overhead) {
+  const auto query = [&](const RigidTransform& p) { return S::query(a, b, p, options); };
+  return answer_pose(pose, repeat, clock_overhead, query,
+                     [&](const std::vector<RigidTransform>& copies, std::vector<QueryRecord>& records) {
+                       timed_series(copies, 0, records, query);
+                     });
 }
 
 }  // namespace
@@ -143,7 +138,7 @@ QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::files
       if constexpr (S::template accepts<D>) {
         const auto options = strategy_options<S>(strategy.values, strategy.budget);
         for (const RigidTransform& pose : poses)
-          outcome.answers.push_back(answer_pose<S>(tree_a, tree_b, options, pose, repeat, overhead));
+          outcome.answers.push_back(answer_on_trees<S>(tree_a, tree_b, options, pose, repeat, overhead));
       } else {
         throw std::invalid_argument("strategy " + strategy.strategy +
                                     " does not run on trees with density '" + std::string(D::name()) + "'");
