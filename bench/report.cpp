@@ -217,18 +217,12 @@ std::string object_text(const SceneObject& o) {
   return text + ")";
 }
 
-const SceneObject* find_object(const Scene& scene, const std::string& name) {
-  for (const auto& o : scene.objects)
-    if (o.name == name) return &o;
-  return nullptr;
-}
-
 /// "`jeep` (jeep1.ms3d, normalised: ...) against a copy of itself; `env` (...) against `rob` (...)".
 std::string pairs_text(const Scene& scene) {
   std::string text;
   for (const ScenePair& p : scene.pairs) {
-    const SceneObject* a = find_object(scene, p.a);
-    const SceneObject* b = find_object(scene, p.b);
+    const SceneObject* a = scene.object(p.a);
+    const SceneObject* b = scene.object(p.b);
     if (!a || !b) continue;
     text += (text.empty() ? "" : "; ") + object_text(*a) + " against " +
             (p.a == p.b ? std::string("a copy of itself") : object_text(*b));
