@@ -21,14 +21,6 @@ bool is_saved_tree(const std::filesystem::path& file) {
   return in.read(magic, 8) && std::string_view(magic, 8) == "BVHLTREE";
 }
 
-namespace {
-
-/// The file's bytes and its checked header, with a BV or density this build does not know refused by name.
-struct SavedTreeFile {
-  std::vector<std::byte> bytes;
-  saved_tree_detail::Header header;
-};
-
 SavedTreeFile read_saved_tree(const std::filesystem::path& file) {
   SavedTreeFile out;
   out.bytes = saved_tree_detail::read_file(file);
@@ -41,6 +33,8 @@ SavedTreeFile read_saved_tree(const std::filesystem::path& file) {
   }
   return out;
 }
+
+namespace {
 
 /// Calls f(tree, header) with the saved tree in `file`, typed by the BV and density its header names.
 template <class F>

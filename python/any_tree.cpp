@@ -173,21 +173,15 @@ AnyTree AnyTree::build(const UnitMesh& mesh, const std::string& bv, const Densit
 }
 
 AnyTree AnyTree::load(const fs::path& file, const UnitMesh* mesh) {
-  const std::vector<std::byte> bytes = saved_tree_detail::read_file(file);
-  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, file.string());
-  try {  // a name this build does not know is refused naming the file
-    with_volume(header.bv_name, [](auto) {});
-    with_density(header.density_name, [](auto) {});
-  } catch (const std::invalid_argument& e) {
-    throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
-  }
+  const SavedTreeFile saved = read_saved_tree(file);
+  const saved_tree_detail::Header& header = saved.header;
   const MeshUnits units{header.units, 1};
   if (mesh) check_mesh_units(units, *mesh, file);
   std::shared_ptr<const Model> model;
   with_volume(header.bv_name, [&]<class BV>(std::type_identity<BV>) {
     with_density(header.density_name, [&]<class D>(std::type_identity<D>) {
       if constexpr (DensityFor<D, BV>) {
-        Tree<BV, D> tree = load_tree_from_buffer<BV, D>(bytes, file.string());
+        Tree<BV, D> tree = load_tree_from_buffer<BV, D>(saved.bytes, file.string());
         if (mesh) tree = with_polygons(tree, *mesh, file);
         model = std::make_shared<TypedModel<BV, D>>(std::move(tree), units, 0.0, 0.0);
       } else {
