@@ -48,39 +48,38 @@ std::shared_ptr<const AdbModel> shared_adb_model(int grid, double tau) {
   return slot;
 }
 
-std::span<const ParamSpec> AdbDensity::parameters() {
+namespace adb_storage {
+
+std::span<const ParamSpec> parameters() {
   return kAdbParameters;
 }
 
-AdbDensity::Params AdbDensity::make_params(const ParamValues& values) {
-  Params params{static_cast<int>(parameter(values, "grid")), parameter(values, "tau")};
+AdbParams make_params(const ParamValues& values, std::string_view name) {
+  AdbParams params{static_cast<int>(parameter(values, "grid")), parameter(values, "tau")};
   try {
     (void)lb_for_tau(params.tau);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(std::string("adb: no LB value for tau = ") + parameter_text(params.tau) +
+    throw std::invalid_argument(std::string(name) + ": no LB value for tau = " + parameter_text(params.tau) +
                                 " (" + e.what() + ")");
   }
   return params;
 }
 
-AdbDensity::Storage AdbDensity::make_storage(const Params& params, std::vector<std::uint8_t> counts) {
-  const Params checked = density_params<AdbDensity>({{"grid", params.grid}, {"tau", params.tau}});
+AdbStorage make(const AdbParams& params, std::vector<std::uint8_t> counts, std::string_view name) {
+  const AdbParams checked =
+      make_params(resolve_parameters(parameters(), {{"grid", params.grid}, {"tau", params.tau}}, name), name);
   const int cells = checked.grid * checked.grid * checked.grid;
   if (std::any_of(counts.begin(), counts.end(), [&](std::uint8_t c) { return c > cells; }))
-    throw std::invalid_argument("adb: a possible-collision-cell count exceeds the grid's " +
+    throw std::invalid_argument(std::string(name) + ": a possible-collision-cell count exceeds the grid's " +
                                 std::to_string(cells) + " cells");
   return {checked, std::move(counts), shared_adb_model(checked.grid, checked.tau)};
 }
 
-std::string AdbDensity::describe(const Params& params) {
-  return "adb grid=" + std::to_string(params.grid) + " tau=" + parameter_text(params.tau);
+std::string describe(const AdbParams& params, std::string_view name) {
+  return std::string(name) + " grid=" + std::to_string(params.grid) + " tau=" + parameter_text(params.tau);
 }
 
-std::string AdbDensity::describe(const Storage& storage) {
-  return describe(storage.params);
-}
-
-std::vector<std::byte> AdbDensity::encode(const Storage& storage) {
+std::vector<std::byte> encode(const AdbStorage& storage) {
   std::vector<std::byte> out;
   out.reserve(kParamsBytes + storage.possible_collision_cells.size());
   put_le(out, static_cast<std::uint32_t>(storage.params.grid), 4);
@@ -90,25 +89,27 @@ std::vector<std::byte> AdbDensity::encode(const Storage& storage) {
   return out;
 }
 
-AdbDensity::Storage AdbDensity::decode(std::span<const std::byte> bytes, std::size_t node_count) {
+AdbStorage decode(std::span<const std::byte> bytes, std::size_t node_count, std::string_view name) {
   if (bytes.size() != kParamsBytes + node_count)
-    throw std::invalid_argument("adb: " + std::to_string(bytes.size()) + " bytes of annotation for " +
-                                std::to_string(node_count) + " nodes (expected " +
-                                std::to_string(kParamsBytes + node_count) + ")");
+    throw std::invalid_argument(std::string(name) + ": " + std::to_string(bytes.size()) +
+                                " bytes of annotation for " + std::to_string(node_count) +
+                                " nodes (expected " + std::to_string(kParamsBytes + node_count) + ")");
   const auto grid = get_le(bytes.data(), 4);
   const double tau = std::bit_cast<double>(get_le(bytes.data() + 4, 8));
   std::vector<std::uint8_t> counts(node_count);
   if (node_count) std::memcpy(counts.data(), bytes.data() + kParamsBytes, node_count);
   const ParamValues values{{"grid", grid > 1000 ? 1000.0 : double(grid)}, {"tau", tau}};
-  return make_storage(density_params<AdbDensity>(values), std::move(counts));
+  return make(make_params(resolve_parameters(parameters(), values, name), name), std::move(counts), name);
 }
 
-AdbDensity::Estimator AdbDensity::estimator(const Storage& a, const Storage& b) {
-  if (!a.model || !b.model) throw std::invalid_argument("adb: a tree carries no ADB annotation");
+void check_combinable(const AdbStorage& a, const AdbStorage& b, std::string_view name) {
+  if (!a.model || !b.model)
+    throw std::invalid_argument(std::string(name) + ": a tree carries no ADB annotation");
   if (!(a.params == b.params))
-    throw std::invalid_argument("adb: the trees were annotated with other parameters (" + describe(a) +
-                                " and " + describe(b) + ")");
-  return {a.model.get(), a.possible_collision_cells.data(), b.possible_collision_cells.data()};
+    throw std::invalid_argument(std::string(name) + ": the trees were annotated with other parameters (" +
+                                describe(a.params, name) + " and " + describe(b.params, name) + ")");
 }
+
+}  // namespace adb_storage
 
 }  // namespace bvhlab

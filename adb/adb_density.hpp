@@ -12,27 +12,49 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace bvhlab {
 
-struct AdbDensity {
-  struct Params {
-    int grid = 2;                 ///< cells per axis
-    double tau = kDefaultAdbTau;  ///< area threshold, fraction of the cell's mean face area
-    friend bool operator==(const Params&, const Params&) = default;
-  };
-  struct Storage {
-    Params params;
-    std::vector<std::uint8_t> possible_collision_cells;  ///< pc(V) per node, same index as the nodes
-    std::shared_ptr<const AdbModel> model;               ///< derived from params; shared per (g, tau)
-  };
+/// What every ADB density stores: the parameters and pc(V) per node. The variants differ only in the
+/// estimate they read from it (AdbRule, adb/model.hpp), so their saved bytes have one layout.
+struct AdbParams {
+  int grid = 2;                 ///< cells per axis
+  double tau = kDefaultAdbTau;  ///< area threshold, fraction of the cell's mean face area
+  friend bool operator==(const AdbParams&, const AdbParams&) = default;
+};
+struct AdbStorage {
+  AdbParams params;
+  std::vector<std::uint8_t> possible_collision_cells;  ///< pc(V) per node, same index as the nodes
+  std::shared_ptr<const AdbModel> model;               ///< derived from params; shared per (g, tau)
+};
 
-  static constexpr std::string_view name() { return "adb"; }
+/// The work shared by the ADB densities; `name` is the density's, for messages and descriptions.
+namespace adb_storage {
+std::span<const ParamSpec> parameters();
+AdbParams make_params(const ParamValues& values, std::string_view name);
+AdbStorage make(const AdbParams& params, std::vector<std::uint8_t> counts, std::string_view name);
+std::string describe(const AdbParams& params, std::string_view name);
+std::vector<std::byte> encode(const AdbStorage& storage);
+AdbStorage decode(std::span<const std::byte> bytes, std::size_t node_count, std::string_view name);
+/// Throws std::invalid_argument when the two trees were annotated with other parameters, or not at all.
+void check_combinable(const AdbStorage& a, const AdbStorage& b, std::string_view name);
+}  // namespace adb_storage
+
+/// An ADB density: the cell counts, read through `Variant::rule`. `Variant` names it: a struct with
+/// `static constexpr std::string_view name` and `static constexpr AdbRule rule`.
+template <class Variant>
+struct BasicAdbDensity {
+  using Params = AdbParams;
+  using Storage = AdbStorage;
+  static constexpr AdbRule rule = Variant::rule;
+
+  static constexpr std::string_view name() { return Variant::name; }
   static constexpr std::uint32_t version() { return 1; }
-  static std::span<const ParamSpec> parameters();
+  static std::span<const ParamSpec> parameters() { return adb_storage::parameters(); }
   /// Throws std::invalid_argument for a tau without an LB value.
-  static Params make_params(const ParamValues& values);
+  static Params make_params(const ParamValues& values) { return adb_storage::make_params(values, name()); }
 
   template <TreeVolume BV>
   static Storage annotate(const Bvh<BV>& bvh, const Params& params, const AnnotationContext& context,
@@ -52,12 +74,16 @@ struct AdbDensity {
 
   /// A storage from counts computed elsewhere (tests, decoding). Throws std::invalid_argument for a count
   /// above g^3 or bad parameters.
-  static Storage make_storage(const Params& params, std::vector<std::uint8_t> counts);
+  static Storage make_storage(const Params& params, std::vector<std::uint8_t> counts) {
+    return adb_storage::make(params, std::move(counts), name());
+  }
 
-  static std::string describe(const Storage& storage);
-  static std::string describe(const Params& params);
-  static std::vector<std::byte> encode(const Storage& storage);
-  static Storage decode(std::span<const std::byte> bytes, std::size_t node_count);
+  static std::string describe(const Storage& storage) { return describe(storage.params); }
+  static std::string describe(const Params& params) { return adb_storage::describe(params, name()); }
+  static std::vector<std::byte> encode(const Storage& storage) { return adb_storage::encode(storage); }
+  static Storage decode(std::span<const std::byte> bytes, std::size_t node_count) {
+    return adb_storage::decode(bytes, node_count, name());
+  }
   static std::size_t memory_bytes(const Storage& storage) { return storage.possible_collision_cells.size(); }
 
   /// e(i, box_a, j, box_b, overlap): the estimate for node i of A against node j of B.
@@ -67,12 +93,22 @@ struct AdbDensity {
     const std::uint8_t* pc_b;
     double operator()(std::uint32_t i, const Box& box_a, std::uint32_t j, const Box& box_b,
                       double overlap) const {
-      return model->estimate(box_a, box_b, overlap, pc_a[i], pc_b[j]);
+      return model->estimate<rule>(box_a, box_b, overlap, pc_a[i], pc_b[j]);
     }
   };
   /// Throws std::invalid_argument when the two trees were annotated with other parameters, or not at all.
-  static Estimator estimator(const Storage& a, const Storage& b);
+  static Estimator estimator(const Storage& a, const Storage& b) {
+    adb_storage::check_combinable(a, b, name());
+    return {a.model.get(), a.possible_collision_cells.data(), b.possible_collision_cells.data()};
+  }
 };
+
+/// The default ADB density: finer cells for differently sized nodes, and no count read as 0 (adb/model.hpp).
+struct SizedAdbVariant {
+  static constexpr std::string_view name = "adb";
+  static constexpr AdbRule rule = kAdbSizedRule;
+};
+using AdbDensity = BasicAdbDensity<SizedAdbVariant>;
 static_assert(ProbabilityDensity<AdbDensity>);
 
 /// Shorthand for tests and tools: the ADB-annotated tree of `bvh`.

@@ -12,6 +12,10 @@
 //     (centre R c + t, half-extents |R| h), and the same with the roles swapped; the smaller bound is used.
 //     It still over-estimates the true overlap of a rotated pair, which errs toward "collision" (false
 //     positives rather than false negatives).
+//   * Flat boxes: a node of polygons in one axis-aligned plane has a box of thickness 0, hence volume 0 and
+//     an overlap of 0 with anything: its estimate would be 0 while the volumes overlap. Each box is thickened
+//     to at least kMinRelativeThickness of its longest side before the overlap and the estimate see it; the
+//     overlap's share of the box, all the estimate uses of it, then stays that of the plane.
 //   * The estimate itself comes from the trees' density (adb/concept.hpp, ProbabilityDensity): for ADB,
 //     adb/model.hpp.
 #pragma once
@@ -56,6 +60,17 @@ struct AdbOptions {
 
 namespace detail {
 
+/// Thinnest side of a box the estimate sees, relative to its longest side (header comment, "Flat boxes").
+inline constexpr double kMinRelativeThickness = 1e-3;
+
+/// `box`, each side at least kMinRelativeThickness times its longest one (same centre).
+[[gnu::always_inline]] inline Box with_min_thickness(const Box& box) {
+  if (box.empty()) return box;
+  const Vec3 extent = box.extent();
+  const Vec3 grow = (Vec3::Constant(kMinRelativeThickness * extent.maxCoeff()) - extent).cwiseMax(0.0) * 0.5;
+  return {box.min - grow, box.max + grow};
+}
+
 /// Volume of `box` ∩ (`other` re-boxed through rotation/translation): an upper bound of the overlap.
 inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rotation,
                               const Mat3& abs_rotation, const Vec3& translation) {
@@ -98,7 +113,8 @@ class AdbHooks {
   [[gnu::always_inline]] double evaluate(const Pair& p) {
     if (!trees_.overlap(p)) return -1;
     ++trees_.counters.probability_evaluations;
-    const Box box_a = trees_.box_a(p), box_b = trees_.box_b(p);
+    const Box box_a = detail::with_min_thickness(trees_.box_a(p));
+    const Box box_b = detail::with_min_thickness(trees_.box_b(p));
     const double overlap = detail::overlap_volume(box_a, box_b, trees_.b_to_a, abs_rotation_);
     return estimate_(box_a, box_b, overlap, p.a, p.b);
   }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "adb/adb_density.hpp"
+#include "adb/adb_paper_density.hpp"
 #include "adb/tree.hpp"
 #include "traversal/strategies.hpp"
 #include "volumes/shipped.hpp"
@@ -33,7 +34,7 @@ using RegisteredVolumes = ShippedVolumes;
 using RegisteredVolumes = TypeList<Aabb, Obb>;
 #endif
 
-using RegisteredDensities = TypeList<NoDensity, AdbDensity
+using RegisteredDensities = TypeList<NoDensity, AdbDensity, AdbPaperDensity
 #ifdef BVHLAB_TEST_POLICIES
                                      ,
                                      testing::TriangleCountDensity

@@ -1,5 +1,6 @@
 // ADB strategies: guided exact equals exact; budgets are honoured; p_min behaves at its ends.
 #include "adb/adb_density.hpp"
+#include "adb/adb_paper_density.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/adb.hpp"
 #include "traversal/exact.hpp"
@@ -14,12 +15,12 @@ namespace bvhlab {
 namespace {
 
 // A crude stand-in annotation, independent of adb/annotate: pc = min(g^3, triangles below the node).
-template <int G, class BV = Aabb>
-Tree<BV, AdbDensity> crude_annotation(Bvh<BV> bvh, double tau) {
+template <int G, class BV = Aabb, class D = AdbDensity>
+Tree<BV, D> crude_annotation(Bvh<BV> bvh, double tau) {
   std::vector<std::uint8_t> counts;
   for (const auto& [begin, end] : node_triangle_ranges(bvh.nodes()))
     counts.push_back(static_cast<std::uint8_t>(std::min<std::uint32_t>(G * G * G, end - begin)));
-  return {std::move(bvh), AdbDensity::make_storage({G, tau}, std::move(counts))};
+  return {std::move(bvh), D::make_storage({G, tau}, std::move(counts))};
 }
 
 struct Scene {
@@ -98,8 +99,14 @@ TEST(AdbTraversal, PMinEnds) {
   EXPECT_FALSE(r1.exact);
 }
 
+// On the paper's rule (adb_paper), where leaf pairs of this scene stay below p_min often enough for the
+// option to matter; the default rule's estimates of small leaves are higher and seldom leave any evidence.
 TEST(AdbTraversal, CombiningLeafEvidenceOnlyAddsCollisionsAndNeverCostsMore) {
-  const Scene scene;
+  const Scene plain;
+  const struct {
+    Tree<Aabb, AdbPaperDensity> tree_a, tree_b;
+  } scene{crude_annotation<2, Aabb, AdbPaperDensity>(Bvh<Aabb>::build(plain.a), 0.5),
+          crude_annotation<2, Aabb, AdbPaperDensity>(Bvh<Aabb>::build(plain.b), 0.5)};
   std::mt19937_64 rng(37);
   int changed = 0;
   for (double p_min : {0.5, 0.9, 0.99})
@@ -162,34 +169,82 @@ Box cube(double side) {
   return {Vec3::Zero(), Vec3::Constant(side)};
 }
 
-TEST(AdbModel, EqualSizesReduceToThePaperCaseAndDifferentSizesScale) {
+TEST(AdbModel, EqualSizesReduceToThePaperCaseUnderBothRules) {
   const AdbModel model(2, 0.5);
   // Equal volumes fully overlapping: s = 8, s_A = pc_A, s_B = pc_B: exactly the table entry.
-  EXPECT_DOUBLE_EQ(model.estimate(cube(2), cube(2), 8.0, 3, 5), model.table().lookup(8, 3, 5));
+  EXPECT_DOUBLE_EQ(model.estimate<kAdbSizedRule>(cube(2), cube(2), 8.0, 3, 5), model.table().lookup(8, 3, 5));
+  EXPECT_DOUBLE_EQ(model.estimate<kAdbPaperRule>(cube(2), cube(2), 8.0, 3, 5), model.table().lookup(8, 3, 5));
   // Half overlap: s = 4, s_A = pc_A / 2.
-  EXPECT_DOUBLE_EQ(model.estimate(cube(2), cube(2), 4.0, 4, 2), model.table().lookup(4, 2, 1));
-  // B eight times smaller (cell side ratio 1/2) inside A: s = Vol(B) / c_A = 1 coarse cell; A's count is
-  // scaled by overlap / Vol(A) = 1/8, B's by the face-area ratio 1/4: s_a = 1, s_b = min(2, s) = 1.
-  EXPECT_DOUBLE_EQ(model.estimate(cube(2), cube(1), 1.0, 8, 8), model.table().lookup(1, 1, 1));
-  // Symmetric in the roles of A and B.
-  EXPECT_DOUBLE_EQ(model.estimate(cube(1), cube(2), 1.0, 8, 8), model.estimate(cube(2), cube(1), 1.0, 8, 8));
+  EXPECT_DOUBLE_EQ(model.estimate<kAdbSizedRule>(cube(2), cube(2), 4.0, 4, 2), model.table().lookup(4, 2, 1));
+  EXPECT_DOUBLE_EQ(model.estimate<kAdbPaperRule>(cube(2), cube(2), 4.0, 4, 2), model.table().lookup(4, 2, 1));
   // Fractional expected counts interpolate: halfway between the integer entries.
   const double mid = model.estimate(cube(2), cube(2), 8.0 * 0.75, 2, 2);  // s = 6, s_a = s_b = 1.5
   EXPECT_NEAR(mid,
               0.25 * (model.table().lookup(6, 1, 1) + model.table().lookup(6, 2, 1) +
                       model.table().lookup(6, 1, 2) + model.table().lookup(6, 2, 2)),
               1e-15);
-  // No possible collision cell on one side: probability 0.
-  EXPECT_EQ(model.estimate(cube(2), cube(2), 8.0, 0, 8), 0.0);
-  // Never outside [0, 1], never NaN, on a sweep including flat, tiny and huge boxes.
+}
+
+TEST(AdbModel, DifferentSizesMapOntoTheRulesCells) {
+  const AdbModel model(2, 0.5);
+  // B eight times smaller (cell side ratio 1/2) inside A, both full (pc = 8).
+  // Paper's rule, A's (coarser) cells: s = Vol(B) / c_A = 1; s_a = 8 * 1/8 = 1; s_b = 8 scaled down by the
+  // face-area ratio 1/4 = 2, capped at s = 1.
+  EXPECT_DOUBLE_EQ(model.estimate<kAdbPaperRule>(cube(2), cube(1), 1.0, 8, 8), model.table().lookup(1, 1, 1));
+  // Default rule, B's (finer) cells: s = Vol(B) / c_B = 8; s_b = 8; s_a = 8 * 1/8 scaled up by 4 = 4.
+  EXPECT_DOUBLE_EQ(model.estimate<kAdbSizedRule>(cube(2), cube(1), 1.0, 8, 8), model.table().lookup(8, 4, 8));
+  // A single cell of A's surface, B 100 times smaller inside it: the estimate falls like the size ratio
+  // under the default rule (s_a = pc_a / 100 = 0.01), like its square under the paper's (s_b = 8e-4).
+  const double sized = model.estimate<kAdbSizedRule>(cube(100), cube(1), 1.0, 1, 8);
+  EXPECT_NEAR(sized, 0.01 * model.table().lookup(8, 1, 8), 1e-15);
+  const double paper = model.estimate<kAdbPaperRule>(cube(100), cube(1), 1.0, 1, 8);
+  EXPECT_LT(paper, sized / 10);
+  // Symmetric in the roles of A and B.
+  for (int pa : {1, 3, 8})
+    for (int pb : {1, 5, 8}) {
+      EXPECT_DOUBLE_EQ(model.estimate<kAdbSizedRule>(cube(1), cube(2), 1.0, pa, pb),
+                       model.estimate<kAdbSizedRule>(cube(2), cube(1), 1.0, pb, pa));
+      EXPECT_DOUBLE_EQ(model.estimate<kAdbPaperRule>(cube(1), cube(2), 1.0, pa, pb),
+                       model.estimate<kAdbPaperRule>(cube(2), cube(1), 1.0, pb, pa));
+    }
+}
+
+TEST(AdbModel, AnEmptyCountIsZeroOnlyUnderThePapersRule) {
+  const AdbModel model(2, 0.5);
+  EXPECT_EQ(model.estimate<kAdbPaperRule>(cube(2), cube(2), 8.0, 0, 8), 0.0);
+  EXPECT_DOUBLE_EQ(model.estimate<kAdbSizedRule>(cube(2), cube(2), 8.0, 0, 8), model.table().lookup(8, 1, 8));
+  EXPECT_GT(model.estimate<kAdbSizedRule>(cube(2), cube(0.01), 1e-6, 0, 0), 0.0);
+  // No overlap is still 0: the volumes are apart.
+  EXPECT_EQ(model.estimate<kAdbSizedRule>(cube(2), cube(2), 0.0, 8, 8), 0.0);
+}
+
+TEST(AdbModel, NeverOutsideTheUnitIntervalOnExtremeBoxes) {
+  const AdbModel model(2, 0.5);
   const Box flat{Vec3::Zero(), Vec3(1, 1, 0)};
   for (const Box& a : {cube(0), cube(1e-300), flat, cube(1), cube(1e100)})
     for (double ov : {0.0, 1e-300, 0.5, 1.0, 1e300})
       for (int pa : {0, 1, 8})
         for (int pb : {0, 1, 8}) {
-          const double q = model.estimate(a, cube(1), ov, pa, pb);
+          const double q = model.estimate<kAdbSizedRule>(a, cube(1), ov, pa, pb);
           EXPECT_TRUE(q >= 0 && q <= 1) << a.max.x() << " " << ov << " " << pa << " " << pb << " -> " << q;
+          const double r = model.estimate<kAdbPaperRule>(a, cube(1), ov, pa, pb);
+          EXPECT_TRUE(r >= 0 && r <= 1) << a.max.x() << " " << ov << " " << pa << " " << pb << " -> " << r;
         }
+}
+
+// Two unit squares in axis planes, crossing: their AABB trees have flat boxes (thickness 0), whose overlap
+// volume is 0. The exact answer is "collision"; ADB must not answer it with the probability 0.
+TEST(AdbTraversal, FlatBoxesThatCrossGetAPositiveProbability) {
+  Mesh in_z{{Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(1, 1, 0), Vec3(-1, 1, 0)}, {{0, 1, 2}, {0, 2, 3}}, "in_z"};
+  Mesh in_x{{Vec3(0, -1, -1), Vec3(0, 1, -1), Vec3(0, 1, 1), Vec3(0, -1, 1)}, {{0, 1, 2}, {0, 2, 3}}, "in_x"};
+  const auto a = annotate_adb(Bvh<Aabb>::build(in_z), 2, 0.25);
+  const auto b = annotate_adb(Bvh<Aabb>::build(in_x), 2, 0.25);
+  ASSERT_TRUE(query_exact(a.bvh, b.bvh, RigidTransform::identity()).collides);
+  AdbOptions options;
+  options.p_min = 0.99;
+  const Result r = query_adb(a, b, RigidTransform::identity(), options);
+  EXPECT_GT(r.probability, 0.0);
+  EXPECT_FALSE(r.exact);
 }
 
 }  // namespace
