@@ -29,7 +29,7 @@ RunPlan plan_run(const Scene& scene) {
     if (usable) plan.pairs.push_back(&pair);
   }
   for (const HierarchySpec& h : scene.hierarchies) {
-    PlannedHierarchy planned{&h, scene.needs_density(h) ? scene.density : DensitySpec{}, {}};
+    PlannedHierarchy planned{&h, scene.needs_density(h) ? scene.density_of(h) : DensitySpec{}, {}};
     for (const StrategySpec& s : scene.strategies)
       if (scene.applies(s, h))
         for (const StrategyVariant& v : expand(s)) planned.variants.push_back(v);

@@ -156,9 +156,9 @@ std::pair<std::size_t, std::size_t> poses_inside(const WorkloadSpec& workload, d
 /// file's groups are the user's own: without quality distances in the scene, all its poses are used.
 QualityRange quality_range(const RunOutput& run) {
   const ReportSpec& spec = run.scene.report;
-  const bool pose_file = run.scene.workload.kind == WorkloadSpec::Kind::PoseFile;
+  const bool own_poses = run.scene.workload.kind != WorkloadSpec::Kind::Protocol;
   QualityRange out;
-  if (pose_file && !spec.quality_given) {
+  if (own_poses && !spec.quality_given) {
     out.text = "all poses";
     return out;
   }
@@ -173,7 +173,7 @@ QualityRange quality_range(const RunOutput& run) {
   out = {inside.front(), inside.back(), false, ""};
   out.text = inside.size() == 1 ? "distance " + fmt("%g", out.lo)
                                 : "distances " + fmt("%g", out.lo) + "–" + fmt("%g", out.hi);
-  if (pose_file) {
+  if (own_poses) {
     const auto [used, total] = poses_inside(run.scene.workload, out.lo, out.hi);
     out.text += " (" + std::to_string(used) + " of " + std::to_string(total) + " poses)";
   }
@@ -249,6 +249,12 @@ std::string workload_text(const Scene& scene) {
        << (normalised_units(scene) ? "Distances are in the normalised model's units (its longest side is 2)."
                                    : "Distances are in the scene's units (each object as listed above).")
        << "\n\n";
+  } else if (w.kind == WorkloadSpec::Kind::Random) {
+    md << "Workload: " << w.count << " random poses (seed " << w.seed << ") on " << pairs_text(scene)
+       << ": B's translation uniform in the box [" << fmt("%g", w.box_min.x()) << ", "
+       << fmt("%g", w.box_max.x()) << "] x [" << fmt("%g", w.box_min.y()) << ", " << fmt("%g", w.box_max.y())
+       << "] x [" << fmt("%g", w.box_min.z()) << ", " << fmt("%g", w.box_max.z())
+       << "] of A's frame, its rotation uniform. They form one group, filed under distance 0.\n\n";
   } else {
     md << "Workload: " << w.groups.size() << " pose groups from `" << w.pose_file.filename().string()
        << "` on " << pairs_text(scene)
@@ -261,6 +267,7 @@ std::string workload_text(const Scene& scene) {
 
 std::string distance_label(const Scene& scene) {
   if (scene.workload.kind == WorkloadSpec::Kind::PoseFile) return "pose group (the pose file's \"group\")";
+  if (scene.workload.kind == WorkloadSpec::Kind::Random) return "random poses (one group, filed under 0)";
   return normalised_units(scene) ? "distance d of B's centre (each model normalised: longest side 2)"
                                  : "distance d of B's centre (scene units)";
 }
@@ -280,6 +287,8 @@ void readme_header(std::ostream& md, const RunOutput& run) {
   if (scene.density.name != NoDensity::name())
     md << "Density annotation of the trees that need one: `" << scene.density.label()
        << "` (parameters in `bvhlab policies`; the ADB method in adb/README.md).\n\n";
+  for (const HierarchySpec& h : scene.hierarchies)
+    if (h.density) md << "Hierarchy `" << h.name << "` carries its own: `" << h.density->label() << "`.\n\n";
   md << "Times are per query, measured one by one with a steady clock (less its own cost, "
      << fmt("%.3f", stats.clock_overhead_us)
      << " µs, measured at the start of the run), all strategies on the same poses in one process.\n\n";

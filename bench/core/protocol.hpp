@@ -3,7 +3,10 @@
 
 #include "volumes/geometry.hpp"
 
+#include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <random>
 #include <vector>
 
 namespace bvhlab {
@@ -29,6 +32,29 @@ inline std::vector<RigidTransform> protocol_poses(double distance, int steps) {
   std::vector<RigidTransform> poses;
   poses.reserve(static_cast<std::size_t>(steps));
   for (int k = 0; k < steps; ++k) poses.push_back(protocol_pose(distance, k, steps));
+  return poses;
+}
+
+/// `count` poses of B in A's frame, drawn from `seed`: translation uniform in the box [lo, hi], rotation
+/// uniform over all rotations (a uniform unit quaternion, Shoemake's method). The same seed gives the same
+/// poses on every machine: the generator is std::mt19937_64 (its output is fixed by the standard) and the
+/// conversion to [0, 1) is written out here rather than left to a library's distribution.
+inline std::vector<RigidTransform> random_poses(std::uint64_t seed, int count, const Vec3& lo,
+                                                const Vec3& hi) {
+  std::mt19937_64 rng(seed);
+  auto unit = [&rng] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  std::vector<RigidTransform> poses;
+  poses.reserve(static_cast<std::size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    RigidTransform pose;
+    for (int axis = 0; axis < 3; ++axis) pose.translation[axis] = lo[axis] + (hi[axis] - lo[axis]) * unit();
+    const double u = unit(), turn_1 = 2 * std::numbers::pi * unit(), turn_2 = 2 * std::numbers::pi * unit();
+    const double r1 = std::sqrt(1 - u), r2 = std::sqrt(u);
+    const Eigen::Quaterniond q(r2 * std::cos(turn_2), r1 * std::sin(turn_1), r1 * std::cos(turn_1),
+                               r2 * std::sin(turn_2));
+    pose.rotation = q.normalized().toRotationMatrix();
+    poses.push_back(pose);
+  }
   return poses;
 }
 

@@ -283,6 +283,20 @@ bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec&
   return !spec.hierarchies.empty();
 }
 
+/// A strategy that needs a density must find one it accepts on every hierarchy it runs on.
+void check_densities(const Node& s, const Scene& scene, const StrategySpec& spec, const StrategyInfo& info) {
+  for (const HierarchySpec& h : scene.hierarchies) {
+    const std::string& density = scene.density_of(h).name;
+    if (!scene.applies(spec, h) || info.accepts(density)) continue;
+    std::string usable;
+    for (const std::string& d : info.densities) usable += (usable.empty() ? "\"" : ", \"") + d + "\"";
+    const std::string whose = h.density ? "hierarchy \"" + h.name + "\"'s" : "the scene's";
+    s.child("type").fail("\"" + spec.name + "\" needs a density it can estimate from (" + usable + "), " +
+                         whose + " is \"" + density +
+                         "\"; add \"annotation\": {\"type\": \"adb\", \"grid\": 2, \"tau\": 0.25}");
+  }
+}
+
 /// One entry of "strategies", checked against the strategy table; nullopt when it has nowhere to run.
 template <class Skipped>
 std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Skipped&& skipped) {
@@ -299,13 +313,7 @@ std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Sk
   if (info.budget == BudgetUse::Required || s.has("budgets"))
     spec.budgets = parse_budgets(s.child("budgets"));
   if (!parse_strategy_hierarchies(s, scene, spec, skipped)) return std::nullopt;
-  if (info.needs_density && !info.accepts(scene.density.name)) {
-    std::string usable;
-    for (const std::string& d : info.densities) usable += (usable.empty() ? "\"" : ", \"") + d + "\"";
-    s.child("type").fail("\"" + spec.name + "\" needs a density it can estimate from (" + usable +
-                         "), the scene's is \"" + scene.density.name +
-                         "\"; add \"annotation\": {\"type\": \"adb\", \"grid\": 2, \"tau\": 0.25}");
-  }
+  if (info.needs_density) check_densities(s, scene, spec, info);
   if (std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
                    [&](const HierarchySpec& h) { return scene.applies(spec, h); }))
     s.fail("\"" + spec.name + "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\" only)");
@@ -484,6 +492,10 @@ bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
   return !h.is_fcl() || s.name == ExactStrategy::name();
 }
 
+const DensitySpec& Scene::density_of(const HierarchySpec& h) const {
+  return h.density ? *h.density : density;
+}
+
 bool Scene::needs_density(const HierarchySpec& h) const {
   return std::any_of(strategies.begin(), strategies.end(), [&](const StrategySpec& s) {
     return strategy_info(s.name).needs_density && applies(s, h);
@@ -636,10 +648,32 @@ void parse_pairs(const Node& root, Scene& scene) {
   }
 }
 
+/// An "annotation" object: a registered density and its parameters.
+DensitySpec parse_density_spec(const Node& a) {
+  if (!a.value().is_object()) a.fail("expected an object; " + a.got());
+  DensitySpec density;
+  density.name = a.child("type").choice(density_names());
+  const DensityInfo& info = density_info(density.name);
+  std::vector<std::string> fields{"type"};
+  for (const ParamSpec& p : info.parameters) fields.emplace_back(p.name);
+  a.expect_object(fields);
+  ParamValues given;
+  for (const ParamSpec& p : info.parameters)
+    if (a.has(std::string(p.name)))
+      given[std::string(p.name)] = read_parameter(a.child(std::string(p.name)), p);
+  density.values = checked(a, [&] {
+    return with_density(density.name, [&]<class D>(std::type_identity<D>) {
+      (void)density_params<D>(given);  // the density's own checks, beyond each parameter's range
+      return resolve_parameters(D::parameters(), given, D::name());
+    });
+  });
+  return density;
+}
+
 /// One entry of "hierarchies"; nullopt (with a note in the scene) for an optional one this build lacks.
 std::optional<HierarchySpec> parse_hierarchy(const Node& h, const std::vector<std::string>& bv_names,
                                              Scene& scene) {
-  h.expect_object({"bv", "name", "split", "max_leaf_triangles", "optional"});
+  h.expect_object({"bv", "name", "split", "max_leaf_triangles", "optional", "annotation"});
   HierarchySpec spec;
   const bool optional = h.has("optional") && h.child("optional").boolean();
   const std::string bv = h.child("bv").string();
@@ -668,6 +702,10 @@ std::optional<HierarchySpec> parse_hierarchy(const Node& h, const std::vector<st
       h.child("max_leaf_triangles").fail("FCL builds its own hierarchy; this does not apply");
     spec.build.max_leaf_triangles = static_cast<std::uint32_t>(h.child("max_leaf_triangles").integer(1, 255));
   }
+  if (h.has("annotation")) {
+    if (spec.is_fcl()) h.child("annotation").fail("FCL hierarchies run \"exact\" only; no density applies");
+    spec.density = parse_density_spec(h.child("annotation"));
+  }
   return spec;
 }
 
@@ -680,26 +718,28 @@ void parse_hierarchies(const Node& root, Scene& scene) {
   if (scene.hierarchies.empty()) hierarchies.fail("no hierarchy is available in this build");
 }
 
-/// The density ("annotation"): a registered density and its parameters.
+/// The scene's density ("annotation").
 void parse_density(const Node& root, Scene& scene) {
-  if (!root.has("annotation")) return;
-  const Node a = root.child("annotation");
-  if (!a.value().is_object()) a.fail("expected an object; " + a.got());
-  scene.density.name = a.child("type").choice(density_names());
-  const DensityInfo& info = density_info(scene.density.name);
-  std::vector<std::string> fields{"type"};
-  for (const ParamSpec& p : info.parameters) fields.emplace_back(p.name);
-  a.expect_object(fields);
-  ParamValues given;
-  for (const ParamSpec& p : info.parameters)
-    if (a.has(std::string(p.name)))
-      given[std::string(p.name)] = read_parameter(a.child(std::string(p.name)), p);
-  scene.density.values = checked(a, [&] {
-    return with_density(scene.density.name, [&]<class D>(std::type_identity<D>) {
-      (void)density_params<D>(given);  // the density's own checks, beyond each parameter's range
-      return resolve_parameters(D::parameters(), given, D::name());
-    });
-  });
+  if (root.has("annotation")) scene.density = parse_density_spec(root.child("annotation"));
+}
+
+/// A density set where no strategy needs it would cost annotation time for nothing: refused, for the
+/// scene's (used by the hierarchies without their own) and for each hierarchy's own.
+void check_densities_needed(const Node& root, const Scene& scene) {
+  const Node hierarchies = root.child("hierarchies");
+  for (std::size_t i = 0, n = hierarchies.array_size(); i < n; ++i) {
+    const Node h = hierarchies.child(i);
+    if (!h.has("annotation")) continue;
+    const HierarchySpec* spec =
+        scene.hierarchy(h.has("name") ? h.child("name").string() : h.child("bv").string());
+    if (spec && spec->density && spec->density->name != NoDensity::name() && !scene.needs_density(*spec))
+      h.child("annotation").fail("a density is set but no strategy on this hierarchy needs it");
+  }
+  if (scene.density.name != NoDensity::name() &&
+      std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
+                   [&](const HierarchySpec& h) { return !h.density && scene.needs_density(h); }))
+    root.child("annotation")
+        .fail("a density is set but no strategy needs it (annotating would cost time for nothing)");
 }
 
 /// Whether the hierarchy of this name was optional and left out (a name may still be referred to).
@@ -723,11 +763,7 @@ void parse_strategies(const Node& root, Scene& scene) {
     }
     scene.strategies.push_back(std::move(*spec));
   }
-  if (scene.density.name != NoDensity::name() &&
-      std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
-                   [&](const HierarchySpec& h) { return scene.needs_density(h); }))
-    root.child("annotation")
-        .fail("a density is set but no strategy needs it (annotating would cost time for nothing)");
+  check_densities_needed(root, scene);
 }
 
 /// A "poses" workload: the pose file, read now, and its content as the workload's identity.
@@ -748,12 +784,38 @@ void parse_pose_file(const Node& w, const std::filesystem::path& base_dir, Workl
   workload.identity = "poses:" + ContentHash().update(text).hex();
 }
 
+/// A "random" workload: seeded poses in a box, one group filed under distance 0.
+void parse_random(const Node& w, WorkloadSpec& workload) {
+  w.expect_object({"type", "count", "seed", "box"});
+  workload.kind = WorkloadSpec::Kind::Random;
+  workload.count = static_cast<int>(w.child("count").integer(1, static_cast<long long>(limits::kSteps.max)));
+  workload.seed = static_cast<std::uint64_t>(w.has("seed") ? w.child("seed").integer(0, 1LL << 53) : 1);
+  const Node box = w.child("box");
+  if (!box.value().is_array() || box.value().size() != 2)
+    box.fail("expected [[x, y, z], [x, y, z]]; " + box.got());
+  const auto lo = box.child(0).numbers(3, -1e12, 1e12), hi = box.child(1).numbers(3, -1e12, 1e12);
+  workload.box_min = Vec3(lo[0], lo[1], lo[2]);
+  workload.box_max = Vec3(hi[0], hi[1], hi[2]);
+  if (!(workload.box_min.array() <= workload.box_max.array()).all())
+    box.fail("expected the box's lower corner first (each coordinate <= the upper corner's)");
+  workload.groups.push_back(
+      {0, random_poses(workload.seed, workload.count, workload.box_min, workload.box_max)});
+  char identity[256];
+  std::snprintf(identity, sizeof identity,
+                "random:count=%d:seed=%llu:box=%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", workload.count,
+                static_cast<unsigned long long>(workload.seed), lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+  workload.identity = identity;
+}
+
 void parse_workload(const Node& root, const std::filesystem::path& base_dir, WorkloadSpec& workload) {
   if (root.has("workload")) {
     const Node w = root.child("workload");
     if (!w.value().is_object()) w.fail("expected an object; " + w.got());
-    const bool protocol = !w.has("type") || w.child("type").choice({"protocol", "poses"}) == "protocol";
-    if (protocol) {
+    const std::string type =
+        w.has("type") ? w.child("type").choice({"protocol", "poses", "random"}) : "protocol";
+    if (type == "random") {
+      parse_random(w, workload);
+    } else if (type == "protocol") {
       w.expect_object({"type", "distances", "steps"});
       if (w.has("distances")) {
         workload.distances = w.child("distances").numbers(0, limits::kDistance.min, limits::kDistance.max);

@@ -72,18 +72,20 @@ struct ScenePair {
   [[nodiscard]] std::string label() const { return a == b ? a : a + "|" + b; }
 };
 
-struct HierarchySpec {
-  std::string name;  ///< label in reports; default: the BV name
-  std::string bv;    ///< a registered BV name, or fcl_obb / fcl_obbrss
-  BuildOptions build;
-  [[nodiscard]] bool is_fcl() const { return bv.rfind("fcl_", 0) == 0; }
-};
-
 /// The density the scene's trees carry ("annotation" in the file): a registered density and its parameters.
 struct DensitySpec {
   std::string name = "none";                ///< a registered density (bench/core/registry.hpp)
   ParamValues values;                       ///< resolved: every parameter, defaults filled in
   [[nodiscard]] std::string label() const;  ///< "none", "adb grid=2 tau=0.25"
+};
+
+struct HierarchySpec {
+  std::string name;  ///< label in reports; default: the BV name
+  std::string bv;    ///< a registered BV name, or fcl_obb / fcl_obbrss
+  BuildOptions build;
+  /// Its own "annotation", in place of the scene's: variants of a density compared in one run.
+  std::optional<DensitySpec> density;
+  [[nodiscard]] bool is_fcl() const { return bv.rfind("fcl_", 0) == 0; }
 };
 
 /// One entry of "strategies": a registered strategy with its given parameters; a sweep parameter may hold
@@ -116,11 +118,15 @@ struct PoseGroup {
 };
 
 struct WorkloadSpec {
-  enum class Kind { Protocol, PoseFile } kind = Kind::Protocol;
+  enum class Kind { Protocol, PoseFile, Random } kind = Kind::Protocol;
   std::vector<double> distances{0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0};
   int steps = 5000;
   std::filesystem::path pose_file;  ///< PoseFile only (resolved)
-  std::vector<PoseGroup> groups;    ///< the poses, generated or read while parsing
+  /// Random only: how many poses, the seed, and the box B's translation is drawn from.
+  int count = 0;
+  std::uint64_t seed = 0;
+  Vec3 box_min = Vec3::Zero(), box_max = Vec3::Zero();
+  std::vector<PoseGroup> groups;  ///< the poses, generated or read while parsing
   /// Identifies the pose set for the ground-truth cache (protocol parameters or the file's content hash).
   std::string identity;
 };
@@ -155,6 +161,8 @@ struct Scene {
   [[nodiscard]] const HierarchySpec* hierarchy(std::string_view name) const;
   /// Whether strategy `s` runs on hierarchy `h` (an FCL hierarchy only takes exact).
   [[nodiscard]] bool applies(const StrategySpec& s, const HierarchySpec& h) const;
+  /// The density `h`'s trees carry when a strategy on them needs one: its own, else the scene's.
+  [[nodiscard]] const DensitySpec& density_of(const HierarchySpec& h) const;
   /// Whether any strategy on `h` needs a density: only then are `h`'s trees annotated.
   [[nodiscard]] bool needs_density(const HierarchySpec& h) const;
 };

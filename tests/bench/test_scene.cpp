@@ -151,7 +151,8 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
        "/strategies/0/p_min/1: p_min must be a number in [0, 1], got 1.5"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "adb", "p_min": 0.9}])",
                   ""),
-       "/strategies/0/type: \"adb\" needs a density it can estimate from (\"adb\"), the scene's is \"none\""},
+       "/strategies/0/type: \"adb\" needs a density it can estimate from (\"adb\", \"adb_paper\"), the "
+       "scene's is \"none\""},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "fastest"}])"),
        "/strategies/0/type: expected one of exact, all_contacts, guided_exact, adb, time_critical"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
@@ -204,6 +205,90 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
     EXPECT_NE(message.find(c.expected), std::string::npos)
         << "scene: " << c.scene << "\nerror: " << message << "\nexpected to contain: " << c.expected;
   }
+}
+
+TEST_F(SceneTest, AHierarchyMayCarryItsOwnAnnotation) {
+  const Scene scene = parse(scene_with(
+      R"([{"mesh": "torus.obj"}])",
+      R"([{"bv": "aabb"}, {"bv": "aabb", "name": "paper", "annotation": {"type": "adb_paper", "grid": 3}}])",
+      R"([{"type": "adb", "p_min": 0.9}])"));
+  ASSERT_EQ(scene.hierarchies.size(), 2u);
+  EXPECT_EQ(scene.density_of(scene.hierarchies[0]).label(), "adb grid=2 tau=0.5");
+  EXPECT_EQ(scene.density_of(scene.hierarchies[1]).label(), "adb_paper grid=3 tau=0.25");
+}
+
+TEST_F(SceneTest, HierarchyAnnotationsAreCheckedLikeTheScenes) {
+  const std::vector<BadField> cases = {
+      {scene_with(R"([{"mesh": "torus.obj"}])",
+                  R"([{"bv": "aabb", "annotation": {"type": "adb", "grid": 9}}])"),
+       "/hierarchies/0/annotation/grid: grid must be an integer in [2, 4], got 9"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb", "annotation": {"type": "magic"}}])"),
+       "/hierarchies/0/annotation/type: expected one of none, adb, adb_paper"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "fcl_obb", "annotation": {"type": "adb"}}])",
+                  R"([{"type": "exact"}])", ""),
+       "/hierarchies/0/annotation: FCL hierarchies run \"exact\" only"},
+      {scene_with(R"([{"mesh": "torus.obj"}])",
+                  R"([{"bv": "aabb"}, {"bv": "obb", "annotation": {"type": "adb_paper"}}])",
+                  R"([{"type": "exact"}, {"type": "adb", "hierarchies": ["aabb"]}])"),
+       "/hierarchies/1/annotation: a density is set but no strategy on this hierarchy needs it"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb", "annotation": {"type": "adb_paper"}}])",
+                  R"([{"type": "adb"}])"),
+       "/annotation: a density is set but no strategy needs it"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb", "annotation": {"type": "none"}}])",
+                  R"([{"type": "adb"}])"),
+       "/strategies/0/type: \"adb\" needs a density it can estimate from (\"adb\", \"adb_paper\"), hierarchy "
+       "\"aabb\"'s is \"none\""},
+  };
+  for (const auto& c : cases) {
+    const std::string message = error_of(c.scene);
+    EXPECT_NE(message.find(c.expected), std::string::npos)
+        << "scene: " << c.scene << "\nerror: " << message << "\nexpected to contain: " << c.expected;
+  }
+}
+
+TEST_F(SceneTest, RandomPosesAreSeededAndInsideTheirBox) {
+  auto random_scene = [&](const std::string& workload) {
+    return parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                            R"("workload": )" + workload));
+  };
+  const Scene a =
+      random_scene(R"({"type": "random", "count": 200, "seed": 7, "box": [[-1, 0, 2], [1, 0.5, 3]]})");
+  const Scene same =
+      random_scene(R"({"type": "random", "count": 200, "seed": 7, "box": [[-1, 0, 2], [1, 0.5, 3]]})");
+  const Scene other =
+      random_scene(R"({"type": "random", "count": 200, "seed": 8, "box": [[-1, 0, 2], [1, 0.5, 3]]})");
+  ASSERT_EQ(a.workload.groups.size(), 1u);
+  const auto& poses = a.workload.groups[0].poses;
+  ASSERT_EQ(poses.size(), 200u);
+  Vec3 mean_row = Vec3::Zero();
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_TRUE((poses[k].translation.array() >= Vec3(-1, 0, 2).array()).all() &&
+                (poses[k].translation.array() <= Vec3(1, 0.5, 3).array()).all())
+        << poses[k].translation.transpose();
+    EXPECT_NO_THROW(poses[k].validate());
+    EXPECT_EQ(poses[k].rotation, same.workload.groups[0].poses[k].rotation);
+    mean_row += poses[k].rotation.row(0).transpose();
+  }
+  // Uniform rotations: the image of x has no preferred direction (mean near 0, not near a fixed axis).
+  EXPECT_LT((mean_row / 200.0).norm(), 0.2);
+  EXPECT_NE(a.workload.identity, other.workload.identity);
+  EXPECT_NE(poses[0].translation, other.workload.groups[0].poses[0].translation);
+  EXPECT_EQ(a.workload.identity, same.workload.identity);
+
+  EXPECT_NE(
+      error_of(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                          R"("workload": {"type": "random", "count": 5, "box": [[1, 0, 0], [0, 1, 1]]})"))
+          .find("/workload/box: expected the box's lower corner first"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                          R"("workload": {"type": "random", "count": 0, "box": [[0, 0, 0], [1, 1, 1]]})"))
+          .find("/workload/count: expected an integer in [1, "),
+      std::string::npos);
+  EXPECT_NE(error_of(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                                R"("workload": {"type": "random", "count": 3})"))
+                .find("/workload/box: missing"),
+            std::string::npos);
 }
 
 TEST_F(SceneTest, AdbRunsOnEveryRegisteredVolume) {
