@@ -25,11 +25,12 @@ struct SceneArgs {
 /// The runner's options for run and report, with --per-pose checked before any work starts.
 RunOptions scene_run_options(const SceneArgs& args) {
   RunOptions options = run_options(args.cache_dir, args.no_cache, args.quiet);
-  if (!args.per_pose.empty()) try {
-      options.per_pose = parse_per_pose(args.per_pose);
-    } catch (const std::invalid_argument& e) {
-      throw CLI::ValidationError("--per-pose", e.what());
-    }
+  if (args.per_pose.empty()) return options;
+  try {
+    options.per_pose = parse_per_pose(args.per_pose);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--per-pose", e.what());
+  }
   return options;
 }
 
@@ -160,11 +161,12 @@ void add_cache_and_quiet(CLI::App* sub, SceneArgs& args) {
   sub->add_flag("--no-cache", args.no_cache, "Neither read nor write the cache");
   sub->add_flag("-q,--quiet", args.quiet, "No progress bar or messages");
   sub->add_option(
-      "--per-pose", args.per_pose,
-      "Also write poses.csv, one row per query: 'all' of them, or only the 'wrong' ones (answer "
-      "differs from the ground truth). Each row has the series, the distance, the pose's index in "
-      "its group and the pose itself (paste its `pose` column into `bvhlab query --pose`), the truth, "
-      "the answer, probability, time and counters");
+         "--per-pose", args.per_pose,
+         "Also write poses.csv, one row per query: 'all' of them, or only the 'wrong' ones (answer "
+         "differs from the ground truth). Each row has the series, the distance, the pose's index in "
+         "its group and the pose itself (paste its `pose` column into `bvhlab query --pose`), the truth, "
+         "the answer, probability, time and counters")
+      ->type_name("all|wrong");
 }
 
 }  // namespace
