@@ -184,7 +184,8 @@ std::string pose_text(const RigidTransform& pose) {
     for (int j = 0; j < 4; ++j) {
       std::snprintf(buf, sizeof buf, "%.17g",
                     j < 3 ? double(pose.rotation(i, j)) : double(pose.translation[i]));
-      out += (out.empty() ? "" : ",") + std::string(buf);
+      if (!out.empty()) out += ',';
+      out += buf;
     }
   return out;
 }
