@@ -44,9 +44,10 @@ std::vector<TruthSummary> summarize_truth(const std::string& label, const Worklo
   return out;
 }
 
-void Aggregation::add_group(const PreparedPair& pair, const RunPlan& plan, const PoseGroup& group,
+void Aggregation::add_group(const PreparedPair& pair, const RunPlan& plan, std::size_t g,
                             const std::vector<std::uint8_t>& truth, const GroupRecords& records,
                             RunOutput& output) {
+  const PoseGroup& group = output.scene.workload.groups[g];
   for (std::size_t i = 0; i < plan.hierarchies.size(); ++i) {
     const HierarchySpec& h = *plan.hierarchies[i].hierarchy;
     const PreparedHierarchy& hierarchy = *pair.hierarchies[i];
@@ -59,6 +60,8 @@ void Aggregation::add_group(const PreparedPair& pair, const RunPlan& plan, const
         series_[key] = CalibrationBin{pair.label, h.name, row.strategy, row.budget, row.p_min};
         order_.push_back(key);
       }
+      if (per_pose_ != PerPose::none)
+        keep_poses(records[i][v], truth, g, output.rows.size(), hierarchy.has_counters(), output.poses);
       output.rows.push_back(row);
     }
   }
@@ -111,6 +114,18 @@ void Aggregation::tally(const std::vector<QueryRecord>& records, const std::vect
   }
   stats.queries += records.size();
   stats.query_seconds += sum_us * 1e-6;
+}
+
+void Aggregation::keep_poses(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,
+                             std::size_t g, std::size_t row, bool has_counters,
+                             std::vector<PoseRecord>& out) const {
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const QueryRecord& r = records[k];
+    const bool truly = truth[k] != 0;
+    if (per_pose_ == PerPose::wrong && r.collides == truly) continue;
+    out.push_back({row, g, k, truly, r.collides, r.exact, r.budget_exhausted, has_counters, r.probability,
+                   net_micros(r.micros, clock_overhead_us_), r.counters});
+  }
 }
 
 std::vector<CalibrationBin> Aggregation::calibration() const {

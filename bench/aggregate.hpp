@@ -20,11 +20,14 @@ std::vector<TruthSummary> summarize_truth(const std::string& label, const Worklo
 /// The aggregate stage of one run.
 class Aggregation {
  public:
-  /// Every query time is reduced by the clock's own cost (clamped at 0).
-  explicit Aggregation(double clock_overhead_us) : clock_overhead_us_(clock_overhead_us) {}
-  /// One row per planned series of the pair on pose group `group` (`truth`: its ground truth), appended to
-  /// output.rows in plan order; the queries and their time are added to output.stats.
-  void add_group(const PreparedPair& pair, const RunPlan& plan, const PoseGroup& group,
+  /// Every query time is reduced by the clock's own cost (clamped at 0). `per_pose` says which queries are
+  /// also kept one by one in RunOutput::poses.
+  explicit Aggregation(double clock_overhead_us, PerPose per_pose = PerPose::none)
+      : clock_overhead_us_(clock_overhead_us), per_pose_(per_pose) {}
+  /// One row per planned series of the pair on pose group `g` of the scene's workload (`truth`: its ground
+  /// truth), appended to output.rows in plan order; the queries and their time are added to output.stats,
+  /// and the queries per_pose asks for to output.poses.
+  void add_group(const PreparedPair& pair, const RunPlan& plan, std::size_t g,
                  const std::vector<std::uint8_t>& truth, const GroupRecords& records, RunOutput& output);
   /// Ten probability bins per inexact series, series in the order they first appeared.
   [[nodiscard]] std::vector<CalibrationBin> calibration() const;
@@ -41,7 +44,12 @@ class Aggregation {
   void tally(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,
              const std::string& series_key, bool has_counters, ResultRow& row, RunStats& stats);
 
+  /// The queries of one series that per_pose_ asks for, as rows of poses.csv for output row `row`.
+  void keep_poses(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,
+                  std::size_t g, std::size_t row, bool has_counters, std::vector<PoseRecord>& out) const;
+
   double clock_overhead_us_;
+  PerPose per_pose_;
   std::map<std::string, Bins> bins_;
   std::map<std::string, CalibrationBin> series_;  ///< what each binned series is, by key
   std::vector<std::string> order_;

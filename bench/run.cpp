@@ -56,6 +56,24 @@ RunOutput start_output(const Scene& scene) {
 
 }  // namespace
 
+PerPose parse_per_pose(std::string_view text) {
+  for (PerPose mode : {PerPose::none, PerPose::all, PerPose::wrong})
+    if (text == per_pose_name(mode)) return mode;
+  throw std::invalid_argument("expected one of none, all, wrong; got \"" + std::string(text) + "\"");
+}
+
+const char* per_pose_name(PerPose mode) {
+  switch (mode) {
+    case PerPose::all:
+      return "all";
+    case PerPose::wrong:
+      return "wrong";
+    case PerPose::none:
+      break;
+  }
+  return "none";
+}
+
 Environment detect_environment() {
   Environment env;
   std::string cpu;
@@ -106,15 +124,15 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
     }
 
   Measurement measurement(scene, plan, options, stats, log, threads);
-  Aggregation aggregation(stats.clock_overhead_us);
+  Aggregation aggregation(stats.clock_overhead_us, options.per_pose);
+  output.per_pose = options.per_pose;
   for (const ScenePair* scene_pair : plan.pairs) {
     const PreparedPair pair = preparation.pair(scene, *scene_pair, plan);
     const Truth truth = measurement.ground_truth(pair, preparation);
     for (const TruthSummary& summary : summarize_truth(pair.label, scene.workload, truth))
       output.truth.push_back(summary);
     for (std::size_t g = 0; g < scene.workload.groups.size(); ++g)
-      aggregation.add_group(pair, plan, scene.workload.groups[g], truth[g], measurement.time_group(pair, g),
-                            output);
+      aggregation.add_group(pair, plan, g, truth[g], measurement.time_group(pair, g), output);
   }
 
   output.calibration = aggregation.calibration();

@@ -5,6 +5,7 @@
 
 #include "adb/saved_tree.hpp"
 #include "bench/core/scene.hpp"
+#include "traversal/result.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -12,9 +13,17 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace bvhlab {
+
+/// Which per-pose records a run keeps (`bvhlab run/report --per-pose`): none (the default: nothing beyond
+/// the aggregates), every timed query, or only those whose answer differs from the ground truth.
+enum class PerPose { none, all, wrong };
+/// "none", "all" or "wrong"; throws std::invalid_argument naming the value and the choices otherwise.
+PerPose parse_per_pose(std::string_view text);
+const char* per_pose_name(PerPose mode);
 
 struct RunOptions {
   /// Root of the on-disk cache (trees/ and truth/ below it). Empty: nothing is read from or written to disk.
@@ -24,6 +33,7 @@ struct RunOptions {
   std::function<void(const std::string&)> log;
   unsigned threads = 0;    ///< preprocessing threads; 0: hardware concurrency
   int warmup_queries = 2;  ///< untimed queries before each timed block of poses (caches, branch predictors)
+  PerPose per_pose = PerPose::none;  ///< which queries RunOutput::poses keeps
 };
 
 /// Evidence of what the run did, for the "only what is needed" rule and the cache.
@@ -79,6 +89,18 @@ struct CalibrationBin {
   double collision_frequency = 0;  ///< fraction of the bin's queries that truly collide
 };
 
+/// One timed query of one series, kept when RunOptions::per_pose asks for it (a row of poses.csv).
+struct PoseRecord {
+  std::size_t row = 0;               ///< its series and distance: an index into RunOutput::rows
+  std::size_t group = 0, index = 0;  ///< its pose: scene.workload.groups[group].poses[index]
+  bool truth = false, answer = false;
+  bool exact = true, budget_exhausted = false;
+  bool has_counters = true;  ///< false for FCL models, which count nothing
+  double probability = 0;
+  double time_us = 0;  ///< net of the clock's own overhead, as results.csv's mean_time_us averages it
+  Counters counters;
+};
+
 /// A tree (or FCL model) the run used, with its preprocessing cost.
 struct ModelInfo {
   std::string object, hierarchy, bv, annotation;
@@ -113,6 +135,8 @@ struct RunOutput {
   std::vector<CalibrationBin> calibration;
   std::vector<ModelInfo> models;
   std::vector<TruthSummary> truth;
+  PerPose per_pose = PerPose::none;  ///< what `poses` holds
+  std::vector<PoseRecord> poses;     ///< in results order: per row, its poses in order
 };
 
 /// Runs a parsed scene. Throws for I/O and model errors; an optional object whose mesh is missing is

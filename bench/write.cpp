@@ -90,6 +90,50 @@ const std::vector<RowField>& row_fields() {
   return fields;
 }
 
+/// The record's pose, from the scene the run kept.
+const RigidTransform& pose_of(const RunOutput& run, const PoseRecord& p) {
+  return run.scene.workload.groups[p.group].poses[p.index];
+}
+json counter(const PoseRecord& p, std::uint64_t value) {
+  return p.has_counters ? json(value) : json(nullptr);
+}
+
+/// One column of poses.csv and one key of poses_document's objects. The series' fields come from its row.
+struct PoseField {
+  const char* name;
+  json (*value)(const RunOutput&, const PoseRecord&);
+};
+
+const std::vector<PoseField>& pose_fields() {
+  using R = const RunOutput&;
+  using P = const PoseRecord&;
+  static const std::vector<PoseField> fields{
+      {"mesh", [](R run, P p) { return json(run.rows[p.row].mesh); }},
+      {"hierarchy", [](R run, P p) { return json(run.rows[p.row].hierarchy); }},
+      {"bv", [](R run, P p) { return json(run.rows[p.row].bv); }},
+      {"strategy", [](R run, P p) { return json(run.rows[p.row].strategy); }},
+      {"label", [](R run, P p) { return json(run.rows[p.row].label); }},
+      {"p_min", [](R run, P p) { return optional_p_min(run.rows[p.row].p_min); }},
+      {"budget", [](R run, P p) { return json(run.rows[p.row].budget); }},
+      {"distance", [](R run, P p) { return json(run.rows[p.row].distance); }},
+      {"pose_index", [](R, P p) { return json(p.index); }},
+      {"pose", [](R run, P p) { return json(pose_text(pose_of(run, p))); }},
+      {"truth", [](R, P p) { return json(p.truth); }},
+      {"answer", [](R, P p) { return json(p.answer); }},
+      {"false_positive", [](R, P p) { return json(p.answer && !p.truth); }},
+      {"false_negative", [](R, P p) { return json(!p.answer && p.truth); }},
+      {"probability", [](R, P p) { return json(p.probability); }},
+      {"exact", [](R, P p) { return json(p.exact); }},
+      {"budget_exhausted", [](R, P p) { return json(p.budget_exhausted); }},
+      {"time_us", [](R, P p) { return json(p.time_us); }},
+      {"bv_tests", [](R, P p) { return counter(p, p.counters.bv_tests); }},
+      {"triangle_tests", [](R, P p) { return counter(p, p.counters.triangle_tests); }},
+      {"probability_evaluations", [](R, P p) { return counter(p, p.counters.probability_evaluations); }},
+      {"nodes_visited", [](R, P p) { return counter(p, p.counters.nodes_visited); }},
+  };
+  return fields;
+}
+
 std::string csv_value(const json& v) {
   if (v.is_null()) return "";
   if (v.is_string()) return csv_field(v.get<std::string>());
@@ -122,6 +166,52 @@ void write_results_csv(const RunOutput& run, const std::filesystem::path& file) 
         << csv_field(env.git_commit) << '\n';
   }
   if (!out) throw std::runtime_error(file.string() + ": write error");
+}
+
+const std::vector<std::string>& poses_csv_columns() {
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> out;
+    for (const PoseField& f : pose_fields()) out.emplace_back(f.name);
+    return out;
+  }();
+  return columns;
+}
+
+std::string pose_text(const RigidTransform& pose) {
+  std::string out;
+  char buf[32];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) {
+      std::snprintf(buf, sizeof buf, "%.17g",
+                    j < 3 ? double(pose.rotation(i, j)) : double(pose.translation[i]));
+      if (!out.empty()) out += ',';
+      out += buf;
+    }
+  return out;
+}
+
+void write_poses_csv(const RunOutput& run, const std::filesystem::path& file) {
+  std::ofstream out = open_output(file);
+  const auto& columns = poses_csv_columns();
+  for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
+  out << '\n';
+  for (const PoseRecord& p : run.poses) {
+    const auto& fields = pose_fields();
+    for (std::size_t i = 0; i < fields.size(); ++i)
+      out << (i ? "," : "") << csv_value(fields[i].value(run, p));
+    out << '\n';
+  }
+  if (!out) throw std::runtime_error(file.string() + ": write error");
+}
+
+json poses_document(const RunOutput& run) {
+  json out = json::array();
+  for (const PoseRecord& p : run.poses) {
+    json record = json::object();
+    for (const PoseField& f : pose_fields()) record[f.name] = f.value(run, p);
+    out.push_back(std::move(record));
+  }
+  return out;
 }
 
 void write_calibration_csv(const RunOutput& run, const std::filesystem::path& file) {

@@ -30,10 +30,16 @@ Scene scene_from(const py::object& scene) {
   return load_scene(file);
 }
 
-py::object run(const py::object& scene_argument, const py::object& cache, int threads, bool quiet) {
+py::object run(const py::object& scene_argument, const py::object& cache, int threads, bool quiet,
+               const std::string& per_pose) {
   if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
-  const Scene scene = scene_from(scene_argument);
   RunOptions options;
+  try {
+    options.per_pose = parse_per_pose(per_pose);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(std::string("per_pose: ") + e.what());
+  }
+  const Scene scene = scene_from(scene_argument);
   if (!cache.is_none()) options.cache_dir = path_argument(cache, "cache");
   options.threads = static_cast<unsigned>(threads);
   options.log = [quiet](const std::string& line) {
@@ -42,7 +48,9 @@ py::object run(const py::object& scene_argument, const py::object& cache, int th
   nlohmann::json document;
   {
     py::gil_scoped_release release;
-    document = results_document(run_scene(scene, options));
+    const RunOutput output = run_scene(scene, options);
+    document = results_document(output);
+    if (options.per_pose != PerPose::none) document["poses"] = poses_document(output);
   }
   return from_json(document);
 }
@@ -51,12 +59,14 @@ py::object run(const py::object& scene_argument, const py::object& cache, int th
 
 void bind_scenes(py::module_& m) {
   m.def("run_scene", &run, py::arg("scene"), py::kw_only(), py::arg("cache") = py::none(),
-        py::arg("threads") = 0, py::arg("quiet") = true,
+        py::arg("threads") = 0, py::arg("quiet") = true, py::arg("per_pose") = "none",
         "Runs a scene (a scene file, or a dict in the same format: bench/scenes/README.md) and returns what "
         "results.json holds: a dict with its rows (one per mesh pair, hierarchy, strategy variant and "
         "distance, keyed like the columns of results.csv), models, stats, ground truth and calibration. "
         "cache: a "
-        "folder for trees and ground truth (default: none); quiet=False prints the runner's messages.");
+        "folder for trees and ground truth (default: none); quiet=False prints the runner's messages; "
+        "per_pose=\"all\" or \"wrong\" adds \"poses\", the records of poses.csv (`bvhlab run --per-pose`), "
+        "one dict per query or per wrong answer.");
   m.def(
       "policies", [] { return from_json(policies_json()); },
       "The registered densities and strategies with their parameters (what `bvhlab policies` prints).");

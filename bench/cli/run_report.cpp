@@ -18,9 +18,26 @@ using Clock = std::chrono::steady_clock;
 
 /// The arguments of run and report (run has no --no-figures or --snippet).
 struct SceneArgs {
-  std::string scene_file, out_dir, cache_dir, snippet_file;
+  std::string scene_file, out_dir, cache_dir, snippet_file, per_pose;
   bool quiet = false, no_cache = false, no_figures = false;
 };
+
+/// The runner's options for run and report, with --per-pose checked before any work starts.
+RunOptions scene_run_options(const SceneArgs& args) {
+  RunOptions options = run_options(args.cache_dir, args.no_cache, args.quiet);
+  if (args.per_pose.empty()) return options;
+  try {
+    options.per_pose = parse_per_pose(args.per_pose);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--per-pose", e.what());
+  }
+  return options;
+}
+
+/// poses.csv, when --per-pose asked for it.
+void write_poses(const RunOutput& output, const fs::path& dir) {
+  if (output.per_pose != PerPose::none) write_poses_csv(output, dir / "poses.csv");
+}
 
 struct DemoArgs {
   std::string build_dir = BVHLAB_BINARY_DIR,
@@ -66,13 +83,14 @@ void fetch_missing_meshes(const Scene& scene) {
 }
 
 int run_command(const SceneArgs& args) {
+  const RunOptions options = scene_run_options(args);
   const Scene scene = load_scene(args.scene_file);
-  const RunOptions options = run_options(args.cache_dir, args.no_cache, args.quiet);
   const RunOutput output = run_scene(scene, options);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / scene.name : fs::path(args.out_dir);
   write_results_csv(output, dir / "results.csv");
   write_results_json(output, dir / "results.json");
   write_calibration_csv(output, dir / "calibration.csv");
+  write_poses(output, dir);
   if (!args.quiet) print_run_summary(output);
   std::printf("%s\n", fs::absolute(dir / "results.csv").c_str());
   return exit_status(output);
@@ -95,6 +113,7 @@ int run_report(const ReportJob& job) {
   ReportOptions report_options;
   report_options.figures = job.figures;
   const ReportFiles files = write_report(output, job.dir, report_options);
+  write_poses(output, files.dir);
   if (!job.snippet_file.empty()) {
     std::ofstream snippet(job.snippet_file, std::ios::trunc);
     snippet << report_snippet(output, files.dir);
@@ -113,8 +132,8 @@ int run_report(const ReportJob& job) {
 int report_command(const SceneArgs& args) {
   ReportJob job;
   job.start = Clock::now();
+  job.options = scene_run_options(args);
   job.scene = load_scene(args.scene_file);
-  job.options = run_options(args.cache_dir, args.no_cache, args.quiet);
   job.dir = args.out_dir;
   job.snippet_file = args.snippet_file;
   job.figures = !args.no_figures;
@@ -141,17 +160,28 @@ void add_cache_and_quiet(CLI::App* sub, SceneArgs& args) {
                   "Cache directory for trees and ground truth (default: <build>/cache)");
   sub->add_flag("--no-cache", args.no_cache, "Neither read nor write the cache");
   sub->add_flag("-q,--quiet", args.quiet, "No progress bar or messages");
+  sub->add_option(
+         "--per-pose", args.per_pose,
+         "Also write poses.csv, one row per query: 'all' of them, or only the 'wrong' ones (answer "
+         "differs from the ground truth). Each row has the series, the distance, the pose's index in "
+         "its group and the pose itself (paste its `pose` column into `bvhlab query --pose`), the truth, "
+         "the answer, probability, time and counters")
+      ->type_name("all|wrong");
 }
 
 }  // namespace
 
 Command add_run_command(CLI::App& app) {
   auto args = std::make_shared<SceneArgs>();
-  auto* run = app.add_subcommand("run", "Run a scene: results.csv, results.json and calibration.csv");
+  auto* run = app.add_subcommand(
+      "run", "Run a scene: results.csv, results.json and calibration.csv (and poses.csv with --per-pose)");
   run->add_option("SCENE", args->scene_file, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
   run->add_option("-o,--output", args->out_dir, "Output folder (default: results/<scene name>)");
   add_cache_and_quiet(run, *args);
-  run->footer("Example: bvhlab run bench/scenes/smoke.json -o /tmp/smoke");
+  run->footer(
+      "Examples:\n"
+      "  bvhlab run bench/scenes/smoke.json -o /tmp/smoke\n"
+      "  bvhlab run bench/scenes/smoke.json -o /tmp/smoke --per-pose wrong   # poses.csv: the wrong answers");
   return {run, [args] { return run_command(*args); }};
 }
 

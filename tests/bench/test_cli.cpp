@@ -243,5 +243,65 @@ TEST_F(Cli, PoseListsAreQueriedInOrder) {
                  "one of --pose, --protocol, --poses");
 }
 
+// ---------------------------------------------------------------------------------------------------------
+// Per-pose output
+
+// run and report write poses.csv only with --per-pose; a bad value is refused by name before any work.
+TEST_F(Cli, PerPoseIsWrittenOnlyWhenAsked) {
+  testing::write_text(dir / "s.json", R"({"objects": [{"mesh": "small.obj"}], "hierarchies": [{"bv": "aabb"}],
+      "strategies": [{"type": "exact"}], "workload": {"distances": [0.9, 1.2], "steps": 6},
+      "report": {"cgal_sample": 0}})");
+  expect_refused("run s.json -o none --per-pose some -q",
+                 "--per-pose: expected one of none, all, wrong; got \"some\"");
+  EXPECT_FALSE(std::filesystem::exists(dir / "none"));
+  ok("run s.json -o plain -q");
+  EXPECT_TRUE(std::filesystem::exists(dir / "plain" / "results.csv"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "plain" / "poses.csv"));
+  ok("run s.json -o all -q --per-pose all");
+  EXPECT_EQ(testing::read_csv(dir / "all" / "poses.csv").size(), 1u + 2 * 6);
+  ok("report s.json -o report -q --no-figures --per-pose wrong");
+  const auto wrong = testing::read_csv(dir / "report" / "poses.csv");  // exact answers: header only
+  ASSERT_EQ(wrong.size(), 1u);
+  EXPECT_EQ(wrong[0][9], "pose");
+}
+
+// The pose column pasted into `bvhlab query` (as a pose list, one per line as --pose takes it) gives the
+// run's answer for each series, and the exact strategy the truth.
+TEST_F(Cli, PosesOfPerPoseOutputQueryBackToTheSameAnswers) {
+  testing::write_obj(testing::make_torus(0.7, 0.25, 24, 12), dir / "torus.obj");
+  testing::write_text(dir / "s.json", R"({"objects": [{"mesh": "torus.obj"}], "hierarchies": [{"bv": "aabb"}],
+      "annotation": {"type": "adb"}, "strategies": [{"type": "exact"}, {"type": "adb", "p_min": 0.5}],
+      "workload": {"distances": [0.8, 1.4], "steps": 10}, "report": {"cgal_sample": 0}})");
+  ok("run s.json -o out -q --per-pose all");
+  const auto csv = testing::read_csv(dir / "out" / "poses.csv");
+  ASSERT_EQ(csv.size(), 1u + 2 * 2 * 10);
+  const auto& header = csv[0];
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  for (const std::string label : {"exact", "adb p_min=0.5"}) {
+    std::string list;
+    std::vector<const std::vector<std::string>*> rows;
+    for (std::size_t i = 1; i < csv.size(); ++i)
+      if (csv[i][col("label")] == label) {
+        list += csv[i][col("pose")] + "\n";
+        rows.push_back(&csv[i]);
+      }
+    testing::write_text(dir / "poses.txt", list);
+    const std::string strategy = label == "exact" ? "--strategy exact" : "--strategy adb --p-min 0.5";
+    const nlohmann::json j =
+        nlohmann::json::parse(ok("query torus.obj torus.obj --poses poses.txt --json " + strategy).out);
+    ASSERT_EQ(j["results"].size(), rows.size()) << label;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const auto& row = *rows[k];
+      EXPECT_EQ(j["results"][k]["collides"], row[col("answer")] == "1") << label << " " << k;
+      if (label == "exact") {
+        EXPECT_EQ(j["results"][k]["collides"], row[col("truth")] == "1") << k;
+      }
+      EXPECT_EQ(j["results"][k]["bv_tests"], std::stoull(row[col("bv_tests")])) << label << " " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace bvhlab

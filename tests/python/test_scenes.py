@@ -78,3 +78,24 @@ def test_the_rest_of_results_json(run):
     assert [s["name"] for s in run["policies"]["strategies"]] == bvhlab.strategies()
     assert [d["name"] for d in bvhlab.policies()["densities"]] == bvhlab.densities()
     assert np.isfinite([c["bin_low"] for c in run["calibration"]]).all()
+
+
+def test_per_pose_records(gear, gear_file):
+    with pytest.raises(ValueError, match='per_pose: expected one of none, all, wrong; got "some"'):
+        bvhlab.run_scene(scene(gear_file), per_pose="some")
+    assert "poses" not in bvhlab.run_scene(scene(gear_file))
+    everything = bvhlab.run_scene(scene(gear_file), per_pose="all")
+    poses = everything["poses"]
+    assert len(poses) == sum(r["queries"] for r in everything["rows"])
+    trees = {bv: bvhlab.Tree(gear, bv, "adb") for bv in ("aabb", "obb")}
+    for record in poses[::7]:  # the pose column is [R | t] row by row: a 4 x 4 matrix less its last row
+        matrix = np.vstack([np.array([float(x) for x in record["pose"].split(",")]).reshape(3, 4), [0, 0, 0, 1]])
+        params = {"p_min": record["p_min"]} if record["strategy"] == "adb" else {}
+        tree = trees[record["bv"]]
+        assert bvhlab.query(tree, tree, matrix, strategy=record["strategy"], **params).collides == \
+            record["answer"], record
+        assert bvhlab.query(tree, tree, matrix).collides == record["truth"], record
+    wrong = bvhlab.run_scene(scene(gear_file), per_pose="wrong")
+    errors = sum(round((r["fp_rate"] + r["fn_rate"]) * r["queries"]) for r in wrong["rows"])
+    assert len(wrong["poses"]) == errors > 0
+    assert all(p["answer"] != p["truth"] and p["false_positive"] != p["false_negative"] for p in wrong["poses"])
