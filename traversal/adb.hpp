@@ -212,6 +212,7 @@ class AdbHooks {
 template <TreeVolume BV, ProbabilityDensity D>
 Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
                  const AdbOptions& options) {
+  BudgetLimit limit(options.budget);  // a deadline counts from here, set-up included
   options.validate();
   b_to_a.validate();
   const auto estimate = D::estimator(a.density, b.density);  // throws for incompatible annotations
@@ -219,15 +220,18 @@ Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransfor
     throw std::invalid_argument("adb: guided exact needs trees with polygons");
 
   Result result;
-  if (a.bvh.empty() || b.bvh.empty()) return result;
-  BudgetLimit limit(options.budget);
-  const auto context = VolumeWalker<BV>::make_context(b_to_a);
-  const TreePair<BV> trees(a.bvh, b.bvh, b_to_a, context, result.counters);
-  // The probability model: the only place the traversal reads it.
-  const auto node_estimate = [&](const Box& box_a, const Box& box_b, double overlap, std::uint32_t i,
-                                 std::uint32_t j) { return estimate(i, box_a, j, box_b, overlap); };
-  AdbHooks<BV, decltype(node_estimate)> hooks(trees, result, options, node_estimate);
-  traverse<BestFirst, SplitBoth>(trees, hooks, limit);
+  if (!a.bvh.empty() && !b.bvh.empty()) {
+    const auto context = VolumeWalker<BV>::make_context(b_to_a);
+    const TreePair<BV> trees(a.bvh, b.bvh, b_to_a, context, result.counters);
+    // The probability model: the only place the traversal reads it.
+    const auto node_estimate = [&](const Box& box_a, const Box& box_b, double overlap, std::uint32_t i,
+                                   std::uint32_t j) { return estimate(i, box_a, j, box_b, overlap); };
+    AdbHooks<BV, decltype(node_estimate)> hooks(trees, result, options, node_estimate);
+    traverse<BestFirst, SplitBoth>(trees, hooks, limit);  // frees its queue before it returns
+  }
+  // The loop reads the clock before each pop, so it misses a deadline that passed during the last step
+  // (a decision, the last pair). Such an answer stands but came late: it is flagged too.
+  if (!result.budget_exhausted && limit.deadline_passed()) result.budget_exhausted = true;
   return result;
 }
 

@@ -37,7 +37,10 @@ struct Result {
   double probability = 0;
   /// True when the answer is decided by exact triangle tests (or by exhausting all overlapping pairs).
   bool exact = true;
-  /// True when a time or BV-test budget ran out and the answer is a best effort.
+  /// True when the deadline or the BV-test cap was reached before the traversal finished. Stopped by it,
+  /// the answer is a best effort (not exact). A traversal that finished (queue empty, or a pair decided) in
+  /// the step during which its deadline passed keeps its answer, which may be exact, and is flagged all the
+  /// same: it came late. A BV-test cap flags only a traversal it stopped.
   bool budget_exhausted = false;
   std::optional<TrianglePair> witness;  ///< set by exact strategies when collides
   std::vector<TrianglePair> contacts;   ///< all-contacts mode only

@@ -270,7 +270,9 @@ void print_answer(const PoseAnswer& answer, bool all_contacts, bool counters) {
   const Result& r = answer.result;
   std::printf("  collides          %s\n  probability       %g\n  exact             %s\n",
               r.collides ? "yes" : "no", r.probability, r.exact ? "yes" : "no");
-  if (r.budget_exhausted) std::printf("  budget            exhausted (best-effort answer)\n");
+  if (r.budget_exhausted)
+    std::printf(
+        "  budget            exhausted (deadline or BV-test cap reached before the traversal finished)\n");
   if (r.witness)
     std::printf("  witness           triangle %u of A, triangle %u of B\n", r.witness->a, r.witness->b);
   if (all_contacts) {

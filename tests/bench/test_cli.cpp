@@ -175,6 +175,23 @@ TEST_F(Cli, ValuesAreCheckedBeforeWorkStarts) {
 }
 
 // The LB table starts at tau = 0 (every cell with some area counts); it is a value like any other.
+// A deadline that has passed before the query could finish (a picosecond) is reported, in text and JSON,
+// whether the traversal was stopped or ended late; a deadline never reached is not.
+TEST_F(Cli, AnExhaustedDeadlineIsReported) {
+  for (const char* pose : {"0.5,0,0", "0.9,0.1,0,1,1,0,30", "20,0,0"}) {
+    const std::string query =
+        std::string("query small.obj small.obj --pose ") + pose + " --strategy time_critical";
+    const Outcome text = ok(query + " --deadline-us 1e-6");
+    EXPECT_NE(text.out.find("budget            exhausted"), std::string::npos) << pose << "\n" << text.out;
+    EXPECT_TRUE(
+        nlohmann::json::parse(ok(query + " --deadline-us 1e-6 --json").out)["budget_exhausted"].get<bool>())
+        << pose;
+    EXPECT_FALSE(
+        nlohmann::json::parse(ok(query + " --deadline-us 1e9 --json").out)["budget_exhausted"].get<bool>())
+        << pose;
+  }
+}
+
 TEST_F(Cli, TauZeroIsAccepted) {
   const Outcome built = ok("build small.obj --adb --tau 0 -o zero.tree");
   EXPECT_NE(built.out.find("adb grid=2 tau=0"), std::string::npos) << built.out;

@@ -286,17 +286,19 @@ TEST(Driver, ABudgetOfBvTestsStopsItExactlyAndKeepsTheUnexpandedPair) {
   EXPECT_EQ(hooks.ended, Ended::QueueEmpty);
 }
 
-TEST(Driver, ADeadlineIsCheckedEverySixteenPops) {
+TEST(Driver, ADeadlineIsCheckedBeforeEveryPop) {
   const Scene scene;
   const RigidTransform pose = RigidTransform::translate(Vec3(0.6, 0.1, 0));
   Counters unlimited;
   record<SplitLarger, false>(scene.tree_a, scene.tree_b, pose, unlimited);
   ASSERT_GT(unlimited.nodes_visited, 16u);
   Counters counters;
-  // A deadline long past by the first check (a nanosecond after the start).
+  // A deadline long past by the first check (a nanosecond after the start): the root was tested before the
+  // loop, and the check before the first pop ends it.
   const auto hooks = record<SplitLarger, false>(scene.tree_a, scene.tree_b, pose, counters,
                                                 BudgetLimit(Budget{.max_bv_tests = 0, .deadline_us = 1e-3}));
-  EXPECT_EQ(counters.nodes_visited, 15u);
+  EXPECT_EQ(counters.nodes_visited, 0u);
+  EXPECT_EQ(counters.bv_tests, 1u);
   EXPECT_EQ(hooks.ended, Ended::BudgetExhausted);
   EXPECT_GE(hooks.left_in_queue, 1u);
 }

@@ -1,0 +1,174 @@
+// Deadlines of the time-critical strategy: how far past its deadline a warm query returns. ADB trees (g = 2)
+// of a protocol mesh against themselves, on the protocol poses whose unbudgeted ADB query is long (at least
+// --min-pops node pairs at p_min 0.9), each query run once untimed and then timed alone with steady_clock.
+// Per (mesh, BV, deadline): median, p99 and max of those per-query times, and the share flagged
+// budget_exhausted. Two more series on the same poses give the cost of the deadline checks: no budget, and a
+// deadline never reached (1e9 us), whose time per query differs only by the clock reads.
+//
+//   bench_deadline [--meshes=injector_pipes.stl] [--bv=aabb,obb] [--deadlines=2,5,10,20]
+//                  [--distances=1.2,1.4,1.6,1.8] [--steps=500] [--min-pops=40] [benchmark flags]
+#include "adb/adb_density.hpp"
+#include "bench/core/arguments.hpp"
+#include "bench/core/mesh_catalog.hpp"
+#include "bench/core/protocol.hpp"
+#include "bench/core/registry.hpp"
+#include "traversal/adb.hpp"
+
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// The value at quantile q of sorted `v` (nearest rank).
+double quantile(const std::vector<double>& v, double q) {
+  const auto rank = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(rank, v.size() - 1)];
+}
+
+/// Context switches of this thread so far, voluntary or not.
+long context_switches() {
+  rusage usage{};
+  getrusage(RUSAGE_THREAD, &usage);
+  return usage.ru_nvcsw + usage.ru_nivcsw;
+}
+
+/// Times every pose warm (one untimed query, then one timed), once per benchmark iteration.
+template <class BV>
+void run_deadline(benchmark::State& state, const Tree<BV, AdbDensity>& tree,
+                  const std::vector<RigidTransform>& poses, const AdbOptions& options) {
+  std::vector<double> micros, undisturbed;
+  std::size_t flagged = 0;
+  bool sink = false;
+  for (auto _ : state) {
+    for (const RigidTransform& pose : poses) {
+      sink ^= query_adb(tree, tree, pose, options).collides;  // warms the caches for this pose
+      const long switches = context_switches();
+      const auto start = Clock::now();
+      const Result r = query_adb(tree, tree, pose, options);
+      const auto stop = Clock::now();
+      const double us = std::chrono::duration<double, std::micro>(stop - start).count();
+      micros.push_back(us);
+      if (context_switches() == switches) undisturbed.push_back(us);
+      flagged += r.budget_exhausted;
+      sink ^= r.collides;
+    }
+  }
+  benchmark::DoNotOptimize(sink);
+  std::sort(micros.begin(), micros.end());
+  std::sort(undisturbed.begin(), undisturbed.end());
+  // Queries during which the thread was switched out (another process took the core) count in p99_us but
+  // not in p99_undisturbed_us: the difference is the machine's load, not the deadline check.
+  state.counters["switched"] =
+      1 - static_cast<double>(undisturbed.size()) / static_cast<double>(micros.size());
+  if (!undisturbed.empty()) state.counters["p99_undisturbed_us"] = quantile(undisturbed, 0.99);
+  double mean = 0;
+  for (double t : micros) mean += t;
+  state.counters["mean_us"] = mean / static_cast<double>(micros.size());
+  state.counters["median_us"] = quantile(micros, 0.5);
+  state.counters["p99_us"] = quantile(micros, 0.99);
+  state.counters["max_us"] = micros.back();
+  state.counters["flagged"] = static_cast<double>(flagged) / static_cast<double>(micros.size());
+  state.counters["poses"] = static_cast<double>(poses.size());
+  if (options.budget.deadline_us > 0 && options.budget.deadline_us < 1e9)
+    state.counters["p99_over_us"] = quantile(micros, 0.99) - options.budget.deadline_us;
+}
+
+struct Setup {
+  std::vector<double> deadlines{2, 5, 10, 20};
+  std::vector<double> distances{1.2, 1.4, 1.6, 1.8};
+  int steps = 500;
+  std::uint64_t min_pops = 40;
+};
+
+template <class BV>
+void register_mesh(const std::string& label, const Mesh& mesh, const Setup& setup) {
+  auto tree = std::make_shared<const Tree<BV, AdbDensity>>(annotate_adb(Bvh<BV>::build(mesh), 2));
+  auto poses = std::make_shared<std::vector<RigidTransform>>();
+  AdbOptions unbudgeted;
+  unbudgeted.p_min = 0.9;
+  for (double d : setup.distances)
+    for (const RigidTransform& pose : protocol_poses(d, setup.steps))
+      if (query_adb(*tree, *tree, pose, unbudgeted).counters.nodes_visited >= setup.min_pops)
+        poses->push_back(pose);
+  std::fprintf(stderr, "bench_deadline: %s on %s: %zu long poses (>= %ju node pairs)\n", label.c_str(),
+               std::string(BV::name()).c_str(), poses->size(), std::uintmax_t(setup.min_pops));
+  if (poses->empty()) return;
+  auto add = [&](const std::string& series, const AdbOptions& options) {
+    const std::string name = label + "/" + std::string(BV::name()) + "/" + series;
+    benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& state) {
+      run_deadline(state, *tree, *poses, options);
+    })->Unit(benchmark::kMillisecond);
+  };
+  add("no_budget", unbudgeted);
+  AdbOptions never = unbudgeted;
+  never.budget.deadline_us = 1e9;
+  add("deadline_never_reached", never);
+  for (double deadline : setup.deadlines) {
+    AdbOptions options = unbudgeted;
+    options.budget.deadline_us = deadline;
+    char series[64];
+    std::snprintf(series, sizeof series, "deadline_us:%g", deadline);
+    add(series, options);
+  }
+}
+
+}  // namespace
+}  // namespace bvhlab
+
+int main(int argc, char** argv) {
+  using namespace bvhlab;
+  benchmark::Initialize(&argc, argv);
+  std::vector<std::string> meshes{"injector_pipes.stl"};
+  std::vector<std::string> volumes{"aabb", "obb"};
+  Setup setup;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      auto value = [&](const char* prefix) { return arg.substr(std::string(prefix).size()); };
+      if (arg.rfind("--meshes=", 0) == 0)
+        meshes = split_list(value("--meshes="));
+      else if (arg.rfind("--bv=", 0) == 0)
+        volumes = split_list(value("--bv="));
+      else if (arg.rfind("--deadlines=", 0) == 0)
+        setup.deadlines = split_numbers(value("--deadlines="));
+      else if (arg.rfind("--distances=", 0) == 0)
+        setup.distances = split_numbers(value("--distances="));
+      else if (arg.rfind("--steps=", 0) == 0)
+        setup.steps = std::stoi(value("--steps="));
+      else if (arg.rfind("--min-pops=", 0) == 0)
+        setup.min_pops = std::stoull(value("--min-pops="));
+      else
+        throw std::invalid_argument("unknown argument '" + arg + "'");
+    }
+    if (setup.steps < 1) throw std::invalid_argument("--steps must be at least 1");
+    for (double d : setup.deadlines)
+      if (!(d > 0 && d < 1e9)) throw std::invalid_argument("--deadlines must lie in (0, 1e9) microseconds");
+    for (const auto& file : meshes) {
+      if (!find_mesh(file)) {
+        std::fprintf(stderr, "bench_deadline: skipping %s (not found; run meshes/fetch.sh)\n", file.c_str());
+        continue;
+      }
+      const Mesh mesh = load_protocol_mesh(file);
+      const std::string label = std::filesystem::path(file).stem().string();
+      for (const auto& v : volumes)
+        with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_mesh<BV>(label, mesh, setup); });
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_deadline: %s\n", e.what());
+    return 2;
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
