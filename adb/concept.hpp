@@ -41,6 +41,10 @@
 //                                   upper bound of the volume of their overlap. Called on the hot path: it
 //                                   must be cheap and inlineable. Throws std::invalid_argument, when
 //                                   created, for two annotations that cannot be combined (other parameters).
+//   D::estimator(storage_a, storage_b, rotation)   (optional)
+//                                   The same for a density whose estimate depends on the pair's relative
+//                                   orientation ("adb_normal"): rotation maps B's frame into A's. The ADB
+//                                   traversal calls this form when D has it.
 #pragma once
 
 #include "../bvh/bvh.hpp"

@@ -215,7 +215,14 @@ Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransfor
   BudgetLimit limit(options.budget);  // a deadline counts from here, set-up included
   options.validate();
   b_to_a.validate();
-  const auto estimate = D::estimator(a.density, b.density);  // throws for incompatible annotations
+  // A density whose estimate depends on the pair's relative rotation takes it (throws for incompatible
+  // annotations).
+  const auto estimate = [&] {
+    if constexpr (requires { D::estimator(a.density, b.density, b_to_a.rotation); })
+      return D::estimator(a.density, b.density, b_to_a.rotation);
+    else
+      return D::estimator(a.density, b.density);
+  }();
   if (options.exact_leaves && (!a.bvh.has_polygons() || !b.bvh.has_polygons()))
     throw std::invalid_argument("adb: guided exact needs trees with polygons");
 

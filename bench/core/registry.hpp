@@ -4,6 +4,7 @@
 #pragma once
 
 #include "adb/adb_density.hpp"
+#include "adb/adb_normal_density.hpp"
 #include "adb/adb_paper_density.hpp"
 #include "adb/tree.hpp"
 #include "traversal/strategies.hpp"
@@ -34,7 +35,7 @@ using RegisteredVolumes = ShippedVolumes;
 using RegisteredVolumes = TypeList<Aabb, Obb>;
 #endif
 
-using RegisteredDensities = TypeList<NoDensity, AdbDensity, AdbPaperDensity
+using RegisteredDensities = TypeList<NoDensity, AdbDensity, AdbPaperDensity, AdbNormalDensity
 #ifdef BVHLAB_TEST_POLICIES
                                      ,
                                      testing::TriangleCountDensity
