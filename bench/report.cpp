@@ -122,6 +122,27 @@ std::vector<SeriesSummary> summarize(const std::vector<ResultRow>& rows, double 
   return out;
 }
 
+std::vector<FrontPoint> error_time_front(const std::vector<SeriesSummary>& series, double max_error) {
+  std::vector<FrontPoint> out;
+  auto faster = [](const std::optional<SeriesSummary>& best, const SeriesSummary& s) {
+    return !best || s.mean_time_us < best->mean_time_us;
+  };
+  for (const SeriesSummary& s : series) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const FrontPoint& f) { return f.mesh == s.mesh; });
+    if (it == out.end()) it = out.insert(out.end(), FrontPoint{s.mesh, {}, {}, 0});
+    if (!(s.mean_time_us >= 0)) continue;
+    if (s.exact_strategy) {
+      if (faster(it->fastest_exact, s)) it->fastest_exact = s;
+    } else if (s.fp_rate + s.fn_rate <= max_error + 1e-12 && faster(it->fastest_inexact, s)) {
+      it->fastest_inexact = s;
+    }
+  }
+  for (FrontPoint& f : out)
+    if (f.fastest_exact && f.fastest_inexact && f.fastest_inexact->mean_time_us > 0)
+      f.speedup = f.fastest_exact->mean_time_us / f.fastest_inexact->mean_time_us;
+  return out;
+}
+
 namespace {
 
 /// Every distance a row has, in order.
@@ -349,6 +370,32 @@ void readme_summary(std::ostream& md, const RunOutput& run, const QualityRange& 
         "the mean is the robust figure. FCL exposes no work counters (n/a).\n\n";
 }
 
+/// The fastest inexact series within 4% wrong answers against the fastest exact one, per mesh pair.
+void readme_front(std::ostream& md, const RunOutput& run, const QualityRange& range) {
+  const auto front = error_time_front(summarize(run.rows, range.lo, range.hi), kFrontMaxError);
+  if (std::none_of(front.begin(), front.end(),
+                   [](const FrontPoint& f) { return f.fastest_exact.has_value(); }))
+    return;
+  const std::string bound = percent(kFrontMaxError) + "%";
+  md << "## Against the fastest exact hierarchy\n\nOver " << range.text
+     << ": the fastest exact series, and the fastest inexact one with at most " << bound
+     << " wrong answers (FP + FN).\n\n"
+     << "| mesh | fastest exact | µs | fastest inexact within " << bound
+     << " | µs | FP % | FN % | speed-up |\n|---|---|---:|---|---:|---:|---:|---:|\n";
+  for (const FrontPoint& f : front) {
+    if (!f.fastest_exact) continue;
+    md << "| " << f.mesh << " | " << f.fastest_exact->hierarchy << " " << f.fastest_exact->label << " | "
+       << micros(f.fastest_exact->mean_time_us) << " | ";
+    if (f.fastest_inexact)
+      md << f.fastest_inexact->hierarchy << " " << f.fastest_inexact->label << " | "
+         << micros(f.fastest_inexact->mean_time_us) << " | " << percent(f.fastest_inexact->fp_rate) << " | "
+         << percent(f.fastest_inexact->fn_rate) << " | " << fmt("%.2f", f.speedup) << "× |\n";
+    else
+      md << "none | | | | |\n";
+  }
+  md << "\n";
+}
+
 /// One table of a value per series (rows) and distance (columns).
 void per_distance_table(std::ostream& md, const RunOutput& run, const std::vector<double>& distances,
                         const std::string& title, bool inexact_only,
@@ -449,6 +496,7 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
   readme_operating_point(md, run, range.text);
   readme_figures(md, figures_ok, plot_error);
   readme_summary(md, run, range);
+  readme_front(md, run, range);
   readme_per_distance(md, run, distances);
   readme_models(md, run);
   readme_ground_truth(md, run, distances);

@@ -30,6 +30,17 @@ struct SeriesSummary {
 /// Series over distances in [lo, hi], in the order the rows first appear.
 std::vector<SeriesSummary> summarize(const std::vector<ResultRow>& rows, double lo, double hi);
 
+/// The error/time front of one mesh pair over the quality range: the fastest exact series, and the fastest
+/// inexact series whose wrong answers (FP + FN) are at most `max_error`. The yardstick: the second
+/// at least 3x faster than the first.
+struct FrontPoint {
+  std::string mesh;
+  std::optional<SeriesSummary> fastest_exact, fastest_inexact;
+  double speedup = 0;  ///< exact mean time / inexact mean time; 0 when either is missing
+};
+inline constexpr double kFrontMaxError = 0.04;
+std::vector<FrontPoint> error_time_front(const std::vector<SeriesSummary>& series, double max_error);
+
 /// The operating point of one mesh pair: ADB at the scene's chosen (hierarchy, p_min) against the baseline.
 struct OperatingPoint {
   std::string mesh;

@@ -124,5 +124,34 @@ TEST_F(ReportTest, AStrategyWithoutDensityIsSizedWithoutTheAnnotation) {
   EXPECT_GT(adb.bytes_per_triangle, exact.bytes_per_triangle);  // the annotation is not free
 }
 
+TEST(ErrorTimeFront, FastestExactAgainstFastestInexactWithinTheErrorBound) {
+  auto series = [](std::string mesh, std::string label, bool exact, double us, double fp, double fn) {
+    SeriesSummary s;
+    s.mesh = std::move(mesh);
+    s.hierarchy = "aabb";
+    s.label = std::move(label);
+    s.exact_strategy = exact;
+    s.mean_time_us = us;
+    s.fp_rate = fp;
+    s.fn_rate = fn;
+    return s;
+  };
+  const std::vector<SeriesSummary> all = {
+      series("jeep", "exact", true, 10, 0, 0),       series("jeep", "exact dop", true, 8, 0, 0),
+      series("jeep", "adb 0.5", false, 1, 0.3, 0),   series("jeep", "adb 0.9", false, 2, 0.03, 0.01),
+      series("jeep", "adb 0.99", false, 4, 0.01, 0), series("bunny", "exact", true, 6, 0, 0),
+      series("bunny", "adb 0.9", false, 1, 0.05, 0)};
+  const auto front = error_time_front(all, 0.04);
+  ASSERT_EQ(front.size(), 2u);
+  EXPECT_EQ(front[0].mesh, "jeep");
+  ASSERT_TRUE(front[0].fastest_exact && front[0].fastest_inexact);
+  EXPECT_EQ(front[0].fastest_exact->label, "exact dop");
+  EXPECT_EQ(front[0].fastest_inexact->label, "adb 0.9");  // 4% wrong: within the bound, faster than 0.99
+  EXPECT_DOUBLE_EQ(front[0].speedup, 4.0);
+  EXPECT_EQ(front[1].mesh, "bunny");
+  EXPECT_FALSE(front[1].fastest_inexact);  // 5% wrong is outside
+  EXPECT_EQ(front[1].speedup, 0.0);
+}
+
 }  // namespace
 }  // namespace bvhlab
