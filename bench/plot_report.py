@@ -16,7 +16,7 @@ Figures (PNG, in REPORT_DIR):
   fig1_time_vs_distance.png   mean time per query against distance, every hierarchy
   fig2_errors_vs_distance.png false-positive and false-negative rates against distance
   fig3_error_vs_time.png      error against mean time over p_min (the Pareto curve)
-  fig4_calibration.png        reported probability against observed collision frequency
+  fig4_calibration.png        reported probability against observed collision frequency, a panel per series
   fig5_time_vs_size.png       mean time per query against model size
 `bvhlab report` runs this; it needs only matplotlib and the standard library.
 """
@@ -33,7 +33,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 DEFAULT_DISTANCE_LABEL = "distance d of B's centre"
 TIME_LABEL = "mean time per query (µs)"
-MIN_BIN_ANSWERS = 5  # calibration bins with fewer answers say nothing
+CALIBRATION_MIN_ANSWERS = 50  # deciles with fewer answers are drawn but not judged, as in the README
+CALIBRATION_TOLERANCE = 0.05  # the target gap between reported and observed
 
 
 def read_csv(path):
@@ -230,7 +231,7 @@ def dodge(series_count, distances):
 def figure_errors_vs_distance(rows, args, out):
     meshes = meshes_of(rows)
     inexact = [r for r in rows if not is_exact(r)]
-    colours = series_colours(list(grouped(inexact).keys()))  # one colour per series, the same in every panel
+    colours = inexact_colours(rows)  # one colour per series, the same in every panel and in figure 4
     distances = sorted({num(r["distance"]) for r in rows})
     fig, per_mesh, axes = subplots(len(meshes), rows_per_mesh=2, height=3.6)
     for (fp_ax, fn_ax), mesh in zip(per_mesh, meshes):
@@ -300,52 +301,141 @@ def figure_error_vs_time(rows, args, out):
     plt.close(fig)
 
 
-def adjacent_runs(bins):
-    """Splits bins (sorted by bin_low) where one does not start where the previous one ended."""
-    runs = []
+def inexact_colours(rows):
+    """The colour of every inexact series of results.csv, keyed as grouped() keys it: figures 2 and 4 share it."""
+    return series_colours(list(grouped([r for r in rows if not is_exact(r)]).keys()))
+
+
+def p_min_of(value):
+    return None if value in ("", None) else round(float(value), 9)
+
+
+def calibration_series(calibration, rows):
+    """{(mesh, series key): the series' bins by bin_low}, in first-appearance order. The key is results.csv's
+    (hierarchy, label), found by (mesh, hierarchy, strategy, p_min, budget), so a series has the colour and
+    name it has in the other figures."""
+    labels = {(r["mesh"], r["hierarchy"], r["strategy"], p_min_of(r["p_min"]), r["budget"]): r
+              for r in rows if not is_exact(r)}
+    out = {}
+    for b in calibration:
+        row = labels.get((b["mesh"], b["hierarchy"], b["strategy"], p_min_of(b["p_min"]), b["budget"]))
+        key = series_key(row) if row else series_key(b)
+        out.setdefault((b["mesh"], key), []).append(b)
+    for bins in out.values():
+        bins.sort(key=lambda b: num(b["bin_low"]))
+    return out
+
+
+def calibration_line(bins):
+    """The x and y of a series' line through its bins (sorted by bin_low): NaN at an empty bin, and between bins
+    that do not touch, so that the line breaks there instead of bridging the gap."""
+    xs, ys = [], []
+    previous_high = None
     for b in bins:
-        if runs and abs(num(runs[-1][-1]["bin_high"]) - num(b["bin_low"])) < 1e-9:
-            runs[-1].append(b)
-        else:
-            runs.append([b])
-    return runs
+        if previous_high is not None and abs(num(b["bin_low"]) - previous_high) > 1e-9:
+            xs.append(math.nan)
+            ys.append(math.nan)
+        empty = int(b["count"]) == 0
+        xs.append(math.nan if empty else num(b["mean_probability"]))
+        ys.append(math.nan if empty else num(b["collision_frequency"]))
+        previous_high = num(b["bin_high"])
+    return xs, ys
 
 
-def figure_calibration(calibration, args, out):
-    meshes = meshes_of(calibration) or ["(no ADB strategy)"]
-    fig, per_mesh, axes = subplots(len(meshes), width=5.2, height=4.6)
-    operated = [c for c in calibration if c["strategy"] == args.operating_strategy]
-    colours = series_colours(list(grouped(operated).keys()))  # one colour per series, the same in every panel
-    for (ax,), mesh in zip(per_mesh, meshes):
-        ax.plot([0, 1], [0, 1], "--", color="grey", label="perfect calibration")
-        series = grouped([c for c in operated if c["mesh"] == mesh])
-        for i, (key, bins) in enumerate(series.items()):
-            used = sorted((b for b in bins if int(b["count"]) >= MIN_BIN_ANSWERS), key=lambda b: num(b["bin_low"]))
-            if not used:
-                continue
-            colour = colours[key]
-            most = max(int(c["count"]) for c in used)
-            for run in adjacent_runs(used):  # no line across an empty or left-out bin
-                if len(run) > 1:
-                    ax.plot([num(b["mean_probability"]) for b in run], [num(b["collision_frequency"]) for b in run],
-                            "-", color=colour, alpha=0.5, linewidth=1, zorder=2 + i)
-            first = bins[0]
-            ax.scatter([num(b["mean_probability"]) for b in used], [num(b["collision_frequency"]) for b in used],
-                       s=[12 + 60 * math.sqrt(int(b["count"]) / most) for b in used], color=colour,
-                       edgecolors="black", linewidths=0.4, zorder=3 + i,
-                       label=f"{first['hierarchy']}: p_min={float(first['p_min']):g}")
+def calibration_gap(bins, min_answers=None):
+    """(largest |reported - observed| over the bins holding at least min_answers, how many bins that is); the
+    gap is None when no bin qualifies. The README's calibration table applies the same rule."""
+    min_answers = CALIBRATION_MIN_ANSWERS if min_answers is None else min_answers
+    gaps = [abs(num(b["mean_probability"]) - num(b["collision_frequency"])) for b in bins
+            if int(b["count"]) >= max(1, min_answers)]
+    return (max(gaps) if gaps else None), len(gaps)
+
+
+def compact_count(n):
+    return f"{n}" if n < 1000 else f"{n / 1000:.0f}k" if n >= 10000 else f"{n / 1000:.1f}k"
+
+
+def draw_calibration_panel(ax, bins, colour):
+    ax.fill_between([0, 1], [-CALIBRATION_TOLERANCE, 1 - CALIBRATION_TOLERANCE],
+                    [CALIBRATION_TOLERANCE, 1 + CALIBRATION_TOLERANCE], color="grey", alpha=0.15, linewidth=0)
+    ax.plot([0, 1], [0, 1], "--", color="grey", linewidth=1)
+    xs, ys = calibration_line(bins)
+    ax.plot(xs, ys, "-", color=colour, linewidth=1.2, alpha=0.7)
+    used = [b for b in bins if int(b["count"]) > 0]
+    most = max([int(b["count"]) for b in used], default=1)
+    for judged in (True, False):
+        picked = [b for b in used if (int(b["count"]) >= CALIBRATION_MIN_ANSWERS) == judged]
+        if picked:
+            ax.scatter([num(b["mean_probability"]) for b in picked], [num(b["collision_frequency"]) for b in picked],
+                       s=[14 + 70 * math.sqrt(int(b["count"]) / most) for b in picked],
+                       facecolors=colour if judged else "none", edgecolors=colour, linewidths=1.2, zorder=3)
+    for b in used:
+        ax.annotate(compact_count(int(b["count"])), (num(b["mean_probability"]), num(b["collision_frequency"])),
+                    textcoords="offset points", xytext=(5, -9), fontsize=6, color="dimgrey")
+    gap, judged = calibration_gap(bins)
+    verdict = ("no decile holds enough answers" if gap is None else
+               f"largest gap {gap:.3f} over {judged} decile{'s' if judged != 1 else ''}: "
+               + ("within" if gap <= CALIBRATION_TOLERANCE else "beyond") + f" {CALIBRATION_TOLERANCE:g}")
+    # Above the axes, under the title: inside, it would hide points.
+    ax.text(0.5, 1.015, verdict, transform=ax.transAxes, ha="center", va="bottom", fontsize=7)
+
+
+def calibration_legend(fig):
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    handles = [Line2D([], [], linestyle="--", color="grey", label="perfect calibration"),
+               Patch(color="grey", alpha=0.15, label=f"within {CALIBRATION_TOLERANCE:g} (the target)"),
+               Line2D([], [], linestyle="none", marker="o", color="black",
+                      label=f"decile with at least {CALIBRATION_MIN_ANSWERS} answers (judged)"),
+               Line2D([], [], linestyle="none", marker="o", markerfacecolor="none", color="black",
+                      label=f"decile with fewer than {CALIBRATION_MIN_ANSWERS} answers (not judged)")]
+    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=2, fontsize=9, frameon=False)
+
+
+def draw_calibration(calibration, rows, columns=4, size=3.1):
+    """Small multiples: per mesh, one panel per inexact series, in the colour figure 2 gives it. Returns the
+    figure and {(mesh, series key): its axes}."""
+    colours = inexact_colours(rows)
+    series = calibration_series(calibration, rows)
+    meshes = list(dict.fromkeys(mesh for mesh, _ in series))
+    per_mesh = {m: [k for k in series if k[0] == m] for m in meshes}
+    columns = max(1, min(columns, max([len(v) for v in per_mesh.values()], default=1)))
+    mesh_rows = [max(1, math.ceil(len(per_mesh[m]) / columns)) for m in meshes] or [1]
+    fig, grid = plt.subplots(sum(mesh_rows), columns, figsize=(size * columns, size * sum(mesh_rows)),
+                             squeeze=False, sharex=True, sharey=True, constrained_layout=True)
+    axes_of, first_row = {}, 0
+    for mesh, n_rows in zip(meshes, mesh_rows):
+        for i, key in enumerate(per_mesh[mesh]):
+            ax = grid[first_row + i // columns][i % columns]
+            axes_of[key] = ax
+            hierarchy, label = key[1]
+            colour = colours.get(key[1], "black")
+            draw_calibration_panel(ax, series[key], colour)
+            name = series_label({"label": label}) if isinstance(label, str) else " ".join(label)
+            ax.set_title(f"{mesh} · {hierarchy}\n{name}", fontsize=8, color=colour, pad=12)
+        for i in range(len(per_mesh[mesh]), n_rows * columns):
+            grid[first_row + i // columns][i % columns].set_visible(False)
+        first_row += n_rows
+    for ax in grid.flat:
         ax.set_xlim(-0.02, 1.02)
         ax.set_ylim(-0.02, 1.02)
         ax.set_aspect("equal")
-        ax.set_title(f"{mesh}: calibration (bins of 0.1)")
-        ax.set_xlabel("probability reported by ADB (bin mean)")
-        ax.set_ylabel("observed collision frequency")
         ax.grid(True, alpha=0.3)
-        if not calibration:
-            ax.text(0.5, 0.5, "no ADB answers", ha="center", transform=ax.transAxes)
-    legend_below(fig, axes)
-    fig.suptitle(f"marker area grows with the number of answers in the bin; bins with fewer than {MIN_BIN_ANSWERS} "
-                 "answers are left out", fontsize=9, color="grey")
+    for ax in grid[:, 0]:
+        ax.set_ylabel("observed collision frequency", fontsize=8)
+    for ax in grid[-1, :]:
+        ax.set_xlabel("reported probability (decile mean)", fontsize=8)
+    if not series:
+        grid[0][0].text(0.5, 0.5, "no inexact strategy", ha="center", transform=grid[0][0].transAxes)
+    calibration_legend(fig)
+    fig.suptitle("Calibration over all distances, deciles of the reported probability: numbers are the answers "
+                 "in each decile (marker area grows with them); the line breaks at an empty decile", fontsize=9)
+    return fig, axes_of
+
+
+def figure_calibration(calibration, rows, out):
+    fig, _ = draw_calibration(calibration, rows)
     fig.savefig(out, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
@@ -398,7 +488,7 @@ def main():
     figure_time_vs_distance(rows, args, os.path.join(args.report_dir, "fig1_time_vs_distance.png"))
     figure_errors_vs_distance(rows, args, os.path.join(args.report_dir, "fig2_errors_vs_distance.png"))
     figure_error_vs_time(rows, args, os.path.join(args.report_dir, "fig3_error_vs_time.png"))
-    figure_calibration(calibration, args, os.path.join(args.report_dir, "fig4_calibration.png"))
+    figure_calibration(calibration, rows, os.path.join(args.report_dir, "fig4_calibration.png"))
     figure_time_vs_size(rows, args, os.path.join(args.report_dir, "fig5_time_vs_size.png"))
 
 

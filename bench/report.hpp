@@ -48,6 +48,27 @@ struct OperatingPoint {
   double speedup = 0;  ///< baseline mean time / ADB mean time
 };
 std::vector<OperatingPoint> operating_points(const RunOutput& run);
+/// How far one ADB-type series' reported probabilities are from what happens, over the deciles of
+/// calibration.csv that hold enough answers to say (a decile with few answers is mostly noise).
+struct CalibrationSummary {
+  std::string mesh, hierarchy, strategy, label, budget;
+  double p_min = -1;
+  std::size_t answers = 0;          ///< over all deciles
+  std::size_t qualifying_bins = 0;  ///< deciles holding at least min_answers
+  double max_gap = 0;               ///< largest |mean reported - observed| over those; NaN if none
+  double worst_reported = 0, worst_observed = 0;  ///< the decile of max_gap
+  double worst_low = 0, worst_high = 0;
+  bool meets = false;  ///< some decile qualifies and every one is within the tolerance
+};
+constexpr std::size_t kCalibrationMinAnswers = 50;
+constexpr double kCalibrationTolerance = 0.05;
+/// One summary per series, in the order the bins first appear; `rows` supplies the series' labels. Throws
+/// std::invalid_argument on a bin holding answers without a finite probability or frequency.
+std::vector<CalibrationSummary> calibration_summary(const std::vector<CalibrationBin>& bins,
+                                                    const std::vector<ResultRow>& rows,
+                                                    std::size_t min_answers = kCalibrationMinAnswers,
+                                                    double tolerance = kCalibrationTolerance);
+
 /// The x-axis label of the figures over distance, in the scene's own terms (normalised units, scene units,
 /// or a pose file's groups).
 std::string distance_label(const Scene& scene);

@@ -3,6 +3,7 @@ labels apart, numbers on short log axes, series side by side rather than on top 
 
 Run by ctest with BVHLAB_SOURCE_DIR set; plain unittest, so it needs nothing beyond matplotlib.
 """
+import math
 import os
 import sys
 import unittest
@@ -11,29 +12,117 @@ sys.path.insert(0, os.path.join(os.environ.get("BVHLAB_SOURCE_DIR", "."), "bench
 
 import plot_report  # noqa: E402
 from matplotlib import pyplot as plt  # noqa: E402
+from matplotlib.colors import to_rgba  # noqa: E402
 
 
-def calibration_bin(low, count=60):
-    return {"bin_low": str(low), "bin_high": str(round(low + 0.1, 10)), "count": str(count)}
+def calibration_bin(low, count=60, p_min="0.9", mesh="m", reported=None, observed=None):
+    reported = low + 0.05 if reported is None else reported
+    return {"mesh": mesh, "hierarchy": "aabb", "strategy": "adb", "p_min": p_min, "budget": "",
+            "bin_low": str(low), "bin_high": str(round(low + 0.1, 10)), "count": str(count),
+            "mean_probability": "" if count == 0 else str(reported),
+            "collision_frequency": "" if count == 0 else str(reported if observed is None else observed)}
 
 
-class SeriesColours(unittest.TestCase):
-    def test_every_series_has_its_own_colour(self):
-        for n in (2, 10, 20, 30):
-            colours = plot_report.series_colours([f"s{i}" for i in range(n)])
-            distinct = {tuple(round(c, 6) for c in colour[:3]) for colour in colours.values()}
-            self.assertEqual(len(distinct), n, f"{n} series")
+def result_row(p_min, mesh="m", strategy="adb", exact="0"):
+    return {"mesh": mesh, "hierarchy": "aabb", "strategy": strategy, "p_min": p_min, "budget": "",
+            "label": f"{strategy} p_min={p_min}" if p_min else strategy, "exact": exact, "distance": "1.2",
+            "queries": "10", "fp_rate": "0", "fn_rate": "0", "mean_time_us": "1", "bytes_per_triangle": "1"}
 
 
-class CalibrationRuns(unittest.TestCase):
-    def test_a_gap_splits_the_line(self):
+def series_line(ax):
+    """The one line of a calibration panel that is neither the diagonal nor the tolerance band."""
+    lines = [line for line in ax.lines if line.get_linestyle() == "-"]
+    assert len(lines) == 1, [line.get_label() for line in ax.lines]
+    return lines[0]
+
+
+def segments(values):
+    """How many unbroken runs of numbers a line's data has (NaN breaks a matplotlib line)."""
+    runs, inside = 0, False
+    for v in values:
+        if math.isnan(v):
+            inside = False
+        elif not inside:
+            runs, inside = runs + 1, True
+    return runs
+
+
+class CalibrationLine(unittest.TestCase):
+    def test_an_empty_bin_breaks_the_line(self):
+        bins = [calibration_bin(0.0), calibration_bin(0.1), calibration_bin(0.2, count=0), calibration_bin(0.3)]
+        xs, ys = plot_report.calibration_line(bins)
+        self.assertTrue(math.isnan(xs[2]) and math.isnan(ys[2]))
+        self.assertEqual(segments(ys), 2)
+
+    def test_a_missing_bin_breaks_the_line_too(self):
         bins = [calibration_bin(0.0), calibration_bin(0.1), calibration_bin(0.4), calibration_bin(0.5)]
-        runs = plot_report.adjacent_runs(bins)
-        self.assertEqual([len(r) for r in runs], [2, 2])
+        self.assertEqual(segments(plot_report.calibration_line(bins)[1]), 2)
 
     def test_adjacent_bins_stay_one_line(self):
-        bins = [calibration_bin(x / 10) for x in range(10)]
-        self.assertEqual(len(plot_report.adjacent_runs(bins)), 1)
+        xs, ys = plot_report.calibration_line([calibration_bin(x / 10) for x in range(10)])
+        self.assertEqual(segments(ys), 1)
+        self.assertEqual(len(ys), 10)
+
+    def test_the_gap_judges_only_bins_with_enough_answers(self):
+        bins = [calibration_bin(0.1, count=100, reported=0.15, observed=0.12),
+                calibration_bin(0.5, count=49, reported=0.55, observed=0.0),
+                calibration_bin(0.8, count=50, reported=0.85, observed=0.79)]
+        gap, judged = plot_report.calibration_gap(bins)
+        self.assertAlmostEqual(gap, 0.06)
+        self.assertEqual(judged, 2)
+        self.assertEqual(plot_report.calibration_gap([calibration_bin(0.5, count=3)]), (None, 0))
+
+
+class CalibrationFigure(unittest.TestCase):
+    def setUp(self):
+        # Two meshes, three ADB series each (p_min 0.5 has an empty decile in the middle), and an exact one.
+        self.rows = [result_row(p, mesh) for mesh in ("m", "n") for p in ("0.5", "0.9", "0.99")]
+        self.rows.append(result_row("", "m", strategy="exact", exact="1"))
+        self.calibration = []
+        for mesh in ("m", "n"):
+            for p in ("0.5", "0.9", "0.99"):
+                for b in range(10):
+                    count = 0 if (p == "0.5" and b == 4) else 20 if b == 7 else 100
+                    self.calibration.append(calibration_bin(b / 10, count, p, mesh))
+        self.fig, self.axes = plot_report.draw_calibration(self.calibration, self.rows)
+
+    def tearDown(self):
+        plt.close("all")
+
+    def test_one_panel_per_series_and_mesh(self):
+        self.assertEqual(len(self.axes), 6)
+        self.assertEqual({mesh for mesh, _ in self.axes}, {"m", "n"})
+
+    def test_the_empty_decile_breaks_that_series_line_only(self):
+        for (mesh, (_, label)), ax in self.axes.items():
+            ys = series_line(ax).get_ydata()
+            self.assertEqual(segments(ys), 2 if label == "adb p_min=0.5" else 1, (mesh, label))
+
+    def test_each_series_has_one_colour_its_figure_2_colour_and_no_other_series_has_it(self):
+        expected = plot_report.inexact_colours(self.rows)
+        seen = {}
+        for (mesh, key), ax in self.axes.items():
+            colour = to_rgba(expected[key])
+            self.assertEqual(to_rgba(series_line(ax).get_color()), colour)
+            for collection in ax.collections[1:]:  # the first is the tolerance band
+                for edge in collection.get_edgecolors():
+                    self.assertEqual(tuple(edge), colour)
+            seen.setdefault(colour, set()).add(key)
+        self.assertTrue(all(len(keys) == 1 for keys in seen.values()), seen)
+        self.assertEqual(len(seen), 3)  # the same series on both meshes keeps its colour
+
+    def test_deciles_with_few_answers_are_hollow(self):
+        ax = self.axes[("m", ("aabb", "adb p_min=0.9"))]
+        filled, hollow = ax.collections[1], ax.collections[2]
+        self.assertEqual(len(filled.get_offsets()), 9)
+        self.assertEqual(len(hollow.get_offsets()), 1)  # the 20-answer decile
+        self.assertEqual(len(hollow.get_facecolors()), 0)
+        self.assertGreater(len(filled.get_facecolors()), 0)
+
+    def test_draws_without_any_inexact_series(self):
+        fig, axes = plot_report.draw_calibration([], [result_row("", strategy="exact", exact="1")])
+        self.assertEqual(axes, {})
+        self.assertIn("no inexact strategy", [t.get_text() for t in fig.axes[0].texts])
 
 
 class Dodge(unittest.TestCase):

@@ -8,6 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
 namespace bvhlab {
 namespace {
 
@@ -151,6 +155,87 @@ TEST(ErrorTimeFront, FastestExactAgainstFastestInexactWithinTheErrorBound) {
   EXPECT_EQ(front[1].mesh, "bunny");
   EXPECT_FALSE(front[1].fastest_inexact);  // 5% wrong is outside
   EXPECT_EQ(front[1].speedup, 0.0);
+}
+
+/// One decile of a series on mesh "m", hierarchy "aabb", strategy "adb".
+CalibrationBin decile(double p_min, int bin, std::size_t count, double reported, double observed) {
+  CalibrationBin b{"m", "aabb", "adb", "", p_min};
+  b.bin_low = bin / 10.0;
+  b.bin_high = (bin + 1) / 10.0;
+  b.count = count;
+  b.mean_probability = reported;
+  b.collision_frequency = observed;
+  return b;
+}
+
+TEST(CalibrationSummary, JudgesOnlyDecilesWithEnoughAnswers) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<CalibrationBin> bins{
+      // p_min 0.9: within 0.05 where it counts; the 10-answer decile is far off but too small to judge.
+      decile(0.9, 1, 100, 0.15, 0.12), decile(0.9, 5, 10, 0.55, 0.0), decile(0.9, 9, 60, 0.95, 0.99),
+      decile(0.9, 3, 0, nan, nan),
+      // p_min 0.5: 50 answers exactly qualify (gap 0.06, too far); 49 do not (gap 0.9).
+      decile(0.5, 2, 50, 0.26, 0.20), decile(0.5, 7, 49, 0.9, 0.0), decile(0.5, 8, 500, 0.85, 0.83),
+      // p_min 0.7: answers, but no decile holds enough of them.
+      decile(0.7, 4, 30, 0.45, 0.4)};
+  const auto s = calibration_summary(bins, {});
+  ASSERT_EQ(s.size(), 3u);
+
+  EXPECT_EQ(s[0].p_min, 0.9);
+  EXPECT_EQ(s[0].answers, 170u);
+  EXPECT_EQ(s[0].qualifying_bins, 2u);
+  EXPECT_NEAR(s[0].max_gap, 0.04, 1e-12);
+  EXPECT_DOUBLE_EQ(s[0].worst_low, 0.9);
+  EXPECT_TRUE(s[0].meets);
+
+  EXPECT_EQ(s[1].qualifying_bins, 2u);
+  EXPECT_NEAR(s[1].max_gap, 0.06, 1e-12);
+  EXPECT_DOUBLE_EQ(s[1].worst_reported, 0.26);
+  EXPECT_DOUBLE_EQ(s[1].worst_observed, 0.20);
+  EXPECT_FALSE(s[1].meets);
+
+  EXPECT_EQ(s[2].answers, 30u);
+  EXPECT_EQ(s[2].qualifying_bins, 0u);
+  EXPECT_TRUE(std::isnan(s[2].max_gap));
+  EXPECT_FALSE(s[2].meets);  // nothing to judge is not a pass
+}
+
+TEST(CalibrationSummary, SeriesDifferingOnlyInBudgetStayApartAndTakeTheirLabelFromTheRows) {
+  CalibrationBin a = decile(0.9, 9, 80, 0.95, 0.95), b = a;
+  b.budget = "bv_tests=50";
+  b.collision_frequency = 0.5;
+  ResultRow row;
+  row.mesh = "m";
+  row.hierarchy = "aabb";
+  row.strategy = "adb";
+  row.p_min = 0.9;
+  row.budget = "bv_tests=50";
+  row.label = "adb p_min=0.9 budget 50";
+  const auto s = calibration_summary({a, b}, {row});
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_TRUE(s[0].meets);
+  EXPECT_FALSE(s[1].meets);
+  EXPECT_EQ(s[1].label, "adb p_min=0.9 budget 50");
+  EXPECT_EQ(s[0].label, "adb p_min=0.9");  // no row: made of its parts
+}
+
+TEST(CalibrationSummary, ABinWithAnswersButNoProbabilityIsAnError) {
+  const std::vector<CalibrationBin> bins{decile(0.9, 2, 70, std::numeric_limits<double>::quiet_NaN(), 0.1)};
+  EXPECT_THROW(calibration_summary(bins, {}), std::invalid_argument);
+}
+
+TEST_F(ReportTest, ReadmeSaysWhichSeriesMeetTheCalibrationTarget) {
+  RunOutput run = run_scene(protocol_scene("[1.2]"), options);
+  run.calibration = {decile(0.9, 1, 100, 0.15, 0.12), decile(0.9, 8, 200, 0.85, 0.2),
+                     decile(0.5, 2, 70, 0.25, 0.26)};
+  for (auto& b : run.calibration) b.mesh = run.rows.front().mesh;
+  const std::string text = readme(run);
+  EXPECT_NE(text.find("## Calibration"), std::string::npos) << text;
+  EXPECT_NE(text.find("| 300 | 2 | 0.650 | 0.8–0.9: 0.850 → 0.200 | no |"), std::string::npos) << text;
+  EXPECT_NE(text.find("| 70 | 1 | 0.010 | 0.2–0.3: 0.250 → 0.260 | yes |"), std::string::npos) << text;
+  EXPECT_NE(text.find("Meeting the target: " + run.rows.front().mesh + " aabb adb p_min=0.5."),
+            std::string::npos)
+      << text;
 }
 
 }  // namespace
