@@ -151,7 +151,8 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
        "/strategies/0/p_min/1: p_min must be a number in [0, 1], got 1.5"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "adb", "p_min": 0.9}])",
                   ""),
-       "/strategies/0/type: \"adb\" needs a density it can estimate from (\"adb\", \"adb_paper\"), the "
+       "/strategies/0/type: \"adb\" needs a density it can estimate from (\"adb\", \"adb_paper\", "
+       "\"adb_normal\"), the "
        "scene's is \"none\""},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "fastest"}])"),
        "/strategies/0/type: expected one of exact, all_contacts, guided_exact, adb, time_critical"},
@@ -223,7 +224,7 @@ TEST_F(SceneTest, HierarchyAnnotationsAreCheckedLikeTheScenes) {
                   R"([{"bv": "aabb", "annotation": {"type": "adb", "grid": 9}}])"),
        "/hierarchies/0/annotation/grid: grid must be an integer in [2, 4], got 9"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb", "annotation": {"type": "magic"}}])"),
-       "/hierarchies/0/annotation/type: expected one of none, adb, adb_paper"},
+       "/hierarchies/0/annotation/type: expected one of none, adb, adb_paper, adb_normal"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "fcl_obb", "annotation": {"type": "adb"}}])",
                   R"([{"type": "exact"}])", ""),
        "/hierarchies/0/annotation: FCL hierarchies run \"exact\" only"},
@@ -236,7 +237,8 @@ TEST_F(SceneTest, HierarchyAnnotationsAreCheckedLikeTheScenes) {
        "/annotation: a density is set but no strategy needs it"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb", "annotation": {"type": "none"}}])",
                   R"([{"type": "adb"}])"),
-       "/strategies/0/type: \"adb\" needs a density it can estimate from (\"adb\", \"adb_paper\"), hierarchy "
+       "/strategies/0/type: \"adb\" needs a density it can estimate from (\"adb\", \"adb_paper\", "
+       "\"adb_normal\"), hierarchy "
        "\"aabb\"'s is \"none\""},
   };
   for (const auto& c : cases) {

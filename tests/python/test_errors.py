@@ -155,7 +155,7 @@ def test_bad_batches(trees):
     ("plain", {"strategy": "exact", "bv_tests": 10}, "takes no budget"),
     ("adb", {"strategy": "time_critical", "bv_tests": -1}, "bv_tests must be >= 0"),
     ("adb", {"strategy": "time_critical", "deadline_us": float("nan")}, "deadline_us must be finite"),
-    ("plain", {"strategy": "adb"}, "does not run on trees with density 'none' \\(it runs on: adb, adb_paper\\)"),
+    ("plain", {"strategy": "adb"}, "does not run on trees with density 'none' \\(it runs on: adb, adb_paper, adb_normal\\)"),
     ("plain", {"strategy": "guided_exact"}, "density 'none'"),
 ])
 def test_bad_strategies(trees, tree, kwargs, message):
