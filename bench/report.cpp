@@ -21,6 +21,13 @@ std::string fmt(const char* format, double v) {
   std::snprintf(buf, sizeof buf, format, v);
   return buf;
 }
+/// Text for a Markdown table cell: a pair label such as "a|b" must not split the cell.
+std::string table_cell(const std::string& text) {
+  std::string out;
+  for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
 std::string percent(double rate) {
   return fmt("%.2f", 100 * rate);
 }
@@ -431,10 +438,10 @@ void readme_summary(std::ostream& md, const RunOutput& run, const QualityRange& 
         "tests/query | "
         "bytes/triangle |\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& s : summarize(run.rows, range.lo, range.hi))
-    md << "| " << s.mesh << " | " << s.hierarchy << " | " << series_name(s) << " | " << micros(s.mean_time_us)
-       << " | " << micros(s.max_time_us) << " | " << percent(s.fp_rate) << " | " << percent(s.fn_rate)
-       << " | " << count(s.bv_tests_per_query) << " | " << count(s.triangle_tests_per_query) << " | "
-       << fmt("%.1f", s.bytes_per_triangle) << " |\n";
+    md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << series_name(s) << " | "
+       << micros(s.mean_time_us) << " | " << micros(s.max_time_us) << " | " << percent(s.fp_rate) << " | "
+       << percent(s.fn_rate) << " | " << count(s.bv_tests_per_query) << " | "
+       << count(s.triangle_tests_per_query) << " | " << fmt("%.1f", s.bytes_per_triangle) << " |\n";
   md << "\nMaximum times include the odd preemption by the operating system (milliseconds on a shared "
         "machine); "
         "the mean is the robust figure. FCL exposes no work counters (n/a).\n\n";
@@ -454,8 +461,8 @@ void readme_front(std::ostream& md, const RunOutput& run, const QualityRange& ra
      << " | µs | FP % | FN % | speed-up |\n|---|---|---:|---|---:|---:|---:|---:|\n";
   for (const FrontPoint& f : front) {
     if (!f.fastest_exact) continue;
-    md << "| " << f.mesh << " | " << f.fastest_exact->hierarchy << " " << f.fastest_exact->label << " | "
-       << micros(f.fastest_exact->mean_time_us) << " | ";
+    md << "| " << table_cell(f.mesh) << " | " << f.fastest_exact->hierarchy << " " << f.fastest_exact->label
+       << " | " << micros(f.fastest_exact->mean_time_us) << " | ";
     if (f.fastest_inexact)
       md << f.fastest_inexact->hierarchy << " " << f.fastest_inexact->label << " | "
          << micros(f.fastest_inexact->mean_time_us) << " | " << percent(f.fastest_inexact->fp_rate) << " | "
@@ -482,7 +489,7 @@ void readme_calibration(std::ostream& md, const RunOutput& run) {
      << tolerance << " |\n|---|---|---|---:|---:|---:|---|---|\n";
   std::vector<std::string> meeting;
   for (const auto& s : summaries) {
-    md << "| " << s.mesh << " | " << s.hierarchy << " | " << s.label << " | " << s.answers << " | "
+    md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << s.label << " | " << s.answers << " | "
        << s.qualifying_bins << " | ";
     if (s.qualifying_bins == 0) {
       md << "n/a | | no decile to judge |\n";
@@ -514,7 +521,7 @@ void per_distance_table(std::ostream& md, const RunOutput& run, const std::vecto
   md << "\n";
   for (const auto& s : summarize(run.rows, -1e300, 1e300)) {
     if (inexact_only && s.exact_strategy) continue;
-    md << "| " << s.mesh << " | " << s.hierarchy << " | " << series_name(s) << " |";
+    md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << series_name(s) << " |";
     for (double d : distances) {
       const ResultRow* row = nullptr;
       for (const auto& r : run.rows)
@@ -542,7 +549,7 @@ void readme_models(std::ostream& md, const RunOutput& run) {
         "build s | "
         "annotate s | from cache |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---|\n";
   for (const auto& m : run.models)
-    md << "| " << m.object << " | " << m.hierarchy << " | " << m.bv << " | " << m.annotation << " | "
+    md << "| " << table_cell(m.object) << " | " << m.hierarchy << " | " << m.bv << " | " << m.annotation << " | "
        << m.triangles << " | " << m.nodes << " | " << (m.depth ? std::to_string(m.depth) : std::string(""))
        << " | " << fmt("%.1f", m.bytes_per_triangle) << " | " << fmt("%.3f", m.build_seconds) << " | "
        << (m.annotate_seconds > 0 ? fmt("%.2f", m.annotate_seconds) : std::string("")) << " | "
@@ -567,7 +574,7 @@ void readme_ground_truth(std::ostream& md, const RunOutput& run, const std::vect
   for (const auto& t : run.truth)
     if (std::find(meshes.begin(), meshes.end(), t.mesh) == meshes.end()) meshes.push_back(t.mesh);
   for (const auto& mesh : meshes) {
-    md << "| " << mesh << " (colliding %) |";
+    md << "| " << table_cell(mesh) << " (colliding %) |";
     for (double d : distances) {
       std::string cell;
       for (const auto& t : run.truth)

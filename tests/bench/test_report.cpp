@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace bvhlab {
@@ -84,6 +85,39 @@ TEST_F(ReportTest, PoseFileIsSummarisedOverAllItsPosesUnlessTheSceneSaysOtherwis
   ASSERT_EQ(operating_points(some).size(), 1u);
   EXPECT_EQ(operating_points(some)[0].adb.queries, 1u);
   EXPECT_NE(readme(some).find("distance 1.5 (1 of 4 poses)"), std::string::npos) << readme(some);
+}
+
+// A pair of two objects is labelled "a|b": in the README's tables the bar must not split a cell, so every
+// table row keeps as many cells as its header.
+TEST_F(ReportTest, PairLabelsKeepTheTablesColumns) {
+  const Scene pair = parse_scene(R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "ring.obj"}],
+      "pairs": [["torus", "ring"]], "hierarchies": [{"bv": "aabb"}],
+      "annotation": {"type": "adb", "grid": 2, "tau": 0.5},
+      "strategies": [{"type": "exact"}, {"type": "adb", "p_min": 0.9}],
+      "workload": {"type": "random", "count": 8, "box": [[-1, -1, -1], [1, 1, 1]]}, "report": {"cgal_sample": 1}})",
+                                 dir.path(), "pair.json");
+  const std::string text = readme(run_scene(pair, options));
+  auto cells = [](const std::string& line) {  // unescaped bars
+    int bars = 0;
+    for (std::size_t i = 0; i < line.size(); ++i) bars += line[i] == '|' && (i == 0 || line[i - 1] != '\\');
+    return bars;
+  };
+  std::istringstream lines(text);
+  std::string line;
+  int header = 0, rows = 0;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] != '|') {
+      header = 0;
+      continue;
+    }
+    if (!header) {
+      header = cells(line);
+      continue;
+    }
+    EXPECT_EQ(cells(line), header) << line;
+    rows += line.find("torus\\|ring") != std::string::npos;
+  }
+  EXPECT_GT(rows, 3);
 }
 
 TEST_F(ReportTest, WorkloadTextAndDistanceLabelFollowTheSceneObjects) {
