@@ -41,13 +41,13 @@ using RegisteredDensities = TypeList<NoDensity, AdbDensity, AdbPaperDensity
 #endif
                                      >;
 
-using RegisteredStrategies =
-    TypeList<ExactStrategy, AllContactsStrategy, GuidedExactStrategy, AdbStrategy, TimeCriticalStrategy
+using RegisteredStrategies = TypeList<ExactStrategy, AllContactsStrategy, GuidedExactStrategy, AdbStrategy,
+                                      TimeCriticalStrategy, GuidedExactDfsStrategy, AdbDfsStrategy
 #ifdef BVHLAB_TEST_POLICIES
-             ,
-             testing::RootOverlapStrategy
+                                      ,
+                                      testing::RootOverlapStrategy
 #endif
-             >;
+                                      >;
 
 namespace registry_detail {
 
