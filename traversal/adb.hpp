@@ -1,11 +1,18 @@
-// ADB traversal (adb/README.md, section 3): best-first descent ordered by the estimated probability that
-// a BV pair holds intersecting polygons. One configuration of the pair-traversal driver
-// (traversal/driver.hpp: BestFirst on the estimate, SplitBoth, AdbHooks, BudgetLimit), parameterised by
-// options, serves three strategies:
+// ADB traversal (adb/README.md, section 3): a descent ordered by the estimated probability that a BV pair
+// holds intersecting polygons. One configuration of the pair-traversal driver (traversal/driver.hpp:
+// AdbHooks, BudgetLimit, and an order: a queue and a descent policy), parameterised by options, serves
+// three strategies:
 //   - probability-guided with p_min: answer "collision" as soon as a pair's estimate exceeds p_min;
 //   - time-critical: the same, under a budget of BV tests and/or a deadline; on exhaustion, a best effort;
 //   - guided exact: the same order, but leaf pairs run exact triangle tests and nothing is pruned by
 //     probability, so the answer is exact.
+// The order is a template parameter of query_adb (each order compiles to a loop of its own):
+//   AdbBestFirst   the paper's rule: the most probable pair anywhere in the queue next (BestFirst,
+//   SplitBoth); AdbDepthFirst  dive: the most probable child of the pair just expanded next, down to a leaf
+//   pair, then
+//                  back to the most probable pair left by the last expansion (OrderedDepthFirst, SplitBoth).
+// Without a budget both orders give the same answers: decisions are made as pairs are filed, and the pairs
+// filed before the queue runs empty are the same in any order; only the work until a decision differs.
 //
 // Decisions (see README, "Method"):
 //   * Vol(A ∩ B) is bounded from above by re-boxing: A's bounding box ∩ B's box re-boxed in A's frame
@@ -58,7 +65,32 @@ struct AdbOptions {
   }
 };
 
+/// The paper's order: best first by estimated probability.
+struct AdbBestFirst {
+  using Queue = BestFirst;
+  using Descent = SplitBoth;
+};
+/// Probability-ordered depth first: the children of an expanded pair are taken most probable first, before
+/// anything queued earlier.
+struct AdbDepthFirst {
+  using Queue = OrderedDepthFirst;
+  using Descent = SplitBoth;
+};
+
 namespace detail {
+
+/// The highest estimate still queued (0 when none): a priority queue's top, or a scan of a stack, whose top
+/// is only the most probable of the latest children. Read once, on an exhausted budget.
+template <class Queue>
+double highest_queued(const Queue& queue) {
+  if constexpr (requires { queue.items(); }) {
+    double best = 0;
+    for (const auto& pair : queue.items()) best = std::max(best, pair.key);
+    return best;
+  } else {
+    return queue.empty() ? 0 : queue.top().key;
+  }
+}
 
 /// Thinnest side of a box the estimate sees, relative to its longest side (header comment, "Flat boxes").
 inline constexpr double kMinRelativeThickness = 1e-3;
@@ -94,7 +126,7 @@ inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b
 
 }  // namespace detail
 
-/// The ADB strategies' hooks (best-first on the estimate, both sides split). `Estimator` is the probability
+/// The ADB strategies' hooks (queued by the estimate, in either order). `Estimator` is the probability
 /// model: estimate(box_a, box_b, overlap volume, node of A, node of B) -> probability.
 template <TreeVolume BV, class Estimator>
 class AdbHooks {
@@ -178,7 +210,7 @@ class AdbHooks {
     if (why == Ended::BudgetExhausted) {
       result_.budget_exhausted = true;
       result_.exact = false;
-      result_.probability = queue.empty() ? best_dropped_ : std::max(queue.top().key, best_dropped_);
+      result_.probability = std::max(detail::highest_queued(queue), best_dropped_);
       result_.collides = result_.probability >= options_.best_effort_threshold;
       return;
     }
@@ -208,8 +240,9 @@ class AdbHooks {
 
 /// ADB query on two trees annotated with a ProbabilityDensity (adb/concept.hpp). `b_to_a` maps B's frame
 /// into A's. The probability model comes from the trees' own annotation.
-/// Const and thread-safe: the model is read-only and all traversal state is local.
-template <TreeVolume BV, ProbabilityDensity D>
+/// `Order` is AdbBestFirst (the paper's) or AdbDepthFirst. Const and thread-safe: the model is read-only and
+/// all traversal state is local.
+template <class Order = AdbBestFirst, TreeVolume BV, ProbabilityDensity D>
 Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
                  const AdbOptions& options) {
   BudgetLimit limit(options.budget);  // a deadline counts from here, set-up included
@@ -234,7 +267,8 @@ Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransfor
     const auto node_estimate = [&](const Box& box_a, const Box& box_b, double overlap, std::uint32_t i,
                                    std::uint32_t j) { return estimate(i, box_a, j, box_b, overlap); };
     AdbHooks<BV, decltype(node_estimate)> hooks(trees, result, options, node_estimate);
-    traverse<BestFirst, SplitBoth>(trees, hooks, limit);  // frees its queue before it returns
+    traverse<typename Order::Queue, typename Order::Descent>(trees, hooks,
+                                                             limit);  // frees its queue before it returns
   }
   // The loop reads the clock before each pop, so it misses a deadline that passed during the last step
   // (a decision, the last pair). Such an answer stands but came late: it is flagged too.

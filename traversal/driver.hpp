@@ -246,22 +246,27 @@ struct OrderedDepthFirst {
   template <class Pair>
   class Queue {
    public:
-    Queue() { items_.reserve(64); }
     [[nodiscard]] bool empty() const { return items_.empty(); }
     [[nodiscard]] const Pair& top() const { return items_.back(); }  ///< the next pair to be taken
     /// Keeps the pairs admitted since the last pop in ascending key order (ties: the later one above),
     /// so the highest is taken next.
-    void push(const Pair& p) {
+    [[gnu::always_inline]] void push(const Pair& p) {
+      // Room reserved at the first push, not at construction: a query decided by its root pair (common for
+      // ADB on deep overlaps) then allocates nothing.
+      if (items_.capacity() == 0) items_.reserve(64);
       items_.push_back(p);
       for (std::size_t i = items_.size() - 1; i > fresh_ && items_[i].key < items_[i - 1].key; --i)
         std::swap(items_[i], items_[i - 1]);
     }
-    Pair pop() {
+    [[gnu::always_inline]] Pair pop() {
       const Pair p = items_.back();
       items_.pop_back();
       fresh_ = items_.size();
       return p;
     }
+    /// Every queued pair, bottom of the stack first (the top is not the highest key: a best-effort answer
+    /// looks at them all).
+    [[nodiscard]] const std::vector<Pair>& items() const { return items_; }
 
    private:
     std::vector<Pair> items_;

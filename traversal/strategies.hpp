@@ -103,6 +103,30 @@ struct AdbStrategy : GuidedExactStrategy {
   }
 };
 
+/// Guided exact in the depth-first order: the most probable child of the pair just expanded next.
+struct GuidedExactDfsStrategy : GuidedExactStrategy {
+  static constexpr std::string_view name() { return "guided_exact_dfs"; }
+  static constexpr std::string_view description() {
+    return "exact, depth first into the most probable child pair";
+  }
+  template <class TreeA, class TreeB>
+  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options) {
+    return query_adb<AdbDepthFirst>(a, b, b_to_a, options);
+  }
+};
+
+/// ADB with p_min in the depth-first order: the same answers as `adb`, reached by diving.
+struct AdbDfsStrategy : AdbStrategy {
+  static constexpr std::string_view name() { return "adb_dfs"; }
+  static constexpr std::string_view description() {
+    return "adb's answers, depth first into the most probable child pair";
+  }
+  template <class TreeA, class TreeB>
+  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options) {
+    return query_adb<AdbDepthFirst>(a, b, b_to_a, options);
+  }
+};
+
 /// ADB under a budget of BV tests and/or a deadline; on exhaustion, a best-effort answer.
 struct TimeCriticalStrategy : AdbStrategy {
   static constexpr std::string_view name() { return "time_critical"; }
@@ -122,6 +146,7 @@ struct TimeCriticalStrategy : AdbStrategy {
 };
 
 static_assert(Strategy<ExactStrategy> && Strategy<AllContactsStrategy> && Strategy<GuidedExactStrategy> &&
-              Strategy<AdbStrategy> && Strategy<TimeCriticalStrategy>);
+              Strategy<AdbStrategy> && Strategy<TimeCriticalStrategy> && Strategy<GuidedExactDfsStrategy> &&
+              Strategy<AdbDfsStrategy>);
 
 }  // namespace bvhlab

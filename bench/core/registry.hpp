@@ -42,13 +42,13 @@ using RegisteredDensities = TypeList<NoDensity, AdbDensity, AdbPaperDensity, Adb
 #endif
                                      >;
 
-using RegisteredStrategies =
-    TypeList<ExactStrategy, AllContactsStrategy, GuidedExactStrategy, AdbStrategy, TimeCriticalStrategy
+using RegisteredStrategies = TypeList<ExactStrategy, AllContactsStrategy, GuidedExactStrategy, AdbStrategy,
+                                      TimeCriticalStrategy, GuidedExactDfsStrategy, AdbDfsStrategy
 #ifdef BVHLAB_TEST_POLICIES
-             ,
-             testing::RootOverlapStrategy
+                                      ,
+                                      testing::RootOverlapStrategy
 #endif
-             >;
+                                      >;
 
 namespace registry_detail {
 

@@ -12,11 +12,13 @@ STRATEGIES = [  # (strategy, its parameters, density the trees need)
     ("exact", {}, "none"),
     ("all_contacts", {}, "none"),
     ("guided_exact", {}, "adb"),
+    ("guided_exact_dfs", {}, "adb"),
     ("adb", {"p_min": 0.5}, "adb"),
     ("adb", {"p_min": 0.95}, "adb"),
+    ("adb_dfs", {"p_min": 0.9}, "adb"),
     ("time_critical", {"p_min": 0.9, "bv_tests": 40}, "adb"),
 ]
-EXACT = [("exact", "none"), ("all_contacts", "none"), ("guided_exact", "adb")]
+EXACT = [("exact", "none"), ("all_contacts", "none"), ("guided_exact", "adb"), ("guided_exact_dfs", "adb")]
 
 
 @pytest.fixture(scope="module")
@@ -110,7 +112,7 @@ def test_batch_equals_single_queries(gear_trees, strategy, params, density):
                   "witness_b": r.witness[1] if r.witness else -1,
                   **r.counters}
         assert single == {key: batch[key][k].item() for key in single}, k
-    if strategy in ("exact", "all_contacts", "guided_exact"):
+    if strategy in ("exact", "all_contacts", "guided_exact", "guided_exact_dfs"):
         np.testing.assert_array_equal(batch["probability"], batch["collides"].astype(float))
         assert batch["exact"].all()
     else:
