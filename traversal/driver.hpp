@@ -227,7 +227,12 @@ struct BestFirst {
    public:
     [[nodiscard]] bool empty() const { return items_.empty(); }
     [[nodiscard]] const Pair& top() const { return items_.top(); }  ///< the highest key
-    [[gnu::always_inline]] void push(const Pair& p) { items_.push(p); }
+    [[gnu::always_inline]] void push(const Pair& p) {
+      // Room for a typical front at the first push: growing it pair by pair copies the whole heap each time
+      // it doubles, a pause a deadline cannot interrupt. Not at construction: a root decision needs none.
+      if (items_.empty() && !reserved_) reserve();
+      items_.push(p);
+    }
     [[gnu::always_inline]] Pair pop() {
       const Pair p = items_.top();
       items_.pop();
@@ -238,7 +243,17 @@ struct BestFirst {
     struct ByKey {
       bool operator()(const Pair& x, const Pair& y) const { return x.key < y.key; }
     };
-    std::priority_queue<Pair, std::vector<Pair>, ByKey> items_;
+    struct Heap : std::priority_queue<Pair, std::vector<Pair>, ByKey> {
+      void reserve(std::size_t n) { this->c.reserve(n); }
+    };
+    void reserve() {
+      items_.reserve(kReservedPairs);
+      reserved_ = true;
+    }
+    // 16 KiB of pairs: far below malloc's mmap threshold, so the reservation costs one ordinary allocation.
+    static constexpr std::size_t kReservedPairs = std::max<std::size_t>(64, 16384 / sizeof(Pair));
+    Heap items_;
+    bool reserved_ = false;
   };
 };
 
