@@ -489,8 +489,8 @@ void readme_calibration(std::ostream& md, const RunOutput& run) {
      << tolerance << " |\n|---|---|---|---:|---:|---:|---|---|\n";
   std::vector<std::string> meeting;
   for (const auto& s : summaries) {
-    md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << s.label << " | " << s.answers << " | "
-       << s.qualifying_bins << " | ";
+    md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << s.label << " | " << s.answers
+       << " | " << s.qualifying_bins << " | ";
     if (s.qualifying_bins == 0) {
       md << "n/a | | no decile to judge |\n";
       continue;
@@ -549,9 +549,10 @@ void readme_models(std::ostream& md, const RunOutput& run) {
         "build s | "
         "annotate s | from cache |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---|\n";
   for (const auto& m : run.models)
-    md << "| " << table_cell(m.object) << " | " << m.hierarchy << " | " << m.bv << " | " << m.annotation << " | "
-       << m.triangles << " | " << m.nodes << " | " << (m.depth ? std::to_string(m.depth) : std::string(""))
-       << " | " << fmt("%.1f", m.bytes_per_triangle) << " | " << fmt("%.3f", m.build_seconds) << " | "
+    md << "| " << table_cell(m.object) << " | " << m.hierarchy << " | " << m.bv << " | " << m.annotation
+       << " | " << m.triangles << " | " << m.nodes << " | "
+       << (m.depth ? std::to_string(m.depth) : std::string("")) << " | " << fmt("%.1f", m.bytes_per_triangle)
+       << " | " << fmt("%.3f", m.build_seconds) << " | "
        << (m.annotate_seconds > 0 ? fmt("%.2f", m.annotate_seconds) : std::string("")) << " | "
        << (m.from_cache ? "yes" : "no") << " |\n";
   md << "\nBytes per triangle count nodes and volumes (and one byte of pc per node when annotated), not "
