@@ -106,6 +106,10 @@ struct AdbStrategy : GuidedExactStrategy {
 /// Guided exact in the depth-first order: the most probable child of the pair just expanded next.
 struct GuidedExactDfsStrategy : GuidedExactStrategy {
   static constexpr std::string_view name() { return "guided_exact_dfs"; }
+  /// The default density only: every (volume, density) pair it accepts is one more traversal for the runner,
+  /// the CLI and Python to compile, and the order does not depend on the density.
+  template <class D>
+  static constexpr bool accepts = ProbabilityDensity<D>&& D::name() == std::string_view("adb");
   static constexpr std::string_view description() {
     return "exact, depth first into the most probable child pair";
   }
@@ -118,6 +122,10 @@ struct GuidedExactDfsStrategy : GuidedExactStrategy {
 /// ADB with p_min in the depth-first order: the same answers as `adb`, reached by diving.
 struct AdbDfsStrategy : AdbStrategy {
   static constexpr std::string_view name() { return "adb_dfs"; }
+  /// The default density only: every (volume, density) pair it accepts is one more traversal for the runner,
+  /// the CLI and Python to compile, and the order does not depend on the density.
+  template <class D>
+  static constexpr bool accepts = ProbabilityDensity<D>&& D::name() == std::string_view("adb");
   static constexpr std::string_view description() {
     return "adb's answers, depth first into the most probable child pair";
   }
