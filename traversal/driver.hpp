@@ -230,7 +230,7 @@ struct BestFirst {
     [[gnu::always_inline]] void push(const Pair& p) {
       // Room for a typical front at the first push: growing it pair by pair copies the whole heap each time
       // it doubles, a pause a deadline cannot interrupt. Not at construction: a root decision needs none.
-      if (items_.empty() && !reserved_) reserve();
+      if (items_.capacity() == 0) items_.reserve(kReservedPairs);
       items_.push(p);
     }
     [[gnu::always_inline]] Pair pop() {
@@ -243,17 +243,13 @@ struct BestFirst {
     struct ByKey {
       bool operator()(const Pair& x, const Pair& y) const { return x.key < y.key; }
     };
-    struct Heap : std::priority_queue<Pair, std::vector<Pair>, ByKey> {
+    struct Heap : std::priority_queue<Pair, std::vector<Pair>, ByKey> {  // with access to its vector's room
+      [[nodiscard]] std::size_t capacity() const { return this->c.capacity(); }
       void reserve(std::size_t n) { this->c.reserve(n); }
     };
-    void reserve() {
-      items_.reserve(kReservedPairs);
-      reserved_ = true;
-    }
     // 16 KiB of pairs: far below malloc's mmap threshold, so the reservation costs one ordinary allocation.
     static constexpr std::size_t kReservedPairs = std::max<std::size_t>(64, 16384 / sizeof(Pair));
     Heap items_;
-    bool reserved_ = false;
   };
 };
 
