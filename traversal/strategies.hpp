@@ -103,35 +103,33 @@ struct AdbStrategy : GuidedExactStrategy {
   }
 };
 
-/// Guided exact in the depth-first order: the most probable child of the pair just expanded next.
-struct GuidedExactDfsStrategy : GuidedExactStrategy {
-  static constexpr std::string_view name() { return "guided_exact_dfs"; }
-  /// The default density only: every (volume, density) pair it accepts is one more traversal for the runner,
-  /// the CLI and Python to compile, and the order does not depend on the density.
+/// `Base` (a strategy running query_adb) in the depth-first order: the most probable child of the pair just
+/// expanded next. On the default density only: every (volume, density) pair a strategy accepts is one more
+/// traversal for the runner, the CLI and Python to compile, and the order does not depend on the density.
+template <class Base>
+struct InDepthFirstOrder : Base {
   template <class D>
   static constexpr bool accepts = ProbabilityDensity<D>&& D::name() == std::string_view("adb");
-  static constexpr std::string_view description() {
-    return "exact, depth first into the most probable child pair";
-  }
   template <class TreeA, class TreeB>
-  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options) {
+  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a,
+                      const typename Base::Options& options) {
     return query_adb<AdbDepthFirst>(a, b, b_to_a, options);
   }
 };
 
+/// Guided exact in the depth-first order.
+struct GuidedExactDfsStrategy : InDepthFirstOrder<GuidedExactStrategy> {
+  static constexpr std::string_view name() { return "guided_exact_dfs"; }
+  static constexpr std::string_view description() {
+    return "exact, depth first into the most probable child pair";
+  }
+};
+
 /// ADB with p_min in the depth-first order: the same answers as `adb`, reached by diving.
-struct AdbDfsStrategy : AdbStrategy {
+struct AdbDfsStrategy : InDepthFirstOrder<AdbStrategy> {
   static constexpr std::string_view name() { return "adb_dfs"; }
-  /// The default density only: every (volume, density) pair it accepts is one more traversal for the runner,
-  /// the CLI and Python to compile, and the order does not depend on the density.
-  template <class D>
-  static constexpr bool accepts = ProbabilityDensity<D>&& D::name() == std::string_view("adb");
   static constexpr std::string_view description() {
     return "adb's answers, depth first into the most probable child pair";
-  }
-  template <class TreeA, class TreeB>
-  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options) {
-    return query_adb<AdbDepthFirst>(a, b, b_to_a, options);
   }
 };
 
