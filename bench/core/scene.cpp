@@ -1,5 +1,7 @@
 #include "bench/core/scene.hpp"
 
+#include "bench/core/scene_json.hpp"
+
 #include "bench/core/content_hash.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/policies.hpp"
@@ -19,185 +21,9 @@
 
 namespace bvhlab {
 
-using json = nlohmann::json;
+using namespace scene_json;
 
 namespace {
-
-std::string number_text(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-std::string join(const std::vector<std::string>& items, std::string_view sep = ", ") {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? std::string(sep) : "") + items[i];
-  return out;
-}
-
-/// A JSON value and where it sits (a JSON pointer), so every complaint can name the field.
-class Node {
- public:
-  Node(const json& value, std::string pointer, const std::string& source)
-      : value_(&value), pointer_(std::move(pointer)), source_(&source) {}
-
-  [[noreturn]] void fail(const std::string& problem) const {
-    throw SceneError(*source_ + ": " + (pointer_.empty() ? "/" : pointer_) + ": " + problem);
-  }
-  [[nodiscard]] const json& value() const { return *value_; }
-  [[nodiscard]] const std::string& pointer() const { return pointer_; }
-
-  [[nodiscard]] std::string got() const {
-    const json& v = *value_;
-    if (v.is_string()) return "got \"" + v.get<std::string>() + "\"";
-    if (v.is_number() || v.is_boolean()) return "got " + v.dump();
-    if (v.is_null()) return "got null";
-    if (v.is_array()) return "got an array";
-    return "got an object";
-  }
-
-  [[nodiscard]] bool has(const std::string& key) const { return value_->contains(key); }
-  [[nodiscard]] Node child(const std::string& key) const {
-    if (!value_->contains(key)) Node(*value_, pointer_ + "/" + key, *source_).fail("missing");
-    return Node((*value_)[key], pointer_ + "/" + escape(key), *source_);
-  }
-  [[nodiscard]] Node child(std::size_t index) const {
-    return Node((*value_)[index], pointer_ + "/" + std::to_string(index), *source_);
-  }
-
-  const Node& expect_object(const std::vector<std::string>& allowed) const {
-    if (!value_->is_object()) fail("expected an object; " + got());
-    for (const auto& [key, _] : value_->items())
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-        Node((*value_)[key], pointer_ + "/" + escape(key), *source_)
-            .fail("unknown field; expected one of " + join(allowed));
-    return *this;
-  }
-  [[nodiscard]] std::size_t array_size(bool allow_empty = false) const {
-    if (!value_->is_array()) fail("expected an array; " + got());
-    if (!allow_empty && value_->empty()) fail("expected a non-empty array");
-    return value_->size();
-  }
-  [[nodiscard]] std::string string() const {
-    if (!value_->is_string()) fail("expected a string; " + got());
-    return value_->get<std::string>();
-  }
-  [[nodiscard]] std::string choice(const std::vector<std::string>& choices) const {
-    if (!value_->is_string() ||
-        std::find(choices.begin(), choices.end(), value_->get<std::string>()) == choices.end())
-      fail("expected one of " + join(choices) + "; " + got());
-    return value_->get<std::string>();
-  }
-  [[nodiscard]] double number(double lo = -HUGE_VAL, double hi = HUGE_VAL) const {
-    if (!value_->is_number()) fail("expected a number; " + got());
-    const double v = value_->get<double>();
-    if (!std::isfinite(v) || v < lo || v > hi)
-      fail("expected a number in [" + number_text(lo) + ", " + number_text(hi) + "]; " + got());
-    return v;
-  }
-  [[nodiscard]] long long integer(long long lo, long long hi) const {
-    if (!value_->is_number_integer()) fail("expected an integer; " + got());
-    const long long v = value_->get<long long>();
-    if (v < lo || v > hi)
-      fail("expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]; " + got());
-    return v;
-  }
-  [[nodiscard]] bool boolean() const {
-    if (!value_->is_boolean()) fail("expected true or false; " + got());
-    return value_->get<bool>();
-  }
-  [[nodiscard]] std::vector<double> numbers(std::size_t count, double lo = -HUGE_VAL,
-                                            double hi = HUGE_VAL) const {
-    if (!value_->is_array() || (count && value_->size() != count))
-      fail("expected an array of " + (count ? std::to_string(count) + " " : std::string()) + "numbers; " +
-           got());
-    std::vector<double> out;
-    for (std::size_t i = 0; i < value_->size(); ++i) out.push_back(child(i).number(lo, hi));
-    return out;
-  }
-
- private:
-  static std::string escape(const std::string& key) {  // RFC 6901
-    std::string out;
-    for (char c : key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
-    return out;
-  }
-  const json* value_;
-  std::string pointer_;
-  const std::string* source_;
-};
-
-json parse_json(std::string_view text, const std::string& source) {
-  try {
-    return json::parse(text.begin(), text.end());
-  } catch (const json::parse_error& e) {
-    // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ..."
-    std::string what = e.what();
-    const auto cut = what.find("] ");
-    throw SceneError(source +
-                     ": not valid JSON: " + (cut == std::string::npos ? what : what.substr(cut + 2)));
-  } catch (const json::exception& e) {
-    // Other parser refusals, e.g. a number beyond double's range ("1e999": out_of_range.406).
-    std::string what = e.what();
-    const auto cut = what.find("] ");
-    throw SceneError(source +
-                     ": not valid JSON: " + (cut == std::string::npos ? what : what.substr(cut + 2)));
-  }
-}
-
-std::string read_text(const std::filesystem::path& file, const std::string& what) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError(file.string() + ": cannot read the " + what + " file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
-/// The rotation by `degrees` about `axis`; nullopt for an axis that is zero or not finite.
-std::optional<Mat3> axis_angle_rotation(const Vec3& axis, double degrees) {
-  // Scale by the largest component before normalising: the norm of [1e200, 1e200, 0] overflows and
-  // that of [1e-200, 1e-200, 0] underflows, and either would silently give a matrix that is no rotation.
-  const double largest = axis.cwiseAbs().maxCoeff();
-  if (!(largest > 0) || !std::isfinite(largest)) return std::nullopt;
-  return Eigen::AngleAxisd(degrees * M_PI / 180.0, (axis / largest).normalized()).toRotationMatrix();
-}
-
-RigidTransform parse_transform(const Node& node) {
-  node.expect_object({"translation", "rotation", "axis_angle_deg", "group"});
-  Vec3 translation = Vec3::Zero();
-  Mat3 rotation = Mat3::Identity();
-  if (node.has("translation")) {
-    const auto t = node.child("translation").numbers(3);
-    translation = Vec3(t[0], t[1], t[2]);
-  }
-  if (node.has("rotation") && node.has("axis_angle_deg"))
-    node.child("axis_angle_deg").fail("give either \"rotation\" or \"axis_angle_deg\", not both");
-  if (node.has("rotation")) {
-    const Node r = node.child("rotation");
-    if (r.array_size() != 3) r.fail("expected 3 rows of 3 numbers");
-    for (std::size_t i = 0; i < 3; ++i) {
-      const auto row = r.child(i).numbers(3);
-      for (int j = 0; j < 3; ++j) rotation(static_cast<int>(i), j) = row[static_cast<std::size_t>(j)];
-    }
-    try {
-      return RigidTransform::checked(rotation, translation, 1e-6);
-    } catch (const std::invalid_argument& e) {
-      r.fail(std::string("not a rotation: ") + e.what());
-    }
-  }
-  if (node.has("axis_angle_deg")) {
-    const Node aa = node.child("axis_angle_deg");
-    const auto v = aa.numbers(4);
-    const std::optional<Mat3> r = axis_angle_rotation(Vec3(v[0], v[1], v[2]), v[3]);
-    if (!r) aa.fail("the rotation axis must be finite and not zero");
-    try {
-      return RigidTransform::checked(*r, translation, 1e-9);
-    } catch (const std::invalid_argument& e) {
-      aa.fail(std::string("not a rotation: ") + e.what());
-    }
-  }
-  return RigidTransform{rotation, translation};
-}
 
 std::vector<PoseGroup> parse_poses(const json& document, const std::string& source) {
   const Node root(document, "", source);
@@ -241,28 +67,6 @@ std::vector<double> read_values(const Node& node, const ParamSpec& p) {
   if (!p.sweep || !node.value().is_array()) return {read_parameter(node, p)};
   std::vector<double> out;
   for (std::size_t k = 0, m = node.array_size(); k < m; ++k) out.push_back(read_parameter(node.child(k), p));
-  return out;
-}
-
-std::vector<Budget> parse_budgets(const Node& budgets) {
-  std::vector<Budget> out;
-  for (std::size_t k = 0, m = budgets.array_size(); k < m; ++k) {
-    const Node b = budgets.child(k);
-    b.expect_object({"bv_tests", "deadline_us"});
-    Budget budget;
-    if (b.has("bv_tests"))
-      budget.max_bv_tests =
-          static_cast<std::uint64_t>(b.child("bv_tests")
-                                         .integer(static_cast<long long>(limits::kBvTests.min),
-                                                  static_cast<long long>(limits::kBvTests.max)));
-    if (b.has("deadline_us")) {
-      budget.deadline_us = b.child("deadline_us").number(limits::kDeadlineUs.min, limits::kDeadlineUs.max);
-      if (!(budget.deadline_us > 0))
-        b.child("deadline_us").fail("expected a positive number of microseconds");
-    }
-    if (budget.unlimited()) b.fail("expected \"bv_tests\" and/or \"deadline_us\"");
-    out.push_back(budget);
-  }
   return out;
 }
 
@@ -497,9 +301,11 @@ const DensitySpec& Scene::density_of(const HierarchySpec& h) const {
 }
 
 bool Scene::needs_density(const HierarchySpec& h) const {
-  return std::any_of(strategies.begin(), strategies.end(), [&](const StrategySpec& s) {
+  const bool strategy_needs = std::any_of(strategies.begin(), strategies.end(), [&](const StrategySpec& s) {
     return strategy_info(s.name).needs_density && applies(s, h);
   });
+  return strategy_needs || (world && std::any_of(world->frame_budgets.begin(), world->frame_budgets.end(),
+                                                 [&](const FrameBudgetSpec& f) { return f.applies_to(h); }));
 }
 
 std::vector<PoseGroup> load_pose_file(const std::filesystem::path& file) {
@@ -763,7 +569,6 @@ void parse_strategies(const Node& root, Scene& scene) {
     }
     scene.strategies.push_back(std::move(*spec));
   }
-  check_densities_needed(root, scene);
 }
 
 /// A "poses" workload: the pose file, read now, and its content as the workload's identity.
@@ -848,14 +653,24 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   const json document = parse_json(json_text, source);
   const Node root(document, "", source);
   root.expect_object({"name", "description", "objects", "pairs", "hierarchies", "annotation", "strategies",
-                      "workload", "report"});
+                      "workload", "report", "world"});
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : "scene";
   parse_objects(root, base_dir, scene);
+  if (root.has("world")) {
+    parse_hierarchies(root, scene);
+    parse_density(root, scene);
+    parse_strategies(root, scene);
+    if (root.has("report")) root.child("report").fail("does not apply to a world scene");
+    parse_world(root, base_dir, scene);
+    check_densities_needed(root, scene);
+    return scene;
+  }
   parse_pairs(root, scene);
   parse_hierarchies(root, scene);
   parse_density(root, scene);
   parse_strategies(root, scene);
+  check_densities_needed(root, scene);
   parse_workload(root, base_dir, scene.workload);
   parse_report(root, scene, [&](const std::string& name) { return hierarchy_skipped(scene, name); });
   return scene;

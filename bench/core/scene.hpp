@@ -38,6 +38,8 @@
 #include "traversal/adb.hpp"
 #include "volumes/geometry.hpp"
 
+#include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -144,6 +146,41 @@ struct ReportSpec {
   std::string baseline_strategy = "exact";  ///< an exact strategy
 };
 
+/// One placed copy of a scene object in a world scene. Copies of one object share its trees.
+struct WorldInstance {
+  std::string name;    ///< "jeep#3" (the object's name and its copy number), or as given
+  std::string object;  ///< a scene object's name
+};
+
+/// One entry of "frame_budgets": schedules that share one budget across a frame's candidate pairs.
+struct FrameBudgetSpec {
+  std::vector<std::string> schedules;    ///< schedule policies, by name
+  std::vector<Budget> budgets;           ///< one run per budget (BV tests and/or microseconds per frame)
+  double p_min = 0.9;                    ///< a pair whose estimate reaches it is decided colliding
+  std::vector<std::string> hierarchies;  ///< restricts it to these; empty: every hierarchy
+  [[nodiscard]] bool applies_to(const HierarchySpec& h) const {
+    return hierarchies.empty() ||
+           std::find(hierarchies.begin(), hierarchies.end(), h.name) != hierarchies.end();
+  }
+};
+
+/// Many objects moving over frames ("world" in the file; format: bench/scenes/README.md).
+struct WorldSpec {
+  std::vector<WorldInstance> instances;
+  Box region;              ///< where random placements start and random walks stay (reflected at its faces)
+  int frames = 0;          ///< how many frames
+  std::uint64_t seed = 0;  ///< random placement and walk
+  double step = 0;         ///< random walk: largest move per axis and frame, in scene units
+  double turn_deg = 0;     ///< random walk: largest turn per axis and frame, in degrees
+  std::filesystem::path frame_file;  ///< a pose per instance and frame, in place of the random walk
+  /// poses[f][i]: instance i's pose in frame f, generated or read while parsing.
+  std::vector<std::vector<RigidTransform>> poses;
+  std::vector<std::string> broad_phases;  ///< by name; default: every registered one
+  std::vector<FrameBudgetSpec> frame_budgets;
+  /// Identifies the instances and their motion for the ground-truth cache.
+  std::string identity;
+};
+
 struct Scene {
   std::string name;
   std::filesystem::path file;  ///< where it was read from (empty for a string)
@@ -154,6 +191,8 @@ struct Scene {
   std::vector<StrategySpec> strategies;
   WorkloadSpec workload;
   ReportSpec report;
+  /// Set for a world scene: many instances over frames, in place of "pairs" and "workload".
+  std::optional<WorldSpec> world;
   /// What the parser left out on purpose (an optional hierarchy this build cannot provide), for the report.
   std::vector<std::string> notes;
 

@@ -1,0 +1,188 @@
+// World scenes: many instances over frames. The motion is deterministic and stays where it was told; every
+// bad field (a missing pose, a pose that is no rotation, an option that does not apply) is refused by name.
+#include "bench/core/scene.hpp"
+#include "bench/core/world_motion.hpp"
+#include "scene_fixtures.hpp"
+#include "support/generated_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+namespace bvhlab {
+namespace {
+
+using testing::TempDir;
+
+class WorldTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    testing::write_obj(testing::make_torus(0.7, 0.25, 12, 8), dir / "torus.obj");
+    testing::write_obj(testing::make_torus(0.3, 0.1, 8, 6), dir / "ring.obj");
+  }
+  Scene parse(const std::string& text) { return parse_scene(text, dir.path(), "world.json"); }
+  std::string error_of(const std::string& text) {
+    try {
+      parse(text);
+    } catch (const SceneError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no SceneError for: " << text;
+    return {};
+  }
+  TempDir dir;
+};
+
+const std::string kObjects = R"("objects": [{"mesh": "torus.obj"}, {"mesh": "ring.obj"}])";
+const std::string kPlain =
+    R"("hierarchies": [{"bv": "aabb"}, {"bv": "obb"}], "strategies": [{"type": "exact"}])";
+// The frame budgets need a probability density on the hierarchies they run on.
+const std::string kAnnotated =
+    R"("hierarchies": [{"bv": "aabb", "annotation": {"type": "adb"}}, {"bv": "obb"}], "strategies": [{"type": "exact"}])";
+
+std::string world_scene(const std::string& world, const std::string& extra = "",
+                        const std::string& hierarchies = kPlain) {
+  return "{" + kObjects + ", " + hierarchies + extra + R"(, "world": )" + world + "}";
+}
+
+const std::string kWalk =
+    R"({"instances": [{"object": "torus", "count": 5}, {"object": "ring", "name": "lonely",
+        "placement": {"translation": [1, 2, 3]}}],
+        "region": {"min": [-10, -10, -10], "max": [10, 10, 10]},
+        "motion": {"type": "random_walk", "frames": 40, "seed": 3, "step": 0.5, "turn_deg": 10}})";
+
+TEST_F(WorldTest, RandomWalkStaysInItsRegionAndStepsNoFurtherThanAsked) {
+  const Scene scene = parse(world_scene(kWalk));
+  ASSERT_TRUE(scene.world);
+  const WorldSpec& w = *scene.world;
+  ASSERT_EQ(w.instances.size(), 6u);
+  EXPECT_EQ(w.instances[0].name, "torus#0");
+  EXPECT_EQ(w.instances[4].name, "torus#4");
+  EXPECT_EQ(w.instances[5].name, "lonely");
+  EXPECT_EQ(w.instances[5].object, "ring");
+  ASSERT_EQ(w.poses.size(), 40u);
+  EXPECT_EQ(w.poses[0][5].translation, Vec3(1, 2, 3));
+  for (std::size_t f = 0; f < w.poses.size(); ++f) {
+    ASSERT_EQ(w.poses[f].size(), 6u);
+    for (std::size_t i = 0; i < 6; ++i) {
+      const RigidTransform& p = w.poses[f][i];
+      EXPECT_TRUE(w.region.contains(p.translation)) << f << " " << i;
+      EXPECT_NEAR((p.rotation * p.rotation.transpose() - Mat3::Identity()).norm(), 0, 1e-12);
+      EXPECT_NEAR(p.rotation.determinant(), 1, 1e-12);
+      if (f == 0) continue;
+      const RigidTransform& q = w.poses[f - 1][i];
+      EXPECT_LE((p.translation - q.translation).cwiseAbs().maxCoeff(), 0.5 + 1e-12);
+      EXPECT_GT((p.translation - q.translation).norm(), 0);
+      // Three turns of at most 10 degrees each: at most 30 degrees in all.
+      const double angle = Eigen::AngleAxisd(p.rotation * q.rotation.transpose()).angle();
+      EXPECT_LE(angle, 30.0 * M_PI / 180 + 1e-9);
+    }
+  }
+  EXPECT_EQ(w.broad_phases.size(), 3u);  // every registered one by default
+}
+
+TEST_F(WorldTest, TheSameSeedGivesTheSameFramesAndAnotherSeedOthers) {
+  const auto a = parse(world_scene(kWalk)).world->poses;
+  const auto b = parse(world_scene(kWalk)).world->poses;
+  std::string other = kWalk;
+  other.replace(other.find("\"seed\": 3"), 9, "\"seed\": 4");
+  const auto c = parse(world_scene(other)).world->poses;
+  EXPECT_EQ(a[39][2].translation, b[39][2].translation);
+  EXPECT_EQ(a[39][2].rotation, b[39][2].rotation);
+  EXPECT_NE(a[39][2].translation, c[39][2].translation);
+}
+
+TEST(WorldMotion, ReflectionFoldsBackIntoTheRegion) {
+  EXPECT_DOUBLE_EQ(reflect_into(0.5, 0, 1), 0.5);
+  EXPECT_DOUBLE_EQ(reflect_into(1.25, 0, 1), 0.75);
+  EXPECT_DOUBLE_EQ(reflect_into(-0.25, 0, 1), 0.25);
+  EXPECT_DOUBLE_EQ(reflect_into(2.5, 0, 1), 0.5);
+  EXPECT_DOUBLE_EQ(reflect_into(-3, -2, 2), -1);
+}
+
+TEST_F(WorldTest, AFrameFileGivesEveryInstanceItsPose) {
+  testing::write_text(dir / "frames.json", R"({"frames": [
+      {"a": {"translation": [0, 0, 0]}, "b": {"translation": [1, 0, 0], "axis_angle_deg": [0, 0, 1, 90]}},
+      {"a": {"translation": [0, 1, 0]}, "b": {"translation": [2, 0, 0]}}]})");
+  const Scene scene = parse(world_scene(R"({"instances": [{"object": "torus", "name": "a"},
+      {"object": "ring", "name": "b"}], "motion": {"type": "frame_file", "file": "frames.json"}})"));
+  ASSERT_EQ(scene.world->poses.size(), 2u);
+  EXPECT_EQ(scene.world->poses[1][0].translation, Vec3(0, 1, 0));
+  EXPECT_NEAR(scene.world->poses[0][1].rotation(1, 0), 1, 1e-12);
+}
+
+TEST_F(WorldTest, AFrameFileWithAMissingOrUnknownInstanceOrABadPoseIsRefused) {
+  const std::string world =
+      R"({"instances": [{"object": "torus", "name": "a"}, {"object": "ring", "name": "b"}],
+      "motion": {"type": "frame_file", "file": "frames.json"}})";
+  testing::write_text(dir / "frames.json", R"({"frames": [{"a": {}, "b": {}}, {"a": {}}]})");
+  EXPECT_NE(error_of(world_scene(world)).find("/frames/1: no pose for instance \"b\""), std::string::npos);
+  testing::write_text(dir / "frames.json", R"({"frames": [{"a": {}, "b": {}, "c": {}}]})");
+  EXPECT_NE(error_of(world_scene(world)).find("/frames/0/c: no instance named \"c\""), std::string::npos);
+  testing::write_text(dir / "frames.json",
+                      R"({"frames": [{"a": {"rotation": [[2, 0, 0], [0, 1, 0], [0, 0, 1]]}, "b": {}}]})");
+  EXPECT_NE(error_of(world_scene(world)).find("/frames/0/a/rotation: not a rotation"), std::string::npos);
+  testing::write_text(dir / "frames.json", R"({"frames": [{"a": {"translation": [0, 0]}, "b": {}}]})");
+  EXPECT_NE(error_of(world_scene(world)).find("/frames/0/a/translation: expected an array of 3 numbers"),
+            std::string::npos);
+  std::filesystem::remove(dir / "frames.json");
+  EXPECT_NE(error_of(world_scene(world)).find("cannot read the frame file"), std::string::npos);
+}
+
+TEST_F(WorldTest, OptionsThatDoNotApplyAreRefusedByName) {
+  auto expect = [&](const std::string& text, const std::string& message) {
+    const std::string error = error_of(text);
+    EXPECT_NE(error.find(message), std::string::npos) << error;
+  };
+  expect(world_scene(kWalk, R"(, "pairs": [["torus", "ring"]])"), "/pairs: does not apply to a world scene");
+  expect(world_scene(kWalk, R"(, "workload": {"type": "protocol"})"), "/workload: does not apply");
+  expect(world_scene(kWalk, "", kAnnotated), "/hierarchies/0/annotation: a density is set but no strategy");
+  expect(world_scene(R"({"instances": [{"object": "teapot"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2}})"),
+         "/world/instances/0/object: no object named \"teapot\"; expected one of torus, ring");
+  expect(world_scene(R"({"instances": [{"object": "torus", "count": 2, "name": "x"}],
+      "region": {"min": [0,0,0], "max": [1,1,1]}, "motion": {"type": "random_walk", "frames": 2}})"),
+         "/world/instances/0/count: \"name\" and \"placement\" describe one instance");
+  expect(
+      world_scene(R"({"instances": [{"object": "torus"}], "motion": {"type": "random_walk", "frames": 2}})"),
+      "/world/region: missing");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,0,1]},
+      "motion": {"type": "random_walk", "frames": 2}})"),
+         "/world/region: expected \"min\" below \"max\" on every axis");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "frame_file", "file": "f.json"}})"),
+         "/world/region: does not apply to a frame file");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2}, "broad_phases": ["octree"]})"),
+         "/world/broad_phases/0: expected one of brute_force, sweep_and_prune, dynamic_aabb_tree");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2},
+      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}]}]})",
+                     "", kAnnotated),
+         "hierarchy \"obb\" carries no probability density");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2},
+      "frame_budgets": [{"schedules": ["greedy"], "budgets": [{"bv_tests": 100}], "hierarchies": ["aabb"]}]})",
+                     "", kAnnotated),
+         "/world/frame_budgets/0/schedules/0: expected one of adb_probability");
+}
+
+TEST_F(WorldTest, FrameBudgetsOnAHierarchyWithAProbabilityDensityAreKept) {
+  const Scene scene = parse(world_scene(R"({"instances": [{"object": "torus", "count": 3}],
+      "region": {"min": [0,0,0], "max": [4,4,4]}, "motion": {"type": "random_walk", "frames": 3},
+      "broad_phases": ["sweep_and_prune"],
+      "frame_budgets": [{"schedules": ["adb_probability", "equal_split"], "budgets": [{"bv_tests": 100},
+                         {"deadline_us": 50}], "p_min": 0.8, "hierarchies": ["aabb"]}]})",
+                                        "", kAnnotated));
+  ASSERT_EQ(scene.world->frame_budgets.size(), 1u);
+  const FrameBudgetSpec& fb = scene.world->frame_budgets[0];
+  EXPECT_EQ(fb.schedules, (std::vector<std::string>{"adb_probability", "equal_split"}));
+  ASSERT_EQ(fb.budgets.size(), 2u);
+  EXPECT_EQ(fb.budgets[0].max_bv_tests, 100u);
+  EXPECT_DOUBLE_EQ(fb.budgets[1].deadline_us, 50);
+  EXPECT_DOUBLE_EQ(fb.p_min, 0.8);
+  EXPECT_EQ(scene.world->broad_phases, std::vector<std::string>{"sweep_and_prune"});
+  // Without a step, nothing moves; the frames still exist.
+  EXPECT_EQ(scene.world->poses[2][1].translation, scene.world->poses[0][1].translation);
+}
+
+}  // namespace
+}  // namespace bvhlab
