@@ -7,6 +7,7 @@
 #include "traversal/adb.hpp"
 #include "traversal/exact.hpp"
 #include "volumes/aabb.hpp"
+#include "volumes/shipped.hpp"
 
 #include <gtest/gtest.h>
 
@@ -128,6 +129,24 @@ Result run(Strategy s, const Annotated<BV>& a, const Annotated<BV>& b, const Rig
   }
   throw std::logic_error("unknown strategy");
 }
+
+// Compiled once, in robust_support.cpp, for every shipped volume: each test file of the suite only calls
+// them (instantiating the five strategies and the annotation per volume in every file cost minutes of CI).
+#define BVHLAB_ROBUST_INSTANTIATIONS(PREFIX, BV)                                       \
+  PREFIX template Result run<BV>(Strategy, const Annotated<BV>&, const Annotated<BV>&, \
+                                 const RigidTransform&, double, std::uint64_t);        \
+  PREFIX template Annotated<BV> annotated<BV>(const Mesh&, const BuildOptions&);
+#define BVHLAB_ROBUST_EXTERN(BV) BVHLAB_ROBUST_INSTANTIATIONS(extern, BV)
+BVHLAB_ROBUST_EXTERN(Aabb)
+BVHLAB_ROBUST_EXTERN(Dop<6>)
+BVHLAB_ROBUST_EXTERN(Dop<14>)
+BVHLAB_ROBUST_EXTERN(Dop<18>)
+BVHLAB_ROBUST_EXTERN(Dop24)
+BVHLAB_ROBUST_EXTERN(Dop<26>)
+BVHLAB_ROBUST_EXTERN(Obb)
+BVHLAB_ROBUST_EXTERN(Sphere)
+BVHLAB_ROBUST_EXTERN(RestrictedBox)
+#undef BVHLAB_ROBUST_EXTERN
 
 /// The one promise every strategy keeps: an answer marked exact is right, probabilities are probabilities.
 inline ::testing::AssertionResult honest(const Result& r, bool truth) {
