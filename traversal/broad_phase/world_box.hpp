@@ -16,6 +16,11 @@
 //                          tighter for a rotated DOP; it costs one vertex search per direction (six).
 //   Sphere                 centre R c + t, radius r.
 //
+// With the object's BoundingBall (the farthest vertex from the root box's centre, computed once per tree),
+// the box is also cut to the cube around that ball: for a round object (a sphere meshed inside an Aabb
+// tree) that cube is up to sqrt(3) times narrower than the rotated root box; for a box-like object the
+// rotated root box stays the tighter, and the intersection keeps the better of the two on every axis.
+//
 // Every box is widened by a few ulps of the magnitudes involved, so rounding never loses a vertex.
 #pragma once
 
@@ -24,6 +29,7 @@
 #include "../../volumes/obb.hpp"
 #include "../../volumes/sphere.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -116,6 +122,39 @@ template <TreeVolume BV>
 Box world_box(const Bvh<BV>& tree, const RigidTransform& pose) {
   if (tree.empty()) return {};
   return world_box(tree.root_volume(), pose);
+}
+
+/// A ball around every vertex of an object, in its own frame: the centre of its root's bounding box and
+/// the distance to the farthest vertex. Derived once per tree (bounding_ball); a round object's rotated
+/// root box is up to sqrt(3) times wider than the cube around this ball.
+struct BoundingBall {
+  Vec3 centre = Vec3::Zero();
+  double radius = -1;  ///< negative: no ball known (the root volume alone bounds the object)
+};
+
+/// The tree's bounding ball from its polygons; no ball (radius -1) for a tree loaded without them.
+template <TreeVolume BV>
+BoundingBall bounding_ball(const Bvh<BV>& tree) {
+  BoundingBall ball;
+  if (tree.empty() || !tree.has_polygons()) return ball;
+  ball.centre = tree.root_volume().bounding_box().center();
+  double farthest = 0;
+  for (const TrianglePoints& t : tree.triangles())
+    for (const Vec3& v : t) farthest = std::max(farthest, (v - ball.centre).squaredNorm());
+  ball.radius = std::sqrt(farthest) * (1 + world_box_detail::kUlps);
+  return ball;
+}
+
+/// The tree's world box, intersected with the cube around its bounding ball: the tighter of the two on
+/// every axis (the ball wins for round objects, the root volume for long or flat ones).
+template <TreeVolume BV>
+Box world_box(const Bvh<BV>& tree, const RigidTransform& pose, const BoundingBall& ball) {
+  const Box box = world_box(tree, pose);
+  if (ball.radius < 0 || box.empty()) return box;
+  const Box cube =
+      world_box_detail::around(pose.rotation * ball.centre + pose.translation, Vec3::Constant(ball.radius),
+                               ball.centre.cwiseAbs().maxCoeff() + pose.translation.cwiseAbs().maxCoeff());
+  return world_box_detail::intersection(box, cube);
 }
 
 }  // namespace bvhlab
