@@ -326,6 +326,12 @@ TYPED_TEST(WorldBox, ContainsEveryTransformedVertexAndIsNoLargerThanTheRotatedRo
         ASSERT_TRUE(world.contains(pose.apply(v)))
             << mesh.name << ", pose " << k << ": vertex " << pose.apply(v).transpose() << " outside ["
             << world.min.transpose() << "] - [" << world.max.transpose() << "]";
+      // With the bounding ball: still every vertex, and never larger than without it.
+      const Box balled = world_box(tree, pose, bounding_ball(tree));
+      for (const Vec3& v : mesh.vertices)
+        ASSERT_TRUE(balled.contains(pose.apply(v))) << mesh.name << ", pose " << k << " (with the ball)";
+      EXPECT_TRUE((balled.min.array() >= world.min.array()).all() &&
+                  (balled.max.array() <= world.max.array()).all());
       const Box reference = rotated_corners(local, pose);
       const double tolerance =
           1e-9 * (reference.extent().maxCoeff() + pose.translation.cwiseAbs().maxCoeff());
@@ -345,6 +351,15 @@ TEST(WorldBox, AabbRootUnder45DegreesIsTighterThanTheCubeAroundItsSphere) {
   const Box local = tree.root_volume().bounding_box();
   const double radius = local.extent().norm() / 2;  // the box's circumscribed sphere
   for (int k = 0; k < 3; ++k) EXPECT_LT(world.extent()[k], 2 * radius * 0.9) << "axis " << k;
+  // A round object in an Aabb tree: its bounding ball cuts the rotated root box down to the sphere's cube.
+  const auto round = Bvh<Aabb>::build(generators::make_sphere(30, 16, 16));
+  RigidTransform tilted = pose;
+  tilted.rotation = Eigen::AngleAxisd(0.6, Vec3(1, 1, 0).normalized()).toRotationMatrix();
+  const Box rotated = world_box(round, tilted), balled = world_box(round, tilted, bounding_ball(round));
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LE(balled.extent()[k], 60 * (1 + 1e-9)) << "axis " << k;
+    EXPECT_GT(rotated.extent()[k], 60 * 1.05) << "axis " << k;
+  }
   // And a sphere root really is a sphere: centre and radius, not its rotated bounding box.
   const auto ball = Bvh<Sphere>::build(generators::make_sphere(30, 16, 16));
   const Box ball_box = world_box(ball, pose);
