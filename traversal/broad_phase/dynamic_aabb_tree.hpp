@@ -7,8 +7,10 @@
 // box stays inside that fat box, its update costs one containment test and nothing else; once it leaves, the
 // leaf is removed and reinserted with a fresh fat box (reinsertions() counts those).
 //
-// Insertion descends from the root by a surface-area cost: at each inner node it compares making a new
-// parent of the leaf and this node (twice the merged box's area) with descending into either child (the
+// Registration builds the tree top-down (median splits), and so does a frame in which more than a quarter
+// of the objects left their fat boxes (reinserting most leaves one by one costs more than building anew).
+// Otherwise, insertion descends from the root by a surface-area cost: at each inner node it compares making a
+// new parent of the leaf and this node (twice the merged box's area) with descending into either child (the
 // child's area growth, plus the growth every ancestor on the way already pays). That is the greedy
 // surface-area heuristic; it keeps boxes that are near each other under one parent. Every ancestor of a
 // changed leaf is then refitted and, where its children's heights differ by more than one, rotated (the
@@ -50,16 +52,22 @@ class DynamicAabbTree {
       registered_ = static_cast<std::int64_t>(boxes.size());
       register_objects();
     } else {
-      last_reinsertions_ = 0;
-      for (std::uint32_t i = 0; i < leaf_of_.size(); ++i) {
-        const std::int32_t leaf = leaf_of_[i];
-        if (contains(nodes_[leaf].box, tight_[i])) continue;
-        remove_leaf(leaf);
-        nodes_[leaf].box = fattened(tight_[i]);
-        insert_leaf(leaf);
-        ++last_reinsertions_;
-      }
+      moved_.clear();
+      for (std::uint32_t i = 0; i < leaf_of_.size(); ++i)
+        if (!contains(nodes_[leaf_of_[i]].box, tight_[i])) moved_.push_back(i);
+      last_reinsertions_ = moved_.size();
       reinsertions_ += last_reinsertions_;
+      if (moved_.size() > kRebuildShare * double(leaf_of_.size())) {
+        for (std::uint32_t i : moved_) nodes_[leaf_of_[i]].box = fattened(tight_[i]);
+        rebuild();
+      } else {
+        for (std::uint32_t i : moved_) {
+          const std::int32_t leaf = leaf_of_[i];
+          remove_leaf(leaf);
+          nodes_[leaf].box = fattened(tight_[i]);
+          insert_leaf(leaf);
+        }
+      }
     }
     find_pairs();
   }
@@ -78,6 +86,8 @@ class DynamicAabbTree {
 
  private:
   static constexpr std::int32_t kNull = -1;
+  /// When more than this share of the objects left their fat boxes in one frame, the tree is rebuilt.
+  static constexpr double kRebuildShare = 0.25;
 
   // Leaves have left == kNull and keep their object in `right`.
   struct Node {
@@ -116,18 +126,50 @@ class DynamicAabbTree {
   }
 
   void register_objects() {
-    nodes_.clear();
-    free_.clear();
-    root_ = kNull;
-    nodes_.reserve(2 * tight_.size());
+    nodes_.assign(tight_.size(), Node{});
     leaf_of_.resize(tight_.size());
     for (std::uint32_t i = 0; i < tight_.size(); ++i) {
-      const std::int32_t leaf = allocate();
-      nodes_[leaf].box = fattened(tight_[i]);
-      nodes_[leaf].right = static_cast<std::int32_t>(i);
-      leaf_of_[i] = leaf;
-      insert_leaf(leaf);
+      nodes_[i].box = fattened(tight_[i]);
+      nodes_[i].right = static_cast<std::int32_t>(i);
+      leaf_of_[i] = static_cast<std::int32_t>(i);
     }
+    rebuild();
+  }
+
+  // Drops every inner node and builds them again top-down over the leaves as they are: each range of
+  // leaves is split at the median of their centres along the axis where the centres spread most. O(n log n),
+  // balanced by construction; far cheaper than reinserting most leaves one by one.
+  void rebuild() {
+    const std::size_t n = leaf_of_.size();
+    nodes_.resize(n);  // leaves are nodes 0 .. n-1 (register_objects), inner nodes follow
+    free_.clear();
+    root_ = kNull;
+    if (n == 0) return;
+    order_.assign(leaf_of_.begin(), leaf_of_.end());
+    centres_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) centres_[i] = nodes_[i].box.center();
+    nodes_.reserve(2 * n);
+    root_ = build_range(0, n);
+    nodes_[root_].parent = kNull;
+  }
+
+  std::int32_t build_range(std::size_t begin, std::size_t end) {
+    if (end - begin == 1) return order_[begin];
+    Box spread;
+    for (std::size_t k = begin; k < end; ++k) spread.extend(centres_[order_[k]]);
+    int axis = 0;
+    spread.extent().maxCoeff(&axis);
+    const std::size_t middle = begin + (end - begin) / 2;
+    std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
+                     [&](std::int32_t a, std::int32_t b) { return centres_[a][axis] < centres_[b][axis]; });
+    const std::int32_t left = build_range(begin, middle), right = build_range(middle, end);
+    const std::int32_t parent = allocate();
+    nodes_[parent].left = left;
+    nodes_[parent].right = right;
+    nodes_[left].parent = parent;
+    nodes_[right].parent = parent;
+    refit(parent);
+    return parent;
   }
 
   // The sibling the surface-area heuristic picks for a new leaf with box b.
@@ -275,6 +317,9 @@ class DynamicAabbTree {
   std::uint64_t reinsertions_ = 0;
   std::uint64_t last_reinsertions_ = 0;
   std::vector<std::pair<std::int32_t, std::int32_t>> stack_;
+  std::vector<std::uint32_t> moved_;  // objects outside their fat boxes this frame
+  std::vector<std::int32_t> order_;   // rebuild: leaves, partitioned
+  std::vector<Vec3> centres_;         // rebuild: leaf box centres
   std::vector<ObjectPair> pairs_;
 };
 
