@@ -1,5 +1,6 @@
-// Procedural geometry shared by the benchmarks and the tests: a closed torus, and random well-shaped
-// triangles. Deterministic for a given std::mt19937_64 state (the benchmarks and the tests fix their seeds).
+// Procedural geometry shared by the benchmarks and the tests: a closed torus, box, sphere and cylinder, and
+// random well-shaped triangles. Deterministic for a given std::mt19937_64 state (the benchmarks and the tests
+// fix their seeds).
 #pragma once
 
 #include "bvh/mesh.hpp"
@@ -28,6 +29,76 @@ inline Mesh make_torus(double major, double minor, int nu, int nv) {
       m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
       m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
     }
+  return m;
+}
+
+/// Closed axis-aligned box centred on the origin with sides (x, y, z): 8 vertices, 12 triangles.
+inline Mesh make_box(double x, double y, double z) {
+  Mesh m;
+  m.name = "box";
+  for (int k = 0; k < 8; ++k)
+    m.vertices.emplace_back(k & 1 ? x / 2 : -x / 2, k & 2 ? y / 2 : -y / 2, k & 4 ? z / 2 : -z / 2);
+  // Two triangles per face, wound outwards; faces as corner quadruples in cyclic order.
+  const std::uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) {
+    m.triangles.push_back({f[0], f[1], f[2]});
+    m.triangles.push_back({f[0], f[2], f[3]});
+  }
+  return m;
+}
+
+/// Closed UV sphere of radius r around the origin: `rings` latitude bands of `segments` quads (the bands at
+/// the poles as triangle fans), 2 * segments * (rings - 1) triangles. Vertices lie on the sphere.
+inline Mesh make_sphere(double r, int segments, int rings) {
+  Mesh m;
+  m.name = "sphere";
+  m.vertices.emplace_back(0, 0, r);
+  for (int i = 1; i < rings; ++i) {
+    const double theta = std::numbers::pi * i / rings;
+    for (int j = 0; j < segments; ++j) {
+      const double phi = 2 * std::numbers::pi * j / segments;
+      m.vertices.emplace_back(r * std::sin(theta) * std::cos(phi), r * std::sin(theta) * std::sin(phi),
+                              r * std::cos(theta));
+    }
+  }
+  m.vertices.emplace_back(0, 0, -r);
+  const auto south = static_cast<std::uint32_t>(m.vertices.size() - 1);
+  auto id = [&](int ring, int j) {
+    return static_cast<std::uint32_t>(1 + (ring - 1) * segments + j % segments);
+  };
+  for (int j = 0; j < segments; ++j) {
+    m.triangles.push_back({0, id(1, j), id(1, j + 1)});
+    m.triangles.push_back({south, id(rings - 1, j + 1), id(rings - 1, j)});
+  }
+  for (int i = 1; i + 1 < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return m;
+}
+
+/// Closed cylinder of radius r and length `length` along z, centred on the origin, its circles as
+/// `segments`-gons: 4 * segments triangles.
+inline Mesh make_cylinder(double r, double length, int segments) {
+  Mesh m;
+  m.name = "cylinder";
+  for (int side = 0; side < 2; ++side)
+    for (int j = 0; j < segments; ++j) {
+      const double phi = 2 * std::numbers::pi * j / segments;
+      m.vertices.emplace_back(r * std::cos(phi), r * std::sin(phi), side ? length / 2 : -length / 2);
+    }
+  m.vertices.emplace_back(0, 0, -length / 2);
+  m.vertices.emplace_back(0, 0, length / 2);
+  const auto bottom = static_cast<std::uint32_t>(2 * segments), top = bottom + 1;
+  auto id = [&](int side, int j) { return static_cast<std::uint32_t>(side * segments + j % segments); };
+  for (int j = 0; j < segments; ++j) {
+    m.triangles.push_back({bottom, id(0, j + 1), id(0, j)});
+    m.triangles.push_back({top, id(1, j), id(1, j + 1)});
+    m.triangles.push_back({id(0, j), id(0, j + 1), id(1, j + 1)});
+    m.triangles.push_back({id(0, j), id(1, j + 1), id(1, j)});
+  }
   return m;
 }
 

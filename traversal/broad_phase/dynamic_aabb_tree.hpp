@@ -1,0 +1,328 @@
+// DynamicAabbTree: a binary tree over fattened object boxes, kept across frames and changed only where
+// objects left their fattened boxes.
+//
+// Fattening: an object's leaf holds its box grown on every side by
+//     margin = relative_margin * (largest side of the object's box) + absolute_margin
+// (defaults 0.1 and 0: a tenth of the object's size, with no unit-dependent constant). While the object's
+// box stays inside that fat box, its update costs one containment test and nothing else; once it leaves, the
+// leaf is removed and reinserted with a fresh fat box (reinsertions() counts those).
+//
+// Registration builds the tree top-down (median splits), and so does a frame in which more than a quarter
+// of the objects left their fat boxes (reinserting most leaves one by one costs more than building anew).
+// Otherwise, insertion descends from the root by a surface-area cost: at each inner node it compares making a
+// new parent of the leaf and this node (twice the merged box's area) with descending into either child (the
+// child's area growth, plus the growth every ancestor on the way already pays). That is the greedy
+// surface-area heuristic; it keeps boxes that are near each other under one parent. Every ancestor of a
+// changed leaf is then refitted and, where its children's heights differ by more than one, rotated (the
+// taller child moves up, AVL style), so the height stays O(log n) whatever the insertion order.
+//
+// Pairs: one self traversal of the tree per frame (a node with itself: its two children with each other
+// and each with itself; two nodes: descend the larger while their fat boxes touch). Two leaves whose fat
+// boxes touch are a candidate, kept only if the objects' own boxes touch, so pairs() is exactly the
+// overlapping tight boxes, as for the other broad phases.
+#pragma once
+
+#include "broad_phase.hpp"
+
+#include <algorithm>
+#include <utility>
+
+namespace bvhlab {
+
+class DynamicAabbTree {
+ public:
+  struct Options {
+    double relative_margin = 0.1;  ///< fraction of the object box's largest side added on every side
+    double absolute_margin = 0;    ///< added on every side, in the scene's units
+  };
+
+  DynamicAabbTree() = default;
+  explicit DynamicAabbTree(const Options& options) : options_(options) {
+    if (!(options.relative_margin >= 0 && options.absolute_margin >= 0 &&
+          std::isfinite(options.relative_margin) && std::isfinite(options.absolute_margin)))
+      throw std::invalid_argument("dynamic_aabb_tree: margins must be finite and non-negative");
+  }
+
+  static constexpr std::string_view name() { return "dynamic_aabb_tree"; }
+
+  void update(std::span<const Box> boxes) {
+    broad_phase_detail::check_update(name(), boxes, registered_);
+    tight_.assign(boxes.begin(), boxes.end());
+    if (registered_ < 0) {
+      registered_ = static_cast<std::int64_t>(boxes.size());
+      register_objects();
+    } else {
+      moved_.clear();
+      for (std::uint32_t i = 0; i < leaf_of_.size(); ++i)
+        if (!contains(nodes_[leaf_of_[i]].box, tight_[i])) moved_.push_back(i);
+      last_reinsertions_ = moved_.size();
+      reinsertions_ += last_reinsertions_;
+      if (moved_.size() > kRebuildShare * double(leaf_of_.size())) {
+        for (std::uint32_t i : moved_) nodes_[leaf_of_[i]].box = fattened(tight_[i]);
+        rebuild();
+      } else {
+        for (std::uint32_t i : moved_) {
+          const std::int32_t leaf = leaf_of_[i];
+          remove_leaf(leaf);
+          nodes_[leaf].box = fattened(tight_[i]);
+          insert_leaf(leaf);
+        }
+      }
+    }
+    find_pairs();
+  }
+
+  [[nodiscard]] const std::vector<ObjectPair>& pairs() const { return pairs_; }
+
+  /// Leaves removed and reinserted because their object left its fat box, since registration.
+  [[nodiscard]] std::uint64_t reinsertions() const { return reinsertions_; }
+  /// The same, in the last update only.
+  [[nodiscard]] std::uint64_t last_reinsertions() const { return last_reinsertions_; }
+  /// Edges on the longest root-to-leaf path (0 for a single leaf or none).
+  [[nodiscard]] int height() const { return root_ == kNull ? 0 : nodes_[root_].height; }
+  /// The fattened box object i's leaf holds.
+  [[nodiscard]] const Box& fat_box(std::uint32_t object) const { return nodes_[leaf_of_.at(object)].box; }
+  [[nodiscard]] const Options& options() const { return options_; }
+
+ private:
+  static constexpr std::int32_t kNull = -1;
+  /// When more than this share of the objects left their fat boxes in one frame, the tree is rebuilt.
+  static constexpr double kRebuildShare = 0.25;
+
+  // Leaves have left == kNull and keep their object in `right`.
+  struct Node {
+    Box box;
+    std::int32_t parent = kNull;
+    std::int32_t left = kNull;
+    std::int32_t right = kNull;
+    std::int32_t height = 0;
+  };
+
+  [[nodiscard]] bool is_leaf(std::int32_t i) const { return nodes_[i].left == kNull; }
+
+  static bool contains(const Box& outer, const Box& inner) {
+    return (outer.min.array() <= inner.min.array()).all() && (inner.max.array() <= outer.max.array()).all();
+  }
+  static Box merged(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
+  static double half_area(const Box& b) {
+    const Vec3 e = b.max - b.min;
+    return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+  }
+
+  [[nodiscard]] Box fattened(const Box& b) const {
+    const double margin = options_.relative_margin * (b.max - b.min).maxCoeff() + options_.absolute_margin;
+    return {b.min.array() - margin, b.max.array() + margin};
+  }
+
+  std::int32_t allocate() {
+    if (!free_.empty()) {
+      const std::int32_t i = free_.back();
+      free_.pop_back();
+      nodes_[i] = Node{};
+      return i;
+    }
+    nodes_.emplace_back();
+    return static_cast<std::int32_t>(nodes_.size() - 1);
+  }
+
+  void register_objects() {
+    nodes_.assign(tight_.size(), Node{});
+    leaf_of_.resize(tight_.size());
+    for (std::uint32_t i = 0; i < tight_.size(); ++i) {
+      nodes_[i].box = fattened(tight_[i]);
+      nodes_[i].right = static_cast<std::int32_t>(i);
+      leaf_of_[i] = static_cast<std::int32_t>(i);
+    }
+    rebuild();
+  }
+
+  // Drops every inner node and builds them again top-down over the leaves as they are: each range of
+  // leaves is split at the median of their centres along the axis where the centres spread most. O(n log n),
+  // balanced by construction; far cheaper than reinserting most leaves one by one.
+  void rebuild() {
+    const std::size_t n = leaf_of_.size();
+    nodes_.resize(n);  // leaves are nodes 0 .. n-1 (register_objects), inner nodes follow
+    free_.clear();
+    root_ = kNull;
+    if (n == 0) return;
+    order_.assign(leaf_of_.begin(), leaf_of_.end());
+    centres_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) centres_[i] = nodes_[i].box.center();
+    nodes_.reserve(2 * n);
+    root_ = build_range(0, n);
+    nodes_[root_].parent = kNull;
+  }
+
+  std::int32_t build_range(std::size_t begin, std::size_t end) {
+    if (end - begin == 1) return order_[begin];
+    Box spread;
+    for (std::size_t k = begin; k < end; ++k) spread.extend(centres_[order_[k]]);
+    int axis = 0;
+    spread.extent().maxCoeff(&axis);
+    const std::size_t middle = begin + (end - begin) / 2;
+    std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
+                     [&](std::int32_t a, std::int32_t b) { return centres_[a][axis] < centres_[b][axis]; });
+    const std::int32_t left = build_range(begin, middle), right = build_range(middle, end);
+    const std::int32_t parent = allocate();
+    nodes_[parent].left = left;
+    nodes_[parent].right = right;
+    nodes_[left].parent = parent;
+    nodes_[right].parent = parent;
+    refit(parent);
+    return parent;
+  }
+
+  // The sibling the surface-area heuristic picks for a new leaf with box b.
+  [[nodiscard]] std::int32_t choose_sibling(const Box& b) const {
+    std::int32_t i = root_;
+    double inherited = 0;  // area growth of the ancestors already passed
+    while (!is_leaf(i)) {
+      const Node& n = nodes_[i];
+      const double area = half_area(n.box), combined = half_area(merged(n.box, b));
+      const double here = combined + inherited;  // a new parent of i and the leaf
+      inherited += combined - area;
+      auto descend_cost = [&](std::int32_t c) {
+        const double grown = half_area(merged(nodes_[c].box, b));
+        return (is_leaf(c) ? grown : grown - half_area(nodes_[c].box)) + inherited;
+      };
+      const double left = descend_cost(n.left), right = descend_cost(n.right);
+      if (here <= left && here <= right) break;
+      i = left <= right ? n.left : n.right;
+    }
+    return i;
+  }
+
+  void insert_leaf(std::int32_t leaf) {
+    if (root_ == kNull) {
+      root_ = leaf;
+      nodes_[leaf].parent = kNull;
+      return;
+    }
+    const std::int32_t sibling = choose_sibling(nodes_[leaf].box);
+    const std::int32_t old_parent = nodes_[sibling].parent;
+    const std::int32_t parent = allocate();  // may reallocate nodes_: no references held across it
+    nodes_[parent].parent = old_parent;
+    nodes_[parent].left = sibling;
+    nodes_[parent].right = leaf;
+    replace_child(old_parent, sibling, parent);
+    nodes_[sibling].parent = parent;
+    nodes_[leaf].parent = parent;
+    refit_upwards(parent);
+  }
+
+  void remove_leaf(std::int32_t leaf) {
+    if (leaf == root_) {
+      root_ = kNull;
+      return;
+    }
+    const std::int32_t parent = nodes_[leaf].parent;
+    const std::int32_t grand = nodes_[parent].parent;
+    const std::int32_t sibling = nodes_[parent].left == leaf ? nodes_[parent].right : nodes_[parent].left;
+    replace_child(grand, parent, sibling);
+    nodes_[sibling].parent = grand;
+    free_.push_back(parent);
+    nodes_[leaf].parent = kNull;
+    if (grand != kNull) refit_upwards(grand);
+  }
+
+  // In `parent` (or at the root when parent is kNull), `from` becomes `to`.
+  void replace_child(std::int32_t parent, std::int32_t from, std::int32_t to) {
+    if (parent == kNull)
+      root_ = to;
+    else if (nodes_[parent].left == from)
+      nodes_[parent].left = to;
+    else
+      nodes_[parent].right = to;
+  }
+
+  void refit(std::int32_t i) {
+    Node& n = nodes_[i];
+    n.box = merged(nodes_[n.left].box, nodes_[n.right].box);
+    n.height = 1 + std::max(nodes_[n.left].height, nodes_[n.right].height);
+  }
+
+  void refit_upwards(std::int32_t i) {
+    while (i != kNull) {
+      i = rebalance(i);
+      refit(i);
+      i = nodes_[i].parent;
+    }
+  }
+
+  // If one child of i is more than one level taller than the other, the taller child takes i's place, i
+  // keeps the shorter child and the shorter of the taller one's children. Returns the node now at i's place.
+  std::int32_t rebalance(std::int32_t i) {
+    const std::int32_t l = nodes_[i].left, r = nodes_[i].right;
+    const std::int32_t skew = nodes_[r].height - nodes_[l].height;
+    if (skew >= -1 && skew <= 1) return i;
+    const bool right_heavy = skew > 1;
+    const std::int32_t up = right_heavy ? r : l;
+    const std::int32_t f = nodes_[up].left, g = nodes_[up].right;
+    const bool keep_f = nodes_[f].height > nodes_[g].height;
+    const std::int32_t keep = keep_f ? f : g, give = keep_f ? g : f;
+
+    replace_child(nodes_[i].parent, i, up);
+    nodes_[up].parent = nodes_[i].parent;
+    nodes_[up].left = i;
+    nodes_[up].right = keep;
+    nodes_[i].parent = up;
+    (right_heavy ? nodes_[i].right : nodes_[i].left) = give;
+    nodes_[give].parent = i;
+    refit(i);
+    refit(up);
+    return up;
+  }
+
+  void find_pairs() {
+    pairs_.clear();
+    if (root_ == kNull) return;
+    stack_.clear();
+    stack_.emplace_back(root_, root_);
+    while (!stack_.empty()) {
+      const auto [a, b] = stack_.back();
+      stack_.pop_back();
+      const Node& na = nodes_[a];
+      if (a == b) {
+        if (na.left == kNull) continue;
+        stack_.emplace_back(na.left, na.left);
+        stack_.emplace_back(na.right, na.right);
+        stack_.emplace_back(na.left, na.right);
+        continue;
+      }
+      const Node& nb = nodes_[b];
+      if (!broad_phase_detail::boxes_touch(na.box, nb.box)) continue;
+      const bool a_leaf = na.left == kNull, b_leaf = nb.left == kNull;
+      if (a_leaf && b_leaf) {
+        const auto oa = static_cast<std::uint32_t>(na.right), ob = static_cast<std::uint32_t>(nb.right);
+        if (broad_phase_detail::boxes_touch(tight_[oa], tight_[ob]))
+          pairs_.push_back(broad_phase_detail::ordered_pair(oa, ob));
+      } else if (b_leaf || (!a_leaf && na.height >= nb.height)) {
+        stack_.emplace_back(na.left, b);
+        stack_.emplace_back(na.right, b);
+      } else {
+        stack_.emplace_back(a, nb.left);
+        stack_.emplace_back(a, nb.right);
+      }
+    }
+    std::sort(pairs_.begin(), pairs_.end());
+  }
+
+  Options options_{};
+  std::int64_t registered_ = -1;
+  std::vector<Node> nodes_;
+  std::vector<std::int32_t> free_;
+  std::vector<std::int32_t> leaf_of_;  // object -> its leaf
+  std::vector<Box> tight_;             // this frame's object boxes
+  std::int32_t root_ = kNull;
+  std::uint64_t reinsertions_ = 0;
+  std::uint64_t last_reinsertions_ = 0;
+  std::vector<std::pair<std::int32_t, std::int32_t>> stack_;
+  std::vector<std::uint32_t> moved_;  // objects outside their fat boxes this frame
+  std::vector<std::int32_t> order_;   // rebuild: leaves, partitioned
+  std::vector<Vec3> centres_;         // rebuild: leaf box centres
+  std::vector<ObjectPair> pairs_;
+};
+
+static_assert(BroadPhase<DynamicAabbTree>);
+
+}  // namespace bvhlab

@@ -1,0 +1,71 @@
+// The broad phases by name, for tools that choose one at run time. A new broad phase is one header
+// (a model of BroadPhase, broad_phase.hpp) and one entry in RegisteredBroadPhases below.
+#pragma once
+
+#include "broad_phase.hpp"
+#include "brute_force.hpp"
+#include "dynamic_aabb_tree.hpp"
+#include "sweep_and_prune.hpp"
+
+#include <memory>
+
+namespace bvhlab {
+
+template <class... Bs>
+struct BroadPhaseList {};
+
+using RegisteredBroadPhases = BroadPhaseList<BruteForce, SweepAndPrune, DynamicAabbTree>;
+
+/// A broad phase chosen at run time: the concept's operations behind one virtual call per frame.
+class AnyBroadPhase {
+ public:
+  virtual ~AnyBroadPhase() = default;
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  virtual void update(std::span<const Box> world_boxes) = 0;
+  [[nodiscard]] virtual const std::vector<ObjectPair>& pairs() const = 0;
+};
+
+namespace broad_phase_detail {
+
+template <BroadPhase B>
+class Holder final : public AnyBroadPhase {
+ public:
+  [[nodiscard]] std::string_view name() const override { return B::name(); }
+  void update(std::span<const Box> world_boxes) override { model_.update(world_boxes); }
+  [[nodiscard]] const std::vector<ObjectPair>& pairs() const override { return model_.pairs(); }
+
+ private:
+  B model_;
+};
+
+template <class... Bs>
+std::vector<std::string> names(BroadPhaseList<Bs...>) {
+  return {std::string(Bs::name())...};
+}
+
+template <class... Bs>
+std::unique_ptr<AnyBroadPhase> make(std::string_view name, BroadPhaseList<Bs...>) {
+  std::unique_ptr<AnyBroadPhase> out;
+  ((out = !out && Bs::name() == name ? std::make_unique<Holder<Bs>>() : std::move(out)), ...);
+  return out;
+}
+
+}  // namespace broad_phase_detail
+
+/// The registered broad phases' names, in registry order.
+inline std::vector<std::string> broad_phase_names() {
+  return broad_phase_detail::names(RegisteredBroadPhases{});
+}
+
+/// A fresh broad phase (default options) by name; std::invalid_argument listing the known names otherwise.
+inline std::unique_ptr<AnyBroadPhase> make_broad_phase(std::string_view name) {
+  auto out = broad_phase_detail::make(name, RegisteredBroadPhases{});
+  if (!out) {
+    std::string known;
+    for (const auto& n : broad_phase_names()) known += (known.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("unknown broad phase '" + std::string(name) + "' (known: " + known + ")");
+  }
+  return out;
+}
+
+}  // namespace bvhlab
