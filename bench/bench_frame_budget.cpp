@@ -3,7 +3,9 @@
 // on AABB trees, g = 2) at random poses near contact, about a third colliding (deterministic seed); ground
 // truth per pair from the exact strategy. For each frame size, policy and frame budget (BV tests: fractions
 // of what the frame's ADB answers cost without a budget; or microseconds), the benchmark reports the time
-// per frame and, as counters, the missed and the false colliding pairs per frame. The summary adds the
+// per frame and, as counters, the missed and the false colliding pairs per frame; budget "none" is ADB's own
+// error without a budget (every policy gives the same answers then), beside the same pairs through query_adb
+// one after the other (the scheduler's overhead). The summary adds the
 // median and 90th percentile of a frame's wall time and compares every policy's misses with equal_split's.
 //
 //   bench_frame_budget [--pairs=20,50,100] [--frames=10] [--fractions=0.0625,0.125,0.25,0.5]
@@ -27,6 +29,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace bvhlab {
@@ -102,13 +105,26 @@ double quantile(std::vector<double>& values, double q) {
   return *at;
 }
 
-void run_frames(benchmark::State& state, const FrameSet& set, const FrameOptions& options, Measured& out) {
+/// The frame's pairs one after the other through query_adb, without a budget: the scheduler's overhead is
+/// the difference to schedule_frame without a budget.
+std::vector<PairOutcome> pair_by_pair(const Frame& frame, const FrameOptions& options) {
+  std::vector<PairOutcome> outcomes;
+  for (const auto& p : frame) {
+    const Result r = query_adb(*p.a, *p.b, p.b_to_a, options.pair_options());
+    outcomes.push_back({r.collides, r.probability, r.budget_exhausted, r.exact, r.counters});
+  }
+  return outcomes;
+}
+
+void run_frames(benchmark::State& state, const FrameSet& set, const FrameOptions& options, bool scheduled,
+                Measured& out) {
   double missed = 0, false_colliding = 0, flagged = 0, bv_tests = 0;
   std::vector<double> frame_us;
   for (auto _ : state) {
     for (std::size_t f = 0; f < set.frames.size(); ++f) {
       const auto start = std::chrono::steady_clock::now();
-      const auto outcomes = schedule_frame<Aabb, AdbDensity>(set.frames[f], options);
+      const auto outcomes = scheduled ? schedule_frame<Aabb, AdbDensity>(set.frames[f], options)
+                                      : pair_by_pair(set.frames[f], options);
       frame_us.push_back(
           std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
       for (std::size_t k = 0; k < outcomes.size(); ++k) {
@@ -133,16 +149,18 @@ void run_frames(benchmark::State& state, const FrameSet& set, const FrameOptions
   state.counters["bv_tests"] = out.bv_tests;
 }
 
+/// Registers the frames of `set` under `options` for every policy, or for the policies `only` names.
 void register_budget(int n, const std::shared_ptr<const FrameSet>& set, const std::string& label,
-                     const FrameOptions& options) {
+                     const FrameOptions& options, const std::vector<std::string_view>& only = {}) {
   g_budgets.emplace_back(n, label);
   for (const FramePolicy& policy : frame_policies()) {
+    if (!only.empty() && std::find(only.begin(), only.end(), policy.name) == only.end()) continue;
     FrameOptions with_policy = options;
     with_policy.policy = policy.name;
     const std::string name =
         "frame/pairs:" + std::to_string(n) + "/" + label + "/" + std::string(policy.name);
     benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& state) {
-      run_frames(state, *set, with_policy, g_measured[{n, label}][with_policy.policy]);
+      run_frames(state, *set, with_policy, true, g_measured[{n, label}][with_policy.policy]);
     })->Unit(benchmark::kMicrosecond);
   }
 }
@@ -220,6 +238,13 @@ int main(int argc, char** argv) {
                    "spends %.0f BV tests per frame, the exact strategy %.0f\n",
                    frames, n, set->colliding, set->pairs, double(set->adb_cost) / frames,
                    double(set->exact_cost) / frames);
+      register_budget(n, set, "none", options, {"adb_probability"});  // ADB's own error: the floor
+      benchmark::RegisterBenchmark(
+          ("frame/pairs:" + std::to_string(n) + "/none/query_adb").c_str(),
+          [=](benchmark::State& state) {
+            run_frames(state, *set, options, false, g_measured[{n, "none"}]["query_adb"]);
+          })
+          ->Unit(benchmark::kMicrosecond);
       for (double fraction : fractions) {
         FrameOptions budgeted = options;
         budgeted.budget.max_bv_tests =
