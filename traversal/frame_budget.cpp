@@ -1,0 +1,87 @@
+// The frame scheduler's options and its registry of policies (traversal/frame_budget.hpp).
+#include "frame_budget.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace bvhlab {
+
+namespace {
+
+// A policy: a name, a one-line description, and the rank of a pair's next step (the highest goes first).
+
+struct AdbProbability {
+  static constexpr std::string_view name = "adb_probability";
+  static constexpr std::string_view description = "the most probable BV pair of all pairs first";
+  static constexpr bool uses_cost = false, equal_shares = false;
+  static double priority(const PairStatus& s) { return s.probability; }
+};
+
+struct UncertaintyPerCost {
+  static constexpr std::string_view name = "uncertainty_per_cost";
+  static constexpr std::string_view description = "the pair maximising p (1 - p) / expected BV tests first";
+  static constexpr bool uses_cost = true, equal_shares = false;
+  static double priority(const PairStatus& s) { return s.probability * (1 - s.probability) / s.cost; }
+};
+
+struct EqualSplit {
+  static constexpr std::string_view name = "equal_split";
+  static constexpr std::string_view description = "budget / n per pair, one pair after the other";
+  static constexpr bool uses_cost = false, equal_shares = true;
+  static double priority(const PairStatus& s) { return -static_cast<double>(s.index); }
+};
+
+struct RoundRobin {
+  static constexpr std::string_view name = "round_robin";
+  static constexpr std::string_view description = "one step per undecided pair in turn";
+  static constexpr bool uses_cost = false, equal_shares = false;
+  static double priority(const PairStatus& s) { return -static_cast<double>(s.expansions); }
+};
+
+template <class P>
+constexpr FramePolicy entry() {
+  return {P::name, P::description, &P::priority, P::uses_cost, P::equal_shares};
+}
+
+const FramePolicy kPolicies[] = {
+    entry<AdbProbability>(),
+    entry<UncertaintyPerCost>(),
+    entry<EqualSplit>(),
+    entry<RoundRobin>(),
+};
+
+}  // namespace
+
+std::span<const FramePolicy> frame_policies() {
+  return kPolicies;
+}
+
+const FramePolicy& frame_policy(std::string_view name) {
+  for (const FramePolicy& policy : kPolicies)
+    if (policy.name == name) return policy;
+  std::string known;
+  for (const FramePolicy& policy : kPolicies) known += (known.empty() ? "" : ", ") + std::string(policy.name);
+  throw std::invalid_argument("frame: unknown policy '" + std::string(name) + "' (known: " + known + ")");
+}
+
+void FrameOptions::validate() const {
+  if (!(p_min > 0 && p_min <= 1))
+    throw std::invalid_argument("frame: p_min must lie in (0, 1], got " + std::to_string(p_min));
+  if (!(budget.deadline_us >= 0))
+    throw std::invalid_argument("frame: the deadline must be >= 0 microseconds, got " +
+                                std::to_string(budget.deadline_us));
+  if (!adb.budget.unlimited())
+    throw std::invalid_argument(
+        "frame: adb.budget must be empty; the frame's budget is FrameOptions::budget");
+  frame_policy(policy);
+  pair_options().validate();
+}
+
+AdbOptions FrameOptions::pair_options() const {
+  AdbOptions options = adb;
+  options.p_min = p_min;
+  options.budget = {};
+  return options;
+}
+
+}  // namespace bvhlab
