@@ -6,6 +6,7 @@
 #include "bench/core/tree_cache.hpp"
 #include "bench/measure.hpp"
 #include "bvh/mesh_io.hpp"
+#include "traversal/broad_phase/world_box.hpp"
 #include "traversal/strategies.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
@@ -50,6 +51,12 @@ class BvhlabHierarchy final : public PreparedHierarchy {
   [[nodiscard]] bool exact_collides(const RigidTransform& pose) const override {
     return query_exact(a_->bvh, b_->bvh, pose).collides;
   }
+  [[nodiscard]] Box world_box(const RigidTransform& pose) const override {
+    return bvhlab::world_box(a_->bvh, pose);
+  }
+  [[nodiscard]] const void* tree_a() const override { return a_.get(); }
+  [[nodiscard]] const void* tree_b() const override { return b_.get(); }
+  [[nodiscard]] const std::type_info& tree_type() const override { return typeid(Tree<BV, D>); }
 
  private:
   /// Calls f(type_identity<S>, options) for the variant's strategy S, configured; throws when S cannot run
@@ -85,6 +92,10 @@ class FclHierarchy final : public PreparedHierarchy {
     return query(pose).collides;
   }
   [[nodiscard]] bool has_counters() const override { return false; }
+  [[nodiscard]] Box world_box(const RigidTransform&) const override {
+    throw std::invalid_argument(
+        "FCL models give no world boxes here (bench_broad_phase times FCL's managers)");
+  }
   [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
     if (variant.strategy != ExactStrategy::name())
       throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only");

@@ -15,6 +15,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
 namespace bvhlab {
@@ -71,6 +72,13 @@ class PreparedHierarchy {
   [[nodiscard]] virtual bool has_counters() const { return true; }
   /// One untimed query with the full result (witness, contacts).
   [[nodiscard]] virtual Result query(const StrategyVariant& variant, const RigidTransform& pose) const = 0;
+  /// A's world box when A is placed by `pose` (its root volume; traversal/broad_phase/world_box.hpp).
+  [[nodiscard]] virtual Box world_box(const RigidTransform& pose) const = 0;
+  /// The two trees and their type (Tree<BV, D>), for code that runs many prepared pairs at once (a frame
+  /// budget); null and typeid(void) for FCL models.
+  [[nodiscard]] virtual const void* tree_a() const { return nullptr; }
+  [[nodiscard]] virtual const void* tree_b() const { return nullptr; }
+  [[nodiscard]] virtual const std::type_info& tree_type() const { return typeid(void); }
   ModelInfo model;  ///< A's tree
 };
 

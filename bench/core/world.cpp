@@ -4,6 +4,8 @@
 #include "bench/core/policies.hpp"
 #include "bench/core/scene_json.hpp"
 #include "bench/core/world_motion.hpp"
+#include "traversal/broad_phase/registry.hpp"
+#include "traversal/frame_budget.hpp"
 
 #include <algorithm>
 #include <map>
@@ -17,12 +19,10 @@ constexpr long long kMaxInstances = 100000;
 constexpr long long kMaxFrames = 1000000;
 constexpr double kMaxPoses = 2e6;  // frames x instances: 190 MB of poses
 
-// The names the broad-phase and schedule registries will provide.
-std::vector<std::string> broad_phase_names() {
-  return {"brute_force", "sweep_and_prune", "dynamic_aabb_tree"};
-}
 std::vector<std::string> frame_schedule_names() {
-  return {"adb_probability", "uncertainty_per_cost", "equal_split", "round_robin"};
+  std::vector<std::string> names;
+  for (const FramePolicy& policy : frame_policies()) names.emplace_back(policy.name);
+  return names;
 }
 
 std::vector<std::string> object_names(const Scene& scene) {
@@ -150,10 +150,7 @@ FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
   for (const auto& h : scene.hierarchies) hierarchy_names.push_back(h.name);
   if (node.has("hierarchies")) spec.hierarchies = parse_names(node.child("hierarchies"), hierarchy_names);
   for (const auto& h : scene.hierarchies) {
-    const bool listed =
-        spec.hierarchies.empty() ||
-        std::find(spec.hierarchies.begin(), spec.hierarchies.end(), h.name) != spec.hierarchies.end();
-    if (listed && (h.is_fcl() || !strategy_info("adb").accepts(scene.density_of(h).name)))
+    if (spec.applies_to(h) && (!strategy_info("adb").accepts(scene.density_of(h).name)))
       (node.has("hierarchies") ? node.child("hierarchies") : node)
           .fail("hierarchy \"" + h.name + "\" carries no probability density (give it an \"annotation\" " +
                 "such as {\"type\": \"adb\"}, or list the hierarchies that have one)");
@@ -167,6 +164,11 @@ void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene&
   for (const char* field : {"pairs", "workload"})
     if (root.has(field))
       root.child(field).fail("does not apply to a world scene (its instances move by \"world\"/\"motion\")");
+  for (const auto& h : scene.hierarchies)
+    if (h.is_fcl())
+      root.child("hierarchies")
+          .fail("hierarchy \"" + h.name + "\": FCL models do not run in a world scene (bench_broad_phase " +
+                "compares FCL's broad-phase managers)");
   const Node w = root.child("world");
   w.expect_object({"instances", "region", "motion", "broad_phases", "frame_budgets"});
   WorldSpec world;

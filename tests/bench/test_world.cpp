@@ -1,11 +1,17 @@
 // World scenes: many instances over frames. The motion is deterministic and stays where it was told; every
 // bad field (a missing pose, a pose that is no rotation, an option that does not apply) is refused by name.
+#include "bench/core/ground_truth.hpp"
 #include "bench/core/scene.hpp"
 #include "bench/core/world_motion.hpp"
+#include "bench/prepare.hpp"
+#include "bench/world.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 
 #include <gtest/gtest.h>
+
+#include <map>
+#include <set>
 
 namespace bvhlab {
 namespace {
@@ -182,6 +188,104 @@ TEST_F(WorldTest, FrameBudgetsOnAHierarchyWithAProbabilityDensityAreKept) {
   EXPECT_EQ(scene.world->broad_phases, std::vector<std::string>{"sweep_and_prune"});
   // Without a step, nothing moves; the frames still exist.
   EXPECT_EQ(scene.world->poses[2][1].translation, scene.world->poses[0][1].translation);
+}
+
+}  // namespace
+}  // namespace bvhlab
+
+namespace bvhlab {
+namespace {
+
+// A small world: two tori in a box where they keep bumping into each other.
+std::string crowded_world(const std::string& hierarchies, const std::string& strategies,
+                          const std::string& frame_budgets = "") {
+  return R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "ring.obj"}], "hierarchies": )" + hierarchies +
+         R"(, "strategies": )" + strategies + R"(, "world": {"instances": [{"object": "torus", "count": 8},
+         {"object": "ring", "count": 6}], "region": {"min": [-2, -2, -2], "max": [2, 2, 2]},
+         "motion": {"type": "random_walk", "frames": 6, "seed": 11, "step": 0.3, "turn_deg": 20})" +
+         frame_budgets + "}}";
+}
+
+RunOptions quiet_options() {
+  RunOptions options;
+  options.log = [](const std::string&) {};
+  options.threads = 1;
+  options.warmup_queries = 0;
+  return options;
+}
+
+TEST_F(WorldTest, TheExactAnswerPerFrameAgreesWithCgalOnEveryPairOfInstances) {
+  const Scene scene =
+      parse(crowded_world(R"([{"bv": "aabb"}, {"bv": "obb"}, {"bv": "dop24"}])", R"([{"type": "exact"}])"));
+  const WorldOutput out = run_world(scene, quiet_options());
+  const WorldSpec& w = *scene.world;
+  std::map<std::string, Mesh> meshes;
+  for (const auto& o : scene.objects) meshes[o.name] = load_scene_object(o);
+  std::size_t checked_colliding = 0;
+  for (int f = 0; f < w.frames; ++f) {
+    std::size_t colliding = 0;  // CGAL over every pair of instances, candidates or not
+    for (std::size_t i = 0; i < w.instances.size(); ++i)
+      for (std::size_t j = i + 1; j < w.instances.size(); ++j) {
+        const CgalGroundTruth truth(meshes[w.instances[i].object], meshes[w.instances[j].object]);
+        const auto& poses = w.poses[static_cast<std::size_t>(f)];
+        colliding += truth.collides(poses[i].inverse() * poses[j]);
+      }
+    checked_colliding += colliding;
+    for (const WorldSeriesRow& row : out.series) {
+      if (row.frame != f) continue;
+      EXPECT_EQ(row.colliding, colliding) << row.hierarchy << " frame " << f;
+      EXPECT_EQ(row.missed + row.false_pairs, 0u) << row.hierarchy << " frame " << f;
+      EXPECT_EQ(row.answered, colliding);
+    }
+  }
+  EXPECT_GT(checked_colliding, 0u);  // the world is crowded enough to test something
+  EXPECT_EQ(out.series.size(), 3u * 6u);
+}
+
+TEST_F(WorldTest, EveryBroadPhaseFindsTheSameCandidatesInEveryFrame) {
+  const Scene scene = parse(crowded_world(R"([{"bv": "aabb"}, {"bv": "sphere"}])", R"([{"type": "exact"}])"));
+  const WorldOutput out = run_world(scene, quiet_options());
+  ASSERT_EQ(out.broad.size(), 6u * 2u * 3u);  // frames x hierarchies x broad phases
+  std::map<std::pair<int, std::string>, std::set<std::size_t>> counts;
+  for (const BroadPhaseRow& r : out.broad) {
+    EXPECT_EQ(r.objects, 14u);
+    counts[{r.frame, r.hierarchy}].insert(r.candidates);
+  }
+  for (const auto& [key, values] : counts)
+    EXPECT_EQ(values.size(), 1u) << key.second << " frame " << key.first;
+}
+
+TEST_F(WorldTest, AFrameBudgetOfOneTestFlagsItsPairsAndAGenerousOneDecidesThemAll) {
+  const Scene scene =
+      parse(crowded_world(R"([{"bv": "aabb", "annotation": {"type": "adb"}}])", R"([{"type": "exact"}])",
+                          R"(, "frame_budgets": [{"schedules": ["adb_probability", "equal_split"],
+          "budgets": [{"bv_tests": 1}, {"bv_tests": 10000000}]}])"));
+  const WorldOutput out = run_world(scene, quiet_options());
+  std::size_t starved = 0, candidates = 0;
+  for (const WorldSeriesRow& row : out.series) {
+    if (row.schedule.empty()) continue;
+    candidates += row.candidates;
+    if (row.budget == "bv_tests=1") {
+      EXPECT_LE(row.bv_tests, 1u);
+      starved += row.flagged;
+    } else {
+      EXPECT_EQ(row.flagged, 0u) << row.series;
+    }
+  }
+  EXPECT_GT(candidates, 0u);
+  EXPECT_GT(starved, 0u);
+}
+
+TEST_F(WorldTest, AWorldRunWritesItsTablesAndRefusesAPairScene) {
+  const Scene scene = parse(crowded_world(R"([{"bv": "aabb"}])", R"([{"type": "exact"}])"));
+  const WorldOutput out = run_world(scene, quiet_options());
+  write_world_csv(out, dir / "out");
+  const std::string frames = testing::read_text(dir / "out" / "world_frames.csv");
+  EXPECT_EQ(std::count(frames.begin(), frames.end(), '\n'), 1 + 6);
+  EXPECT_NE(world_readme(out).find("| aabb | exact |"), std::string::npos);
+  Scene pairs = scene;
+  pairs.world.reset();
+  EXPECT_THROW(run_world(pairs, quiet_options()), std::invalid_argument);
 }
 
 }  // namespace

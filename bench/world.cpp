@@ -1,0 +1,228 @@
+#include "bench/world.hpp"
+
+#include "bench/core/policies.hpp"
+#include "bench/core/registry.hpp"
+#include "bench/plan.hpp"
+#include "bench/prepare.hpp"
+#include "traversal/broad_phase/registry.hpp"
+#include "traversal/frame_budget.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+namespace bvhlab {
+
+namespace {
+
+double micros_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
+
+/// A candidate pair of one frame: the instances, the prepared trees of their objects and B's pose in A's.
+struct Candidate {
+  ObjectPair instances;
+  const PreparedHierarchy* trees = nullptr;
+  RigidTransform b_to_a;
+  bool truth = false;
+};
+
+/// The objects, trees and broad phases of one hierarchy, made once and used in every frame.
+class WorldHierarchy {
+ public:
+  WorldHierarchy(const Scene& scene, const PlannedHierarchy& planned, Preparation& preparation)
+      : scene_(scene), planned_(planned), preparation_(preparation) {
+    for (const std::string& name : scene.world->broad_phases) broad_phases_.push_back(make_broad_phase(name));
+  }
+
+  [[nodiscard]] const PlannedHierarchy& planned() const { return planned_; }
+
+  /// The prepared trees of two objects (by name), made on first use.
+  const PreparedHierarchy& trees(const std::string& a, const std::string& b) {
+    auto& slot = pairs_[{a, b}];
+    if (!slot)
+      slot = preparation_.hierarchy(planned_, preparation_.object(*scene_.object(a)),
+                                    preparation_.object(*scene_.object(b)));
+    return *slot;
+  }
+
+  /// Every broad phase on the frame's world boxes (timed, rows into `out`); their common answer.
+  std::vector<ObjectPair> candidates(int frame, std::span<const RigidTransform> poses,
+                                     std::vector<BroadPhaseRow>& out) {
+    const auto& instances = scene_.world->instances;
+    const auto start = Clock::now();
+    std::vector<Box> boxes;
+    boxes.reserve(instances.size());
+    for (std::size_t i = 0; i < instances.size(); ++i)
+      boxes.push_back(trees(instances[i].object, instances[i].object).world_box(poses[i]));
+    const double boxes_micros = micros_since(start);
+    std::vector<ObjectPair> first;
+    for (const auto& broad_phase : broad_phases_) {
+      const auto begin = Clock::now();
+      broad_phase->update(boxes);
+      const std::vector<ObjectPair>& pairs = broad_phase->pairs();
+      const double update_micros = micros_since(begin);
+      out.push_back({frame, planned_.hierarchy->name, std::string(broad_phase->name()), boxes.size(),
+                     pairs.size(), boxes_micros, update_micros});
+      if (&broad_phase == &broad_phases_.front())
+        first = pairs;
+      else if (pairs != first)
+        throw std::logic_error("broad phases " + std::string(broad_phases_.front()->name()) + " and " +
+                               std::string(broad_phase->name()) + " disagree in frame " +
+                               std::to_string(frame));
+    }
+    return first;
+  }
+
+ private:
+  const Scene& scene_;
+  const PlannedHierarchy& planned_;
+  Preparation& preparation_;
+  std::vector<std::unique_ptr<AnyBroadPhase>> broad_phases_;
+  std::map<std::pair<std::string, std::string>, std::unique_ptr<PreparedHierarchy>> pairs_;
+};
+
+/// Counts one series' answers against the truth.
+void count(WorldSeriesRow& row, const std::vector<Candidate>& candidates, const std::vector<char>& answers,
+           const std::vector<char>& flagged) {
+  row.candidates = candidates.size();
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    row.colliding += candidates[k].truth;
+    row.answered += answers[k];
+    row.missed += candidates[k].truth && !answers[k];
+    row.false_pairs += !candidates[k].truth && answers[k];
+    row.flagged += flagged[k];
+  }
+}
+
+/// A per-pair strategy on every candidate pair, each query timed alone (as the pair runner times them).
+WorldSeriesRow run_variant(const StrategyVariant& variant, const std::vector<Candidate>& candidates,
+                           int warmup) {
+  WorldSeriesRow row;
+  row.series = variant.label();
+  row.exact_strategy = strategy_info(variant.strategy).exact;
+  std::vector<char> answers(candidates.size()), flagged(candidates.size());
+  std::vector<QueryRecord> records;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    records.clear();
+    candidates[k].trees->run(variant, std::span(&candidates[k].b_to_a, 1), warmup, records);
+    row.micros += records.front().micros;
+    row.bv_tests += records.front().counters.bv_tests;
+    answers[k] = records.front().collides;
+    flagged[k] = records.front().budget_exhausted;
+  }
+  count(row, candidates, answers, flagged);
+  return row;
+}
+
+/// One frame budget on every candidate pair at once, through the trees' own type (schedule_frame).
+std::vector<PairOutcome> schedule(const PlannedHierarchy& planned, const std::vector<Candidate>& candidates,
+                                  const FrameOptions& options, double& micros) {
+  std::vector<PairOutcome> out;
+  with_volume(planned.hierarchy->bv, [&]<class BV>(std::type_identity<BV>) {
+    with_density(planned.density.name, [&]<class D>(std::type_identity<D>) {
+      if constexpr (ProbabilityDensity<D> && DensityFor<D, BV>) {
+        std::vector<FramePair<BV, D>> pairs;
+        for (const Candidate& c : candidates) {
+          if (c.trees->tree_type() != typeid(Tree<BV, D>)) throw std::logic_error("frame budget: tree type");
+          pairs.push_back({static_cast<const Tree<BV, D>*>(c.trees->tree_a()),
+                           static_cast<const Tree<BV, D>*>(c.trees->tree_b()), c.b_to_a});
+        }
+        const auto start = Clock::now();
+        out = schedule_frame<BV, D>(pairs, options);
+        micros = micros_since(start);
+      } else {
+        throw std::invalid_argument("frame budgets need a probability density; hierarchy " +
+                                    planned.hierarchy->name + " carries " + planned.density.name);
+      }
+    });
+  });
+  return out;
+}
+
+std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedHierarchy& planned,
+                                              const std::vector<Candidate>& candidates) {
+  std::vector<WorldSeriesRow> rows;
+  for (const FrameBudgetSpec& spec : scene.world->frame_budgets) {
+    if (!spec.applies_to(*planned.hierarchy)) continue;
+    for (const std::string& policy : spec.schedules)
+      for (const Budget& budget : spec.budgets) {
+        FrameOptions options;
+        options.policy = policy;
+        options.p_min = spec.p_min;
+        options.budget = budget;
+        WorldSeriesRow row;
+        row.schedule = policy;
+        row.budget = budget_label(budget);
+        row.series = "frame " + policy + " " + row.budget + " p_min=" + parameter_text(spec.p_min);
+        const std::vector<PairOutcome> outcomes = schedule(planned, candidates, options, row.micros);
+        std::vector<char> answers(candidates.size()), flagged(candidates.size());
+        for (std::size_t k = 0; k < outcomes.size(); ++k) {
+          answers[k] = outcomes[k].collides;
+          flagged[k] = outcomes[k].budget_exhausted;
+          row.bv_tests += outcomes[k].counters.bv_tests;
+        }
+        count(row, candidates, answers, flagged);
+        rows.push_back(std::move(row));
+      }
+  }
+  return rows;
+}
+
+/// The candidate pairs of a frame with their exact answers (memoised per frame across hierarchies: any
+/// exact traversal gives the same answer).
+std::vector<Candidate> with_truth(WorldHierarchy& h, const Scene& scene, std::span<const ObjectPair> pairs,
+                                  std::span<const RigidTransform> poses,
+                                  std::map<std::pair<std::uint32_t, std::uint32_t>, bool>& truth) {
+  const auto& instances = scene.world->instances;
+  std::vector<Candidate> out;
+  for (const ObjectPair& p : pairs) {
+    Candidate c{p, &h.trees(instances[p.a].object, instances[p.b].object), poses[p.a].inverse() * poses[p.b]};
+    auto [it, fresh] = truth.try_emplace({p.a, p.b}, false);
+    if (fresh) it->second = c.trees->exact_collides(c.b_to_a);
+    c.truth = it->second;
+    out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace
+
+WorldOutput run_world(const Scene& scene, const RunOptions& options) {
+  if (!scene.world) throw std::invalid_argument("scene " + scene.name + " has no \"world\"");
+  WorldOutput output;
+  output.scene = scene.name;
+  output.instances = scene.world->instances.size();
+  output.frames = scene.world->frames;
+  const auto wall = Clock::now();
+  LogFn log = options.log ? options.log : [](const std::string& m) { std::cerr << m << '\n'; };
+  const RunPlan plan = plan_run(scene);
+  Preparation preparation(options.cache_dir, output.stats, log, options.threads ? options.threads : 1);
+  std::vector<std::unique_ptr<WorldHierarchy>> hierarchies;
+  for (const PlannedHierarchy& planned : plan.hierarchies)
+    hierarchies.push_back(std::make_unique<WorldHierarchy>(scene, planned, preparation));
+  for (int frame = 0; frame < scene.world->frames; ++frame) {
+    const auto& poses = scene.world->poses[static_cast<std::size_t>(frame)];
+    std::map<std::pair<std::uint32_t, std::uint32_t>, bool> truth;
+    for (auto& h : hierarchies) {
+      const std::vector<ObjectPair> pairs = h->candidates(frame, poses, output.broad);
+      const std::vector<Candidate> candidates = with_truth(*h, scene, pairs, poses, truth);
+      std::vector<WorldSeriesRow> rows;
+      for (const StrategyVariant& variant : h->planned().variants)
+        rows.push_back(run_variant(variant, candidates, options.warmup_queries));
+      for (WorldSeriesRow& row : run_frame_budgets(scene, h->planned(), candidates)) rows.push_back(row);
+      for (WorldSeriesRow& row : rows) {
+        row.frame = frame;
+        row.hierarchy = h->planned().hierarchy->name;
+        output.series.push_back(std::move(row));
+      }
+    }
+  }
+  output.models = preparation.models();
+  output.stats.wall_seconds = std::chrono::duration<double>(Clock::now() - wall).count();
+  return output;
+}
+
+}  // namespace bvhlab

@@ -1,0 +1,65 @@
+// The world runner: a scene of many instances moving over frames (scene "world"). Per frame and hierarchy:
+// the world box of every instance from its tree's root, each broad phase's candidate pairs (timed; all must
+// agree), the exact answer on every candidate pair (the ground truth: a pair the broad phase leaves out is
+// apart), then every per-pair strategy on every candidate pair and every frame budget shared across them,
+// each counted against the truth in pairs: missed (false negatives) and false (false positives).
+#pragma once
+
+#include "bench/core/scene.hpp"
+#include "bench/run.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+
+/// One frame of one series on one hierarchy.
+struct WorldSeriesRow {
+  int frame = 0;
+  std::string hierarchy;
+  std::string series;    ///< "exact", "adb p_min=0.9", "frame adb_probability bv_tests=2000"
+  std::string schedule;  ///< the frame-budget policy; empty for a per-pair strategy
+  std::string budget;    ///< the frame's budget ("bv_tests=2000"); empty for a per-pair strategy
+  bool exact_strategy = false;
+  std::size_t candidates = 0;   ///< candidate pairs of the frame (the broad phase's answer)
+  std::size_t colliding = 0;    ///< of those, colliding in truth
+  std::size_t answered = 0;     ///< of those, answered colliding
+  std::size_t missed = 0;       ///< colliding, answered apart
+  std::size_t false_pairs = 0;  ///< apart, answered colliding
+  std::size_t flagged = 0;      ///< answered as a best effort (budget ran out)
+  double micros = 0;            ///< narrow phase of the frame: every candidate pair
+  std::uint64_t bv_tests = 0;
+};
+
+/// One frame of one broad phase on one hierarchy's world boxes.
+struct BroadPhaseRow {
+  int frame = 0;
+  std::string hierarchy, broad_phase;
+  std::size_t objects = 0, candidates = 0;
+  double boxes_micros = 0;   ///< the world boxes of every instance (shared by the broad phases)
+  double update_micros = 0;  ///< update plus pair finding
+};
+
+struct WorldOutput {
+  std::string scene;
+  std::size_t instances = 0;
+  int frames = 0;
+  std::vector<WorldSeriesRow> series;
+  std::vector<BroadPhaseRow> broad;
+  std::vector<ModelInfo> models;
+  RunStats stats;
+};
+
+/// Runs a world scene (scene.world set). Throws std::invalid_argument for a scene without one.
+WorldOutput run_world(const Scene& scene, const RunOptions& options);
+
+/// world_frames.csv and world_broad_phase.csv in `dir` (columns: the rows' fields, in order).
+void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir);
+
+/// The README of a world report: per series the pairs missed and false (percent of colliding and of apart
+/// candidate pairs), median and 90th-percentile frame times; per broad phase the median frame time.
+std::string world_readme(const WorldOutput& output);
+
+}  // namespace bvhlab

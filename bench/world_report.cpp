@@ -1,0 +1,116 @@
+// The files of a world run: one CSV row per frame and series, one per frame and broad phase, and a README
+// that sums them up.
+#include "bench/world.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace bvhlab {
+
+namespace {
+
+std::ofstream open_csv(const std::filesystem::path& file) {
+  std::ofstream out(file, std::ios::trunc);
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  return out;
+}
+
+/// The value below which `share` of `values` lie (nearest rank); 0 for none.
+double quantile(std::vector<double> values, double share) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const auto rank = static_cast<std::size_t>(share * static_cast<double>(values.size() - 1) + 0.5);
+  return values[std::min(rank, values.size() - 1)];
+}
+
+std::string percent(std::size_t part, std::size_t whole) {
+  return whole ? fmt::format("{:.2f}", 100.0 * static_cast<double>(part) / static_cast<double>(whole)) : "-";
+}
+
+/// One summary line per (hierarchy, series), in first-seen order.
+struct SeriesTotals {
+  std::string hierarchy, series;
+  std::size_t candidates = 0, colliding = 0, missed = 0, false_pairs = 0, flagged = 0;
+  std::vector<double> micros;
+};
+
+std::vector<SeriesTotals> totals(const std::vector<WorldSeriesRow>& rows) {
+  std::vector<SeriesTotals> out;
+  std::map<std::pair<std::string, std::string>, std::size_t> index;
+  for (const WorldSeriesRow& r : rows) {
+    auto [it, fresh] = index.try_emplace({r.hierarchy, r.series}, out.size());
+    if (fresh) out.push_back({r.hierarchy, r.series, 0, 0, 0, 0, 0, {}});
+    SeriesTotals& t = out[it->second];
+    t.candidates += r.candidates;
+    t.colliding += r.colliding;
+    t.missed += r.missed;
+    t.false_pairs += r.false_pairs;
+    t.flagged += r.flagged;
+    t.micros.push_back(r.micros);
+  }
+  return out;
+}
+
+}  // namespace
+
+void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  std::ofstream frames = open_csv(dir / "world_frames.csv");
+  frames << "frame,hierarchy,series,schedule,budget,exact_strategy,candidates,colliding,answered,missed,"
+            "false_pairs,flagged,micros,bv_tests\n";
+  for (const WorldSeriesRow& r : output.series)
+    frames << fmt::format("{},{},\"{}\",{},{},{},{},{},{},{},{},{},{:.3f},{}\n", r.frame, r.hierarchy,
+                          r.series, r.schedule, r.budget, r.exact_strategy ? 1 : 0, r.candidates, r.colliding,
+                          r.answered, r.missed, r.false_pairs, r.flagged, r.micros, r.bv_tests);
+  std::ofstream broad = open_csv(dir / "world_broad_phase.csv");
+  broad << "frame,hierarchy,broad_phase,objects,candidates,boxes_micros,update_micros\n";
+  for (const BroadPhaseRow& r : output.broad)
+    broad << fmt::format("{},{},{},{},{},{:.3f},{:.3f}\n", r.frame, r.hierarchy, r.broad_phase, r.objects,
+                         r.candidates, r.boxes_micros, r.update_micros);
+  if (!frames || !broad) throw std::runtime_error(dir.string() + ": writing the world CSV files failed");
+}
+
+std::string world_readme(const WorldOutput& output) {
+  std::ostringstream md;
+  md << "# " << output.scene << ": " << output.instances << " instances, " << output.frames << " frames\n\n"
+     << "Missed: colliding candidate pairs answered apart (percent of the colliding ones). False: pairs "
+        "apart "
+        "answered colliding (percent of the apart candidates). Flagged: best-effort answers when the budget "
+        "ran out. Times are per frame, for every candidate pair of the frame.\n\n"
+     << "| hierarchy | series | candidate pairs | colliding | missed % | false % | flagged | median µs | p90 "
+        "µs |\n"
+     << "|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const SeriesTotals& t : totals(output.series))
+    md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {:.1f} | {:.1f} |\n", t.hierarchy, t.series,
+                      t.candidates, t.colliding, percent(t.missed, t.colliding),
+                      percent(t.false_pairs, t.candidates - t.colliding), t.flagged, quantile(t.micros, 0.5),
+                      quantile(t.micros, 0.9));
+  md << "\nBroad phase per frame (world boxes of every instance, then update and pair finding):\n\n"
+     << "| hierarchy | broad phase | objects | candidate pairs per frame (median) | boxes µs | update µs |\n"
+     << "|---|---|---:|---:|---:|---:|\n";
+  std::map<std::pair<std::string, std::string>, std::vector<const BroadPhaseRow*>> groups;
+  std::vector<std::pair<std::string, std::string>> order;
+  for (const BroadPhaseRow& r : output.broad) {
+    auto& g = groups[{r.hierarchy, r.broad_phase}];
+    if (g.empty()) order.emplace_back(r.hierarchy, r.broad_phase);
+    g.push_back(&r);
+  }
+  for (const auto& key : order) {
+    std::vector<double> candidates, boxes, update;
+    for (const BroadPhaseRow* r : groups[key]) {
+      candidates.push_back(static_cast<double>(r->candidates));
+      boxes.push_back(r->boxes_micros);
+      update.push_back(r->update_micros);
+    }
+    md << fmt::format("| {} | {} | {} | {:.0f} | {:.1f} | {:.1f} |\n", key.first, key.second,
+                      output.instances, quantile(candidates, 0.5), quantile(boxes, 0.5),
+                      quantile(update, 0.5));
+  }
+  return md.str();
+}
+
+}  // namespace bvhlab
