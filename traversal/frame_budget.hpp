@@ -183,27 +183,27 @@ class PairRun {
         trees_(pair.a->bvh, pair.b->bvh, pair.b_to_a, context_, result_.counters),
         estimate_{density_estimator(*pair.a, *pair.b, pair.b_to_a)},
         hooks_(trees_, result_, options, estimate_),
-        progress_(pair.a->bvh.empty() || pair.b->bvh.empty() ? Progress::Done : Progress::Stopped) {}
+        progress_(pair.a->bvh.empty() || pair.b->bvh.empty() ? StepProgress::Done : StepProgress::Stopped) {}
   PairRun(const PairRun&) = delete;
   PairRun& operator=(const PairRun&) = delete;
 
   /// The root test, with at most `allowance` BV tests.
-  Progress begin(std::uint64_t allowance) {
-    if (progress_ == Progress::Done) return progress_;  // an empty tree: no contact (query_adb's answer)
+  StepProgress begin(std::uint64_t allowance) {
+    if (progress_ == StepProgress::Done) return progress_;  // an empty tree: no contact (query_adb's answer)
     TestCap cap = cap_after(allowance);
     return progress_ = steps(cap).begin();
   }
   /// One step, with at most `allowance` BV tests. Only while running (or stopped, to resume).
-  Progress step(std::uint64_t allowance) {
+  StepProgress step(std::uint64_t allowance) {
     TestCap cap = cap_after(allowance);
     return progress_ = steps(cap).step();
   }
   /// The best-effort answer of a pair still undecided; a decided pair keeps its answer.
   void end() {
-    if (progress_ == Progress::Done) return;
+    if (progress_ == StepProgress::Done) return;
     TestCap none{0};
     steps(none).stop();
-    progress_ = Progress::Done;
+    progress_ = StepProgress::Done;
   }
 
   [[nodiscard]] std::uint64_t bv_tests() const { return result_.counters.bv_tests; }
@@ -235,7 +235,7 @@ class PairRun {
   Hooks hooks_;
   typename Steps::Queue queue_;
   typename Steps::Staged staged_;
-  Progress progress_;  ///< Stopped until begun; Done at once for an empty tree
+  StepProgress progress_;  ///< Stopped until begun; Done at once for an empty tree
 };
 
 /// Checks one pair (header comment, 1.); `index` names it.
@@ -307,11 +307,11 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   const auto advance = [&](std::size_t k, bool root) {
     Run& run = runs[k];
     const std::uint64_t before = run.bv_tests();
-    const Progress progress =
+    const StepProgress progress =
         root ? run.begin(tests.allowance(k, before)) : run.step(tests.allowance(k, before));
     tests.spend(run.bv_tests() - before);
-    if (progress == Progress::Running) rank(k);
-    return progress == Progress::Stopped && !policy.equal_shares;
+    if (progress == StepProgress::Running) rank(k);
+    return progress == StepProgress::Stopped && !policy.equal_shares;
   };
 
   bool exhausted = false;
