@@ -646,6 +646,30 @@ std::string report_snippet(const RunOutput& run, const std::filesystem::path& re
   return md.str();
 }
 
+std::string run_plot_script(const ReportOptions& options, const std::string& script_name,
+                            const std::filesystem::path& dir, const std::string& arguments) {
+  std::filesystem::path script = options.plot_script;
+#ifdef BVHLAB_SOURCE_DIR
+  if (script.empty()) script = std::filesystem::path(BVHLAB_SOURCE_DIR) / "bench" / script_name;
+#endif
+  const std::string python = options.python.empty() ? find_python() : options.python.string();
+  if (python.empty())
+    return "no Python with matplotlib found (install python3-matplotlib, or set BVHLAB_PYTHON)";
+  if (!std::filesystem::is_regular_file(script)) return "plot script " + script.string() + " not found";
+  const std::string command =
+      shell_quote(python) + " " + shell_quote(script.string()) + " " + shell_quote(dir.string()) + arguments;
+  const std::filesystem::path log = dir / "plot.log";
+  const int status = std::system((command + " > " + shell_quote(log.string()) + " 2>&1").c_str());
+  if (status == 0) {
+    std::filesystem::remove(log);
+    return {};
+  }
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  return script.filename().string() + " failed (exit status " + std::to_string(status) + "): " + text.str();
+}
+
 ReportFiles write_report(const RunOutput& run, const std::filesystem::path& dir,
                          const ReportOptions& options) {
   ReportFiles files;
@@ -661,39 +685,16 @@ ReportFiles write_report(const RunOutput& run, const std::filesystem::path& dir,
 
   for (const auto& f : report_figures()) std::filesystem::remove(files.dir / f.file);  // no stale figures
   if (options.figures) {
-    std::filesystem::path script = options.plot_script;
-#ifdef BVHLAB_SOURCE_DIR
-    if (script.empty()) script = std::filesystem::path(BVHLAB_SOURCE_DIR) / "bench" / "plot_report.py";
-#endif
-    const std::string python = options.python.empty() ? find_python() : options.python.string();
-    if (python.empty()) {
-      files.plot_error = "no Python with matplotlib found (install python3-matplotlib, or set BVHLAB_PYTHON)";
-    } else if (!std::filesystem::is_regular_file(script)) {
-      files.plot_error = "plot script " + script.string() + " not found";
-    } else {
-      const ReportSpec& r = run.scene.report;
-      const QualityRange range = quality_range(run);
-      std::string command = shell_quote(python) + " " + shell_quote(script.string()) + " " +
-                            shell_quote(files.dir.string()) + " --quality-min " + fmt("%.17g", range.lo) +
-                            " --quality-max " + fmt("%.17g", range.hi) + " --quality-text " +
-                            shell_quote(range.text) + " --distance-label " +
-                            shell_quote(distance_label(run.scene));
-      if (!r.operating_hierarchy.empty())
-        command += " --operating-strategy " + shell_quote(r.operating_strategy) + " --operating-hierarchy " +
+    const ReportSpec& r = run.scene.report;
+    const QualityRange range = quality_range(run);
+    std::string arguments = " --quality-min " + fmt("%.17g", range.lo) + " --quality-max " +
+                            fmt("%.17g", range.hi) + " --quality-text " + shell_quote(range.text) +
+                            " --distance-label " + shell_quote(distance_label(run.scene));
+    if (!r.operating_hierarchy.empty())
+      arguments += " --operating-strategy " + shell_quote(r.operating_strategy) + " --operating-hierarchy " +
                    shell_quote(r.operating_hierarchy) + " --operating-p-min " +
                    fmt("%.17g", r.operating_p_min);
-      const std::filesystem::path log = files.dir / "plot.log";
-      const int status = std::system((command + " > " + shell_quote(log.string()) + " 2>&1").c_str());
-      if (status != 0) {
-        std::ifstream in(log);
-        std::stringstream text;
-        text << in.rdbuf();
-        files.plot_error =
-            "plot_report.py failed (exit status " + std::to_string(status) + "): " + text.str();
-      } else {
-        std::filesystem::remove(log);
-      }
-    }
+    files.plot_error = run_plot_script(options, "plot_report.py", files.dir, arguments);
   } else {
     files.plot_error = "figures were not requested";
   }

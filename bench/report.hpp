@@ -79,6 +79,11 @@ struct ReportOptions {
   std::filesystem::path plot_script;  ///< empty: bench/plot_report.py in the source tree
 };
 
+/// Runs bench/SCRIPT_NAME (or options.plot_script) with Python on `dir` and `arguments` (already quoted);
+/// returns why it failed, or "" when it exited with status 0.
+std::string run_plot_script(const ReportOptions& options, const std::string& script_name,
+                            const std::filesystem::path& dir, const std::string& arguments);
+
 struct ReportFiles {
   std::filesystem::path dir, results_csv, results_json, calibration_csv, readme;
   std::vector<std::filesystem::path> figures;  ///< the PNGs that exist after plotting

@@ -2,6 +2,7 @@
 
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
+#include "bench/core/world_motion.hpp"
 #include "bench/plan.hpp"
 #include "bench/prepare.hpp"
 #include "traversal/broad_phase/registry.hpp"
@@ -16,6 +17,20 @@
 namespace bvhlab {
 
 namespace {
+
+constexpr int kScalingFrames = 10;
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
+std::vector<std::string> instance_objects(const Scene& scene) {
+  std::vector<std::string> objects;
+  for (const WorldInstance& instance : scene.world->instances) objects.push_back(instance.object);
+  return objects;
+}
 
 double micros_since(Clock::time_point start) {
   return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
@@ -48,15 +63,28 @@ class WorldHierarchy {
     return *slot;
   }
 
+  /// Each object's own prepared trees (the source of its world box), looked up before any timing.
+  std::vector<const PreparedHierarchy*> own_trees(std::span<const std::string> objects) {
+    std::vector<const PreparedHierarchy*> out;
+    for (const std::string& o : objects) out.push_back(&trees(o, o));
+    return out;
+  }
+
+  /// The world box of every instance: own[i]'s tree placed by poses[i].
+  static std::vector<Box> world_boxes(std::span<const PreparedHierarchy* const> own,
+                                      std::span<const RigidTransform> poses) {
+    std::vector<Box> boxes;
+    boxes.reserve(own.size());
+    for (std::size_t i = 0; i < own.size(); ++i) boxes.push_back(own[i]->world_box(poses[i]));
+    return boxes;
+  }
+
   /// Every broad phase on the frame's world boxes (timed, rows into `out`); their common answer.
   std::vector<ObjectPair> candidates(int frame, std::span<const RigidTransform> poses,
                                      std::vector<BroadPhaseRow>& out) {
-    const auto& instances = scene_.world->instances;
+    if (instance_trees_.empty()) instance_trees_ = own_trees(instance_objects(scene_));
     const auto start = Clock::now();
-    std::vector<Box> boxes;
-    boxes.reserve(instances.size());
-    for (std::size_t i = 0; i < instances.size(); ++i)
-      boxes.push_back(trees(instances[i].object, instances[i].object).world_box(poses[i]));
+    const std::vector<Box> boxes = world_boxes(instance_trees_, poses);
     const double boxes_micros = micros_since(start);
     std::vector<ObjectPair> first;
     for (const auto& broad_phase : broad_phases_) {
@@ -76,11 +104,45 @@ class WorldHierarchy {
     return first;
   }
 
+  /// Each broad phase alone on `count` copies of the scene's objects (cyclically) at the scene's density:
+  /// the region grows with the count, the walk keeps its steps; medians over kScalingFrames frames.
+  std::vector<ScalingRow> scaling(int count) {
+    const WorldSpec& w = *scene_.world;
+    const std::vector<std::string> names = instance_objects(scene_);
+    std::vector<std::string> objects;
+    for (int i = 0; i < count; ++i) objects.push_back(names[static_cast<std::size_t>(i) % names.size()]);
+    const std::vector<const PreparedHierarchy*> own = own_trees(objects);
+    const double grow = std::cbrt(double(count) / double(names.size()));
+    const Box region{w.region.center() - 0.5 * grow * w.region.extent(),
+                     w.region.center() + 0.5 * grow * w.region.extent()};
+    const std::vector<std::optional<RigidTransform>> random(objects.size());
+    const auto frames = random_walk(random, region, w.seed + 1, kScalingFrames, w.step, w.turn_deg);
+    std::vector<ScalingRow> rows;
+    for (const std::string& name : w.broad_phases) {
+      std::unique_ptr<AnyBroadPhase> broad_phase = make_broad_phase(name);
+      std::vector<double> boxes_micros, update_micros, candidates;
+      for (const auto& poses : frames) {
+        const auto start = Clock::now();
+        const std::vector<Box> boxes = world_boxes(own, poses);
+        boxes_micros.push_back(micros_since(start));
+        const auto begin = Clock::now();
+        broad_phase->update(boxes);
+        candidates.push_back(double(broad_phase->pairs().size()));
+        update_micros.push_back(micros_since(begin));
+      }
+      rows.push_back({planned_.hierarchy->name, name, objects.size(),
+                      static_cast<std::size_t>(median(candidates)), median(boxes_micros),
+                      median(update_micros)});
+    }
+    return rows;
+  }
+
  private:
   const Scene& scene_;
   const PlannedHierarchy& planned_;
   Preparation& preparation_;
   std::vector<std::unique_ptr<AnyBroadPhase>> broad_phases_;
+  std::vector<const PreparedHierarchy*> instance_trees_;
   std::map<std::pair<std::string, std::string>, std::unique_ptr<PreparedHierarchy>> pairs_;
 };
 
@@ -219,6 +281,10 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
         output.series.push_back(std::move(row));
       }
     }
+  }
+  for (int count : scene.world->scaling) {
+    log("broad phases alone at " + std::to_string(count) + " objects");
+    for (auto& row : hierarchies.front()->scaling(count)) output.scaling.push_back(row);
   }
   output.models = preparation.models();
   output.stats.wall_seconds = std::chrono::duration<double>(Clock::now() - wall).count();

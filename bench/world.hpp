@@ -42,12 +42,20 @@ struct BroadPhaseRow {
   double update_micros = 0;  ///< update plus pair finding
 };
 
+/// A broad phase alone at one object count (WorldSpec::scaling): medians over the frames.
+struct ScalingRow {
+  std::string hierarchy, broad_phase;
+  std::size_t objects = 0, candidates = 0;
+  double boxes_micros = 0, update_micros = 0;
+};
+
 struct WorldOutput {
   std::string scene;
   std::size_t instances = 0;
   int frames = 0;
   std::vector<WorldSeriesRow> series;
   std::vector<BroadPhaseRow> broad;
+  std::vector<ScalingRow> scaling;
   std::vector<ModelInfo> models;
   RunStats stats;
 };
@@ -55,11 +63,15 @@ struct WorldOutput {
 /// Runs a world scene (scene.world set). Throws std::invalid_argument for a scene without one.
 WorldOutput run_world(const Scene& scene, const RunOptions& options);
 
-/// world_frames.csv and world_broad_phase.csv in `dir` (columns: the rows' fields, in order).
+/// world_frames.csv, world_broad_phase.csv and world_scaling.csv in `dir` (columns: the rows' fields).
 void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir);
+
+/// The whole report: the CSV files, the figures (bench/plot_world.py, when `figures`) and README.md.
+/// Returns why figures are missing ("" when drawn).
+std::string write_world_report(const WorldOutput& output, const std::filesystem::path& dir, bool figures);
 
 /// The README of a world report: per series the pairs missed and false (percent of colliding and of apart
 /// candidate pairs), median and 90th-percentile frame times; per broad phase the median frame time.
-std::string world_readme(const WorldOutput& output);
+std::string world_readme(const WorldOutput& output, const std::vector<std::string>& figures = {});
 
 }  // namespace bvhlab

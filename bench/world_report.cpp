@@ -2,6 +2,8 @@
 // that sums them up.
 #include "bench/world.hpp"
 
+#include "bench/report.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -71,26 +73,42 @@ void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir
   for (const BroadPhaseRow& r : output.broad)
     broad << fmt::format("{},{},{},{},{},{:.3f},{:.3f}\n", r.frame, r.hierarchy, r.broad_phase, r.objects,
                          r.candidates, r.boxes_micros, r.update_micros);
-  if (!frames || !broad) throw std::runtime_error(dir.string() + ": writing the world CSV files failed");
+  std::ofstream scaling = open_csv(dir / "world_scaling.csv");
+  scaling << "hierarchy,broad_phase,objects,candidates,boxes_micros,update_micros\n";
+  for (const ScalingRow& r : output.scaling)
+    scaling << fmt::format("{},{},{},{},{:.3f},{:.3f}\n", r.hierarchy, r.broad_phase, r.objects, r.candidates,
+                           r.boxes_micros, r.update_micros);
+  if (!frames || !broad || !scaling)
+    throw std::runtime_error(dir.string() + ": writing the world CSV files failed");
 }
 
-std::string world_readme(const WorldOutput& output) {
-  std::ostringstream md;
-  md << "# " << output.scene << ": " << output.instances << " instances, " << output.frames << " frames\n\n"
-     << "Missed: colliding candidate pairs answered apart (percent of the colliding ones). False: pairs "
+namespace {
+
+void series_table(std::ostream& md, const WorldOutput& output) {
+  md << "Missed: colliding candidate pairs answered apart (percent of the colliding ones). False: pairs "
         "apart "
-        "answered colliding (percent of the apart candidates). Flagged: best-effort answers when the budget "
-        "ran out. Times are per frame, for every candidate pair of the frame.\n\n"
-     << "| hierarchy | series | candidate pairs | colliding | missed % | false % | flagged | median µs | p90 "
-        "µs |\n"
-     << "|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const SeriesTotals& t : totals(output.series))
-    md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {:.1f} | {:.1f} |\n", t.hierarchy, t.series,
-                      t.candidates, t.colliding, percent(t.missed, t.colliding),
-                      percent(t.false_pairs, t.candidates - t.colliding), t.flagged, quantile(t.micros, 0.5),
-                      quantile(t.micros, 0.9));
-  md << "\nBroad phase per frame (world boxes of every instance, then update and pair finding):\n\n"
-     << "| hierarchy | broad phase | objects | candidate pairs per frame (median) | boxes µs | update µs |\n"
+        "answered colliding (percent of the apart candidates). Correct: pairs answered right, in percent of "
+        "the candidate pairs and of all pairs of instances (a pair the broad phase leaves out is answered "
+        "right by it). Flagged: best-effort answers when the budget ran out. Times are per frame, for every "
+        "candidate pair of the frame.\n\n"
+     << "| hierarchy | series | candidate pairs | colliding | missed % | false % | correct % of candidates | "
+        "correct % of all pairs | flagged | median µs | p90 µs |\n"
+     << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  const std::size_t all_pairs = output.instances * (output.instances ? output.instances - 1 : 0) / 2 *
+                                static_cast<std::size_t>(output.frames);
+  for (const SeriesTotals& t : totals(output.series)) {
+    const std::size_t wrong = t.missed + t.false_pairs;
+    md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1f} | {:.1f} |\n", t.hierarchy,
+                      t.series, t.candidates, t.colliding, percent(t.missed, t.colliding),
+                      percent(t.false_pairs, t.candidates - t.colliding),
+                      percent(t.candidates - wrong, t.candidates), percent(all_pairs - wrong, all_pairs),
+                      t.flagged, quantile(t.micros, 0.5), quantile(t.micros, 0.9));
+  }
+}
+
+void broad_phase_table(std::ostream& md, const WorldOutput& output) {
+  md << "\nBroad phase per frame (world boxes of every instance, then update and pair finding; medians):\n\n"
+     << "| hierarchy | broad phase | objects | candidate pairs | boxes µs | update µs |\n"
      << "|---|---|---:|---:|---:|---:|\n";
   std::map<std::pair<std::string, std::string>, std::vector<const BroadPhaseRow*>> groups;
   std::vector<std::pair<std::string, std::string>> order;
@@ -110,7 +128,44 @@ std::string world_readme(const WorldOutput& output) {
                       output.instances, quantile(candidates, 0.5), quantile(boxes, 0.5),
                       quantile(update, 0.5));
   }
+}
+
+void scaling_table(std::ostream& md, const WorldOutput& output) {
+  if (output.scaling.empty()) return;
+  md << "\nBroad phases alone against the object count (the scene's objects copied at its density; medians "
+        "per "
+        "frame):\n\n| hierarchy | broad phase | objects | candidate pairs | boxes µs | update µs |\n"
+        "|---|---|---:|---:|---:|---:|\n";
+  for (const ScalingRow& r : output.scaling)
+    md << fmt::format("| {} | {} | {} | {} | {:.1f} | {:.1f} |\n", r.hierarchy, r.broad_phase, r.objects,
+                      r.candidates, r.boxes_micros, r.update_micros);
+}
+
+}  // namespace
+
+std::string world_readme(const WorldOutput& output, const std::vector<std::string>& figures) {
+  std::ostringstream md;
+  md << "# " << output.scene << ": " << output.instances << " instances, " << output.frames << " frames\n\n";
+  series_table(md, output);
+  broad_phase_table(md, output);
+  scaling_table(md, output);
+  for (const std::string& figure : figures) md << "\n![" << figure << "](" << figure << ")\n";
   return md.str();
+}
+
+std::string write_world_report(const WorldOutput& output, const std::filesystem::path& dir, bool figures) {
+  write_world_csv(output, dir);
+  const std::vector<std::string> names{"world_errors_vs_budget.png", "world_broad_phase_vs_objects.png"};
+  for (const auto& name : names) std::filesystem::remove(dir / name);
+  const std::string error =
+      figures ? run_plot_script({}, "plot_world.py", dir, "") : "figures were not requested";
+  std::vector<std::string> drawn;
+  for (const auto& name : names)
+    if (std::filesystem::is_regular_file(dir / name)) drawn.push_back(name);
+  std::ofstream readme(dir / "README.md", std::ios::trunc);
+  readme << world_readme(output, drawn);
+  if (!readme) throw std::runtime_error((dir / "README.md").string() + ": cannot write");
+  return error;
 }
 
 }  // namespace bvhlab

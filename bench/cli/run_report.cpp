@@ -83,24 +83,23 @@ void fetch_missing_meshes(const Scene& scene) {
                  "without the missing ones\n");
 }
 
-/// A world scene's run: its CSV files and README in `dir`; prints the README's path.
-int run_world_scene(const Scene& scene, const RunOptions& options, const fs::path& dir, bool quiet) {
+/// A world scene's run: its CSV files, figures (when asked) and README in `dir`; prints the README's path.
+/// 4 if figures were asked for and could not be drawn.
+int run_world_scene(const Scene& scene, const RunOptions& options, const fs::path& dir, bool figures,
+                    bool quiet) {
   const WorldOutput output = run_world(scene, options);
-  write_world_csv(output, dir);
-  const std::string readme = world_readme(output);
-  std::ofstream out(dir / "README.md", std::ios::trunc);
-  out << readme;
-  if (!out) throw std::runtime_error((dir / "README.md").string() + ": cannot write");
-  if (!quiet) std::fputs(readme.c_str(), stderr);
+  const std::string plot_error = write_world_report(output, dir, figures);
+  if (!quiet) std::fputs(world_readme(output).c_str(), stderr);
+  if (figures && !plot_error.empty()) std::fprintf(stderr, "bvhlab: %s\n", plot_error.c_str());
   std::printf("%s\n", fs::absolute(dir / "README.md").c_str());
-  return 0;
+  return figures && !plot_error.empty() ? 4 : 0;
 }
 
 int run_command(const SceneArgs& args) {
   const RunOptions options = scene_run_options(args);
   const Scene scene = load_scene(args.scene_file);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / scene.name : fs::path(args.out_dir);
-  if (scene.world) return run_world_scene(scene, options, dir, args.quiet);
+  if (scene.world) return run_world_scene(scene, options, dir, false, args.quiet);
   const RunOutput output = run_scene(scene, options);
   write_results_csv(output, dir / "results.csv");
   write_results_json(output, dir / "results.json");
@@ -124,7 +123,7 @@ struct ReportJob {
 /// Runs the scene and writes the report (and the snippet, if asked): 3 if the ground truth is suspect, 4 if
 /// figures were asked for and could not be drawn.
 int run_report(const ReportJob& job) {
-  if (job.scene.world) return run_world_scene(job.scene, job.options, job.dir, job.quiet);
+  if (job.scene.world) return run_world_scene(job.scene, job.options, job.dir, job.figures, job.quiet);
   const RunOutput output = run_scene(job.scene, job.options);
   ReportOptions report_options;
   report_options.figures = job.figures;

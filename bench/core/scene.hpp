@@ -157,7 +157,7 @@ struct FrameBudgetSpec {
   std::vector<std::string> schedules;    ///< schedule policies, by name
   std::vector<Budget> budgets;           ///< one run per budget (BV tests and/or microseconds per frame)
   double p_min = 0.9;                    ///< a pair whose estimate reaches it is decided colliding
-  std::vector<std::string> hierarchies;  ///< restricts it to these; empty: every hierarchy
+  std::vector<std::string> hierarchies;  ///< where it runs: as given, else each with a probability density
   [[nodiscard]] bool applies_to(const HierarchySpec& h) const {
     return hierarchies.empty() ||
            std::find(hierarchies.begin(), hierarchies.end(), h.name) != hierarchies.end();
@@ -177,6 +177,9 @@ struct WorldSpec {
   std::vector<std::vector<RigidTransform>> poses;
   std::vector<std::string> broad_phases;  ///< by name; default: every registered one
   std::vector<FrameBudgetSpec> frame_budgets;
+  /// Object counts at which the broad phases are also timed alone (the scene's objects copied to that many
+  /// instances at the scene's density); empty: none.
+  std::vector<int> scaling;
   /// Identifies the instances and their motion for the ground-truth cache.
   std::string identity;
 };

@@ -148,12 +148,24 @@ FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
   }
   std::vector<std::string> hierarchy_names;
   for (const auto& h : scene.hierarchies) hierarchy_names.push_back(h.name);
-  if (node.has("hierarchies")) spec.hierarchies = parse_names(node.child("hierarchies"), hierarchy_names);
-  for (const auto& h : scene.hierarchies) {
-    if (spec.applies_to(h) && (!strategy_info("adb").accepts(scene.density_of(h).name)))
-      (node.has("hierarchies") ? node.child("hierarchies") : node)
-          .fail("hierarchy \"" + h.name + "\" carries no probability density (give it an \"annotation\" " +
-                "such as {\"type\": \"adb\"}, or list the hierarchies that have one)");
+  auto probability = [&](const HierarchySpec& h) {
+    return !h.is_fcl() && strategy_info("adb").accepts(scene.density_of(h).name);
+  };
+  if (node.has("hierarchies")) {
+    spec.hierarchies = parse_names(node.child("hierarchies"), hierarchy_names);
+    for (std::size_t k = 0; k < spec.hierarchies.size(); ++k)
+      if (!probability(*scene.hierarchy(spec.hierarchies[k])))
+        node.child("hierarchies")
+            .child(k)
+            .fail("hierarchy \"" + spec.hierarchies[k] + "\" carries no probability density (give it an " +
+                  "\"annotation\" such as {\"type\": \"adb\"})");
+  } else {
+    for (const auto& h : scene.hierarchies)
+      if (probability(h)) spec.hierarchies.push_back(h.name);
+    if (spec.hierarchies.empty())
+      node.fail(
+          "no hierarchy carries a probability density (give one an \"annotation\" such as "
+          "{\"type\": \"adb\"})");
   }
   return spec;
 }
@@ -170,7 +182,7 @@ void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene&
           .fail("hierarchy \"" + h.name + "\": FCL models do not run in a world scene (bench_broad_phase " +
                 "compares FCL's broad-phase managers)");
   const Node w = root.child("world");
-  w.expect_object({"instances", "region", "motion", "broad_phases", "frame_budgets"});
+  w.expect_object({"instances", "region", "motion", "broad_phases", "frame_budgets", "scaling"});
   WorldSpec world;
   std::vector<std::optional<RigidTransform>> placements;
   const Node instances = w.child("instances");
@@ -190,6 +202,12 @@ void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene&
     const Node budgets = w.child("frame_budgets");
     for (std::size_t k = 0, n = budgets.array_size(); k < n; ++k)
       world.frame_budgets.push_back(parse_frame_budget(budgets.child(k), scene));
+  }
+  if (w.has("scaling")) {
+    if (!walk) w.child("scaling").fail("needs the random walk (its region and steps set the density)");
+    const Node counts = w.child("scaling");
+    for (std::size_t k = 0, n = counts.array_size(); k < n; ++k)
+      world.scaling.push_back(static_cast<int>(counts.child(k).integer(2, kMaxInstances)));
   }
   scene.world = std::move(world);
 }

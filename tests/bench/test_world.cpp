@@ -162,8 +162,13 @@ TEST_F(WorldTest, OptionsThatDoNotApplyAreRefusedByName) {
   expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
       "motion": {"type": "random_walk", "frames": 2},
       "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}]}]})",
+                     "", kPlain),
+         "/world/frame_budgets/0: no hierarchy carries a probability density");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2},
+      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "hierarchies": ["obb"]}]})",
                      "", kAnnotated),
-         "hierarchy \"obb\" carries no probability density");
+         "/world/frame_budgets/0/hierarchies/0: hierarchy \"obb\" carries no probability density");
   expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
       "motion": {"type": "random_walk", "frames": 2},
       "frame_budgets": [{"schedules": ["greedy"], "budgets": [{"bv_tests": 100}], "hierarchies": ["aabb"]}]})",

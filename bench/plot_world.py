@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""Figures of a world report (bvhlab report on a scene with "world"), from the CSV files in REPORT_DIR:
+
+  world_errors_vs_budget.png        wrong pairs (missed and false, percent of the candidate pairs) against the
+                                    frame budget, one line per schedule, per budget kind (BV tests, µs);
+                                    the per-pair strategies as horizontal references
+  world_broad_phase_vs_objects.png  broad-phase time per frame (world boxes plus update and pair finding)
+                                    against the object count, log-log (from world_scaling.csv; the scene's
+                                    own count when the scene asks for no scaling)
+"""
+import argparse
+import csv
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_csv(path):
+    if not os.path.exists(path):
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def budget_value(budget):
+    """("bv_tests", 200.0) from "bv_tests=200"; the first part of a combined budget."""
+    kind, _, value = budget.split(";")[0].partition("=")
+    return kind, float(value)
+
+
+def wrong_percent(rows):
+    candidates = sum(int(r["candidates"]) for r in rows)
+    wrong = sum(int(r["missed"]) + int(r["false_pairs"]) for r in rows)
+    return 100.0 * wrong / candidates if candidates else 0.0
+
+
+def totals_by(rows, key):
+    groups = defaultdict(list)
+    for r in rows:
+        groups[key(r)].append(r)
+    return groups
+
+
+def figure_errors_vs_budget(rows, out):
+    budgeted = [r for r in rows if r["schedule"]]
+    kinds = sorted({budget_value(r["budget"])[0] for r in budgeted}) or ["bv_tests"]
+    fig, axes = plt.subplots(1, len(kinds), figsize=(6.2 * len(kinds), 4.4), squeeze=False)
+    references = totals_by([r for r in rows if not r["schedule"]], lambda r: (r["hierarchy"], r["series"]))
+    for ax, kind in zip(axes[0], kinds):
+        lines = defaultdict(dict)
+        for (hierarchy, schedule, budget), group in totals_by(
+            budgeted, lambda r: (r["hierarchy"], r["schedule"], r["budget"])
+        ).items():
+            k, value = budget_value(budget)
+            if k == kind:
+                lines[(hierarchy, schedule)][value] = wrong_percent(group)
+        for (hierarchy, schedule), points in sorted(lines.items()):
+            xs = sorted(points)
+            ax.plot(xs, [points[x] for x in xs], marker="o", label=f"{schedule} ({hierarchy})")
+        for (hierarchy, series), group in sorted(references.items()):
+            ax.axhline(wrong_percent(group), linestyle=":", linewidth=1, color="grey")
+            ax.annotate(f"{series} ({hierarchy})", (0.01, wrong_percent(group)), xycoords=("axes fraction", "data"),
+                        fontsize=7, color="grey", va="bottom")
+        ax.set_xscale("log")
+        ax.set_xlabel("frame budget, " + ("BV tests" if kind == "bv_tests" else "microseconds"))
+        ax.set_ylabel("wrong pairs, % of candidate pairs (missed + false)")
+        ax.set_ylim(bottom=0)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Pair errors against the frame budget")
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
+def figure_broad_phase_vs_objects(scaling, broad, out):
+    fig, ax = plt.subplots(figsize=(6.2, 4.4))
+    points = defaultdict(dict)
+    for r in scaling:
+        points[(r["hierarchy"], r["broad_phase"])][int(r["objects"])] = float(r["boxes_micros"]) + float(
+            r["update_micros"]
+        )
+    if not points:
+        for key, group in totals_by(broad, lambda r: (r["hierarchy"], r["broad_phase"])).items():
+            times = sorted(float(r["boxes_micros"]) + float(r["update_micros"]) for r in group)
+            points[key][int(group[0]["objects"])] = times[len(times) // 2]
+    for (hierarchy, name), by_count in sorted(points.items()):
+        xs = sorted(by_count)
+        ax.plot(xs, [by_count[x] for x in xs], marker="o", label=f"{name} ({hierarchy})")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("objects")
+    ax.set_ylabel("µs per frame (world boxes + update + pairs), median")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("Broad phase against the object count")
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("report_dir")
+    args = parser.parse_args()
+    rows = read_csv(os.path.join(args.report_dir, "world_frames.csv"))
+    broad = read_csv(os.path.join(args.report_dir, "world_broad_phase.csv"))
+    if not rows or not broad:
+        sys.exit("plot_world.py: world_frames.csv or world_broad_phase.csv is missing or empty")
+    scaling = read_csv(os.path.join(args.report_dir, "world_scaling.csv"))
+    figure_errors_vs_budget(rows, os.path.join(args.report_dir, "world_errors_vs_budget.png"))
+    figure_broad_phase_vs_objects(scaling, broad, os.path.join(args.report_dir, "world_broad_phase_vs_objects.png"))
+
+
+if __name__ == "__main__":
+    main()
