@@ -170,6 +170,31 @@ FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
   return spec;
 }
 
+/// Instances of an optional object whose mesh is missing leave the world (with their poses), with a note.
+void drop_missing_objects(const Node& w, Scene& scene, WorldSpec& world) {
+  std::vector<std::size_t> kept;
+  for (std::size_t i = 0; i < world.instances.size(); ++i) {
+    if (!scene.object(world.instances[i].object)->path.empty()) {
+      kept.push_back(i);
+      continue;
+    }
+    const std::string note =
+        "instances of " + world.instances[i].object + " skipped: optional mesh not found";
+    if (std::find(scene.notes.begin(), scene.notes.end(), note) == scene.notes.end())
+      scene.notes.push_back(note);
+  }
+  if (kept.empty()) w.child("instances").fail("no instance is left: every object's mesh is missing");
+  if (kept.size() == world.instances.size()) return;
+  std::vector<WorldInstance> instances;
+  for (std::size_t i : kept) instances.push_back(world.instances[i]);
+  world.instances = std::move(instances);
+  for (auto& frame : world.poses) {
+    std::vector<RigidTransform> row;
+    for (std::size_t i : kept) row.push_back(frame[i]);
+    frame = std::move(row);
+  }
+}
+
 }  // namespace
 
 void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene& scene) {
@@ -196,6 +221,7 @@ void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene&
   else if (w.has("region"))
     w.child("region").fail("does not apply to a frame file (it gives every pose)");
   parse_motion(w.child("motion"), base_dir, world, placements);
+  drop_missing_objects(w, scene, world);
   world.broad_phases =
       w.has("broad_phases") ? parse_names(w.child("broad_phases"), broad_phase_names()) : broad_phase_names();
   if (w.has("frame_budgets")) {

@@ -96,6 +96,23 @@ TEST_F(WorldTest, TheSameSeedGivesTheSameFramesAndAnotherSeedOthers) {
   EXPECT_NE(a[39][2].translation, c[39][2].translation);
 }
 
+TEST_F(WorldTest, InstancesOfAMissingOptionalObjectLeaveTheWorldWithANote) {
+  const Scene scene = parse(R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "gone.obj", "optional": true}],
+      "hierarchies": [{"bv": "aabb"}], "strategies": [{"type": "exact"}],
+      "world": {"instances": [{"object": "gone", "count": 2}, {"object": "torus", "count": 3}],
+                "region": {"min": [0, 0, 0], "max": [5, 5, 5]}, "motion": {"type": "random_walk", "frames": 4}}})");
+  ASSERT_EQ(scene.world->instances.size(), 3u);
+  EXPECT_EQ(scene.world->instances[0].name, "torus#0");
+  for (const auto& frame : scene.world->poses) EXPECT_EQ(frame.size(), 3u);
+  ASSERT_EQ(scene.notes.size(), 1u);
+  EXPECT_NE(scene.notes[0].find("instances of gone skipped"), std::string::npos);
+  EXPECT_NE(error_of(R"({"objects": [{"mesh": "gone.obj", "optional": true}], "hierarchies": [{"bv": "aabb"}],
+      "strategies": [{"type": "exact"}], "world": {"instances": [{"object": "gone"}],
+      "region": {"min": [0, 0, 0], "max": [5, 5, 5]}, "motion": {"type": "random_walk", "frames": 4}}})")
+                .find("/world/instances: no instance is left"),
+            std::string::npos);
+}
+
 TEST(WorldMotion, ReflectionFoldsBackIntoTheRegion) {
   EXPECT_DOUBLE_EQ(reflect_into(0.5, 0, 1), 0.5);
   EXPECT_DOUBLE_EQ(reflect_into(1.25, 0, 1), 0.75);
