@@ -298,6 +298,19 @@ TEST_F(WorldTest, AFrameBudgetOfOneTestFlagsItsPairsAndAGenerousOneDecidesThemAl
   EXPECT_GT(starved, 0u);
 }
 
+TEST_F(WorldTest, AnObjectWithoutTrianglesIsRefusedByName) {
+  testing::write_text(dir / "flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+  const Scene scene = parse(R"({"objects": [{"mesh": "flat.obj"}], "hierarchies": [{"bv": "aabb"}],
+      "strategies": [{"type": "exact"}], "world": {"instances": [{"object": "flat", "count": 2}],
+      "region": {"min": [0, 0, 0], "max": [1, 1, 1]}, "motion": {"type": "random_walk", "frames": 2}}})");
+  try {
+    run_world(scene, quiet_options());
+    ADD_FAILURE() << "an object without triangles ran";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("flat.obj"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(WorldTest, AWorldRunWritesItsTablesAndRefusesAPairScene) {
   const Scene scene = parse(crowded_world(R"([{"bv": "aabb"}])", R"([{"type": "exact"}])"));
   const WorldOutput out = run_world(scene, quiet_options());
