@@ -8,6 +8,8 @@
 #include "bench/core/scene.hpp"
 #include "bench/run.hpp"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -65,6 +67,10 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options);
 
 /// world_frames.csv, world_broad_phase.csv and world_scaling.csv in `dir` (columns: the rows' fields).
 void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir);
+
+/// The rows as JSON (Python's run_scene on a world scene): {"scene", "instances", "frames", "series": [...],
+/// "broad_phase": [...], "scaling": [...]}, each row keyed like its CSV columns.
+nlohmann::json world_document(const WorldOutput& output);
 
 /// The whole report: the CSV files, the figures (bench/plot_world.py, when `figures`) and README.md.
 /// Returns why figures are missing ("" when drawn).

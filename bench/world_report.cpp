@@ -5,6 +5,7 @@
 #include "bench/report.hpp"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <fstream>
@@ -151,6 +152,43 @@ std::string world_readme(const WorldOutput& output, const std::vector<std::strin
   scaling_table(md, output);
   for (const std::string& figure : figures) md << "\n![" << figure << "](" << figure << ")\n";
   return md.str();
+}
+
+nlohmann::json world_document(const WorldOutput& output) {
+  nlohmann::json series = nlohmann::json::array(), broad = nlohmann::json::array(),
+                 scaling = nlohmann::json::array();
+  for (const WorldSeriesRow& r : output.series)
+    series.push_back({{"frame", r.frame},
+                      {"hierarchy", r.hierarchy},
+                      {"series", r.series},
+                      {"schedule", r.schedule},
+                      {"budget", r.budget},
+                      {"exact_strategy", r.exact_strategy},
+                      {"candidates", r.candidates},
+                      {"colliding", r.colliding},
+                      {"answered", r.answered},
+                      {"missed", r.missed},
+                      {"false_pairs", r.false_pairs},
+                      {"flagged", r.flagged},
+                      {"micros", r.micros},
+                      {"bv_tests", r.bv_tests}});
+  for (const BroadPhaseRow& r : output.broad)
+    broad.push_back({{"frame", r.frame},
+                     {"hierarchy", r.hierarchy},
+                     {"broad_phase", r.broad_phase},
+                     {"objects", r.objects},
+                     {"candidates", r.candidates},
+                     {"boxes_micros", r.boxes_micros},
+                     {"update_micros", r.update_micros}});
+  for (const ScalingRow& r : output.scaling)
+    scaling.push_back({{"hierarchy", r.hierarchy},
+                       {"broad_phase", r.broad_phase},
+                       {"objects", r.objects},
+                       {"candidates", r.candidates},
+                       {"boxes_micros", r.boxes_micros},
+                       {"update_micros", r.update_micros}});
+  return {{"scene", output.scene}, {"instances", output.instances}, {"frames", output.frames},
+          {"series", series},      {"broad_phase", broad},          {"scaling", scaling}};
 }
 
 std::string write_world_report(const WorldOutput& output, const std::filesystem::path& dir, bool figures) {

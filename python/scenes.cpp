@@ -3,6 +3,7 @@
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
 #include "bench/run.hpp"
+#include "bench/world.hpp"
 #include "bench/write.hpp"
 #include "python/bindings.hpp"
 
@@ -45,12 +46,18 @@ py::object run(const py::object& scene_argument, const py::object& cache, int th
   options.log = [quiet](const std::string& line) {
     if (!quiet) std::cerr << line << '\n';
   };
+  if (scene.world && options.per_pose != PerPose::none)
+    throw py::value_error("per_pose: does not apply to a world scene (its rows are per frame)");
   nlohmann::json document;
   {
     py::gil_scoped_release release;
-    const RunOutput output = run_scene(scene, options);
-    document = results_document(output);
-    if (options.per_pose != PerPose::none) document["poses"] = poses_document(output);
+    if (scene.world) {
+      document = world_document(run_world(scene, options));
+    } else {
+      const RunOutput output = run_scene(scene, options);
+      document = results_document(output);
+      if (options.per_pose != PerPose::none) document["poses"] = poses_document(output);
+    }
   }
   return from_json(document);
 }
@@ -66,7 +73,9 @@ void bind_scenes(py::module_& m) {
         "cache: a "
         "folder for trees and ground truth (default: none); quiet=False prints the runner's messages; "
         "per_pose=\"all\" or \"wrong\" adds \"poses\", the records of poses.csv (`bvhlab run --per-pose`), "
-        "one dict per query or per wrong answer.");
+        "one dict per query or per wrong answer. A world scene (\"world\") returns its rows instead: "
+        "\"series\" (per frame, hierarchy and series: candidates, colliding, missed, false_pairs, flagged, "
+        "micros), \"broad_phase\" and \"scaling\", keyed like the columns of its CSV files.");
   m.def(
       "policies", [] { return from_json(policies_json()); },
       "The registered densities and strategies with their parameters (what `bvhlab policies` prints).");
