@@ -7,11 +7,11 @@
 // box stays inside that fat box, its update costs one containment test and nothing else; once it leaves, the
 // leaf is removed and reinserted with a fresh fat box (reinsertions() counts those).
 //
-// Registration builds the tree top-down (median splits), and so does a frame in which more than a quarter
-// of the objects left their fat boxes (reinserting most leaves one by one costs more than building anew).
-// Otherwise, insertion descends from the root by a surface-area cost: at each inner node it compares making a
-// new parent of the leaf and this node (twice the merged box's area) with descending into either child (the
-// child's area growth, plus the growth every ancestor on the way already pays). That is the greedy
+// Registration builds the tree over the leaves in Morton order, and so does a frame in which more than a
+// quarter of the objects left their fat boxes (reinserting most leaves one by one costs more than building
+// anew). Otherwise, insertion descends from the root by a surface-area cost: at each inner node it compares
+// making a new parent of the leaf and this node (twice the merged box's area) with descending into either
+// child (the child's area growth, plus the growth every ancestor on the way already pays). That is the greedy
 // surface-area heuristic; it keeps boxes that are near each other under one parent. Every ancestor of a
 // changed leaf is then refitted and, where its children's heights differ by more than one, rotated (the
 // taller child moves up, AVL style), so the height stays O(log n) whatever the insertion order.
@@ -25,6 +25,7 @@
 #include "broad_phase.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <utility>
 
 namespace bvhlab {
@@ -136,32 +137,62 @@ class DynamicAabbTree {
     rebuild();
   }
 
-  // Drops every inner node and builds them again top-down over the leaves as they are: each range of
-  // leaves is split at the median of their centres along the axis where the centres spread most. O(n log n),
-  // balanced by construction; far cheaper than reinserting most leaves one by one.
+  // Drops every inner node and builds them again over the leaves as they are: the leaves sorted along a
+  // Morton (Z-order) curve through their centres (21 bits an axis over the centres' bounds), each range
+  // split where its codes' highest differing bit changes, i.e. on a plane of the implicit octree. O(n log n)
+  // for the sort and little else: far cheaper than reinserting most leaves one by one. The height is at most
+  // 63 plus log2 of the largest group of coincident centres.
   void rebuild() {
     const std::size_t n = leaf_of_.size();
     nodes_.resize(n);  // leaves are nodes 0 .. n-1 (register_objects), inner nodes follow
     free_.clear();
     root_ = kNull;
     if (n == 0) return;
-    order_.assign(leaf_of_.begin(), leaf_of_.end());
-    centres_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) centres_[i] = nodes_[i].box.center();
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 c = nodes_[i].box.min + nodes_[i].box.max;  // twice the centre: only the order matters
+      lo = lo.cwiseMin(c);
+      hi = hi.cwiseMax(c);
+    }
+    constexpr double kCells = (1 << 21) - 1;  // 21 bits per axis: a 63-bit code
+    const Vec3 scale = kCells * (hi - lo).cwiseMax(Vec3::Constant(1e-300)).cwiseInverse();
+    items_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 cell = ((nodes_[i].box.min + nodes_[i].box.max - lo).cwiseProduct(scale)).cwiseMin(kCells);
+      items_[i] = {spread_bits(std::uint64_t(cell.x())) | spread_bits(std::uint64_t(cell.y())) << 1 |
+                       spread_bits(std::uint64_t(cell.z())) << 2,
+                   static_cast<std::int32_t>(i)};
+    }
+    std::sort(items_.begin(), items_.end(), [](const Item& a, const Item& b) { return a.code < b.code; });
     nodes_.reserve(2 * n);
     root_ = build_range(0, n);
     nodes_[root_].parent = kNull;
   }
 
+  // The 21 low bits of x moved to every third bit (bit k to bit 3k).
+  static std::uint64_t spread_bits(std::uint64_t x) {
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffull;
+    x = (x | x << 16) & 0x1f0000ff0000ffull;
+    x = (x | x << 8) & 0x100f00f00f00f00full;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
+  }
+
   std::int32_t build_range(std::size_t begin, std::size_t end) {
-    if (end - begin == 1) return order_[begin];
-    Box spread;
-    for (std::size_t k = begin; k < end; ++k) spread.extend(centres_[order_[k]]);
-    int axis = 0;
-    spread.extent().maxCoeff(&axis);
-    const std::size_t middle = begin + (end - begin) / 2;
-    std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
-                     [&](std::int32_t a, std::int32_t b) { return centres_[a][axis] < centres_[b][axis]; });
+    if (end - begin == 1) return items_[begin].node;
+    // Split where the highest bit in which the range's codes differ turns on: a plane of the implicit
+    // octree, so each child is one spatial cell. Equal codes (coincident centres) split in the middle.
+    std::size_t middle = begin + (end - begin) / 2;
+    const std::uint64_t first = items_[begin].code, last = items_[end - 1].code;
+    if (first != last) {
+      const std::uint64_t bit = std::uint64_t(1) << (63 - std::countl_zero(first ^ last));
+      middle = static_cast<std::size_t>(
+          std::partition_point(items_.begin() + begin, items_.begin() + end,
+                               [bit](const Item& item) { return (item.code & bit) == 0; }) -
+          items_.begin());
+    }
     const std::int32_t left = build_range(begin, middle), right = build_range(middle, end);
     const std::int32_t parent = allocate();
     nodes_[parent].left = left;
@@ -276,17 +307,20 @@ class DynamicAabbTree {
   void find_pairs() {
     pairs_.clear();
     if (root_ == kNull) return;
-    stack_.clear();
-    stack_.emplace_back(root_, root_);
-    while (!stack_.empty()) {
-      const auto [a, b] = stack_.back();
-      stack_.pop_back();
+    // Depth first, each pop pushes at most three pairs and each push goes a level deeper on one side, so
+    // the stack never holds more than 2 (2 height + 1) + 3 pairs: a fixed buffer, no growth checks.
+    stack_.resize(4 * static_cast<std::size_t>(nodes_[root_].height) + 8);
+    std::pair<std::int32_t, std::int32_t>* stack = stack_.data();
+    std::size_t top = 0;
+    stack[top++] = {root_, root_};
+    while (top > 0) {
+      const auto [a, b] = stack[--top];
       const Node& na = nodes_[a];
       if (a == b) {
         if (na.left == kNull) continue;
-        stack_.emplace_back(na.left, na.left);
-        stack_.emplace_back(na.right, na.right);
-        stack_.emplace_back(na.left, na.right);
+        stack[top++] = {na.left, na.left};
+        stack[top++] = {na.right, na.right};
+        stack[top++] = {na.left, na.right};
         continue;
       }
       const Node& nb = nodes_[b];
@@ -297,11 +331,11 @@ class DynamicAabbTree {
         if (broad_phase_detail::boxes_touch(tight_[oa], tight_[ob]))
           pairs_.push_back(broad_phase_detail::ordered_pair(oa, ob));
       } else if (b_leaf || (!a_leaf && na.height >= nb.height)) {
-        stack_.emplace_back(na.left, b);
-        stack_.emplace_back(na.right, b);
+        stack[top++] = {na.left, b};
+        stack[top++] = {na.right, b};
       } else {
-        stack_.emplace_back(a, nb.left);
-        stack_.emplace_back(a, nb.right);
+        stack[top++] = {a, nb.left};
+        stack[top++] = {a, nb.right};
       }
     }
     std::sort(pairs_.begin(), pairs_.end());
@@ -318,8 +352,11 @@ class DynamicAabbTree {
   std::uint64_t last_reinsertions_ = 0;
   std::vector<std::pair<std::int32_t, std::int32_t>> stack_;
   std::vector<std::uint32_t> moved_;  // objects outside their fat boxes this frame
-  std::vector<std::int32_t> order_;   // rebuild: leaves, partitioned
-  std::vector<Vec3> centres_;         // rebuild: leaf box centres
+  struct Item {
+    std::uint64_t code;  // Morton code of the leaf's centre
+    std::int32_t node;
+  };
+  std::vector<Item> items_;  // rebuild: the leaves in Morton order
   std::vector<ObjectPair> pairs_;
 };
 
