@@ -287,6 +287,24 @@ TEST(SweepAndPrune, SweepsAlongTheWidestSpread) {
   EXPECT_EQ(sap.pairs(), reference.pairs());
 }
 
+TEST(SweepAndPrune, IncoherentMotionFallsBackToAFullSort) {
+  std::mt19937_64 rng(4);
+  std::vector<Box> boxes = random_boxes(1000, false, rng);
+  SweepAndPrune sap;
+  BruteForce reference;
+  sap.update(boxes);
+  // Small steps: insertion sort only.
+  random_walk(boxes, rng);
+  sap.update(boxes);
+  EXPECT_EQ(sap.full_sorts(), 0u);
+  // Every box somewhere else: far more inversions than a sort costs.
+  boxes = random_boxes(1000, false, rng);
+  sap.update(boxes);
+  reference.update(boxes);
+  EXPECT_EQ(sap.full_sorts(), 1u);
+  EXPECT_EQ(sap.pairs(), reference.pairs());
+}
+
 // World boxes: every transformed vertex inside, never larger than the root's rotated bounding box.
 
 template <class BV>
