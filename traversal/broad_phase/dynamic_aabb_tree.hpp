@@ -7,9 +7,11 @@
 // box stays inside that fat box, its update costs one containment test and nothing else; once it leaves, the
 // leaf is removed and reinserted with a fresh fat box (reinsertions() counts those).
 //
-// Registration builds the tree over the leaves in Morton order, and so does a frame in which more than a
-// quarter of the objects left their fat boxes (reinserting most leaves one by one costs more than building
-// anew). Otherwise, insertion descends from the root by a surface-area cost: at each inner node it compares
+// Registration builds the tree over the leaves in Morton order. A frame in which more than a quarter of the
+// objects left their fat boxes (reinserting most leaves one by one costs more than building anew) first
+// refits the tree as it stands, which keeps it good under coherent motion, and rebuilds it only when the
+// inner boxes' total area, relative to the leaves', has grown by kRefitSlack (1.25) since the last build.
+// Otherwise, insertion descends from the root by a surface-area cost: at each inner node it compares
 // making a new parent of the leaf and this node (twice the merged box's area) with descending into either
 // child (the child's area growth, plus the growth every ancestor on the way already pays). That is the greedy
 // surface-area heuristic; it keeps boxes that are near each other under one parent. Every ancestor of a
@@ -60,7 +62,14 @@ class DynamicAabbTree {
       reinsertions_ += last_reinsertions_;
       if (moved_.size() > kRebuildShare * double(leaf_of_.size())) {
         for (std::uint32_t i : moved_) nodes_[leaf_of_[i]].box = fattened(tight_[i]);
-        rebuild();
+        // Coherent motion: the old topology, refitted, is usually still good. Rebuild only when its
+        // inner boxes have grown by kRefitSlack relative to the leaves since the last build.
+        double leaves = 0;
+        const double inner = refit_subtree(root_, leaves);
+        if (inner > kRefitSlack * built_quality_ * leaves)
+          rebuild();
+        else
+          ++refits_;
       } else {
         for (std::uint32_t i : moved_) {
           const std::int32_t leaf = leaf_of_[i];
@@ -77,6 +86,8 @@ class DynamicAabbTree {
 
   /// Leaves removed and reinserted because their object left its fat box, since registration.
   [[nodiscard]] std::uint64_t reinsertions() const { return reinsertions_; }
+  /// Frames in which most objects moved and the tree was refitted rather than rebuilt.
+  [[nodiscard]] std::uint64_t refits() const { return refits_; }
   /// The same, in the last update only.
   [[nodiscard]] std::uint64_t last_reinsertions() const { return last_reinsertions_; }
   /// Edges on the longest root-to-leaf path (0 for a single leaf or none).
@@ -89,6 +100,8 @@ class DynamicAabbTree {
   static constexpr std::int32_t kNull = -1;
   /// When more than this share of the objects left their fat boxes in one frame, the tree is rebuilt.
   static constexpr double kRebuildShare = 0.25;
+  /// How much the inner boxes' total area (relative to the leaves') may grow under refits before a rebuild.
+  static constexpr double kRefitSlack = 1.25;
 
   // Leaves have left == kNull and keep their object in `right`.
   struct Node {
@@ -167,6 +180,30 @@ class DynamicAabbTree {
     nodes_.reserve(2 * n);
     root_ = build_range(0, n);
     nodes_[root_].parent = kNull;
+    double leaves = 0;
+    const double inner = subtree_area(root_, leaves);
+    built_quality_ = leaves > 0 ? inner / leaves : 0;
+  }
+
+  // Sum of the inner nodes' half areas below i (and of the leaves' into `leaves`), refitting on the way.
+  double refit_subtree(std::int32_t i, double& leaves) {
+    Node& n = nodes_[i];
+    if (n.left == kNull) {
+      leaves += half_area(n.box);
+      return 0;
+    }
+    const double below = refit_subtree(n.left, leaves) + refit_subtree(n.right, leaves);
+    n.box = merged(nodes_[n.left].box, nodes_[n.right].box);
+    return below + half_area(n.box);
+  }
+  // The same without refitting.
+  double subtree_area(std::int32_t i, double& leaves) const {
+    const Node& n = nodes_[i];
+    if (n.left == kNull) {
+      leaves += half_area(n.box);
+      return 0;
+    }
+    return subtree_area(n.left, leaves) + subtree_area(n.right, leaves) + half_area(n.box);
   }
 
   // The 21 low bits of x moved to every third bit (bit k to bit 3k).
@@ -194,12 +231,12 @@ class DynamicAabbTree {
           items_.begin());
     }
     const std::int32_t left = build_range(begin, middle), right = build_range(middle, end);
-    const std::int32_t parent = allocate();
-    nodes_[parent].left = left;
-    nodes_[parent].right = right;
+    // Appended whole (the free list is empty during a rebuild): no default box written and overwritten.
+    const auto parent = static_cast<std::int32_t>(nodes_.size());
+    nodes_.push_back({merged(nodes_[left].box, nodes_[right].box), kNull, left, right,
+                      1 + std::max(nodes_[left].height, nodes_[right].height)});
     nodes_[left].parent = parent;
     nodes_[right].parent = parent;
-    refit(parent);
     return parent;
   }
 
@@ -312,30 +349,33 @@ class DynamicAabbTree {
     stack_.resize(4 * static_cast<std::size_t>(nodes_[root_].height) + 8);
     std::pair<std::int32_t, std::int32_t>* stack = stack_.data();
     std::size_t top = 0;
-    stack[top++] = {root_, root_};
+    // A pair is pushed only once its boxes are known to touch (a node with itself always does), so most
+    // separated pairs cost one test and no stack traffic.
+    auto touch = [this](std::int32_t x, std::int32_t y) {
+      return broad_phase_detail::boxes_touch(nodes_[x].box, nodes_[y].box);
+    };
+    if (nodes_[root_].left != kNull) stack[top++] = {root_, root_};
     while (top > 0) {
       const auto [a, b] = stack[--top];
       const Node& na = nodes_[a];
-      if (a == b) {
-        if (na.left == kNull) continue;
-        stack[top++] = {na.left, na.left};
-        stack[top++] = {na.right, na.right};
-        stack[top++] = {na.left, na.right};
+      if (a == b) {  // an inner node with itself
+        if (nodes_[na.left].left != kNull) stack[top++] = {na.left, na.left};
+        if (nodes_[na.right].left != kNull) stack[top++] = {na.right, na.right};
+        if (touch(na.left, na.right)) stack[top++] = {na.left, na.right};
         continue;
       }
       const Node& nb = nodes_[b];
-      if (!broad_phase_detail::boxes_touch(na.box, nb.box)) continue;
       const bool a_leaf = na.left == kNull, b_leaf = nb.left == kNull;
       if (a_leaf && b_leaf) {
         const auto oa = static_cast<std::uint32_t>(na.right), ob = static_cast<std::uint32_t>(nb.right);
         if (broad_phase_detail::boxes_touch(tight_[oa], tight_[ob]))
           pairs_.push_back(broad_phase_detail::ordered_pair(oa, ob));
       } else if (b_leaf || (!a_leaf && na.height >= nb.height)) {
-        stack[top++] = {na.left, b};
-        stack[top++] = {na.right, b};
+        if (touch(na.left, b)) stack[top++] = {na.left, b};
+        if (touch(na.right, b)) stack[top++] = {na.right, b};
       } else {
-        stack[top++] = {a, nb.left};
-        stack[top++] = {a, nb.right};
+        if (touch(a, nb.left)) stack[top++] = {a, nb.left};
+        if (touch(a, nb.right)) stack[top++] = {a, nb.right};
       }
     }
     std::sort(pairs_.begin(), pairs_.end());
@@ -350,6 +390,8 @@ class DynamicAabbTree {
   std::int32_t root_ = kNull;
   std::uint64_t reinsertions_ = 0;
   std::uint64_t last_reinsertions_ = 0;
+  std::uint64_t refits_ = 0;
+  double built_quality_ = 0;  // inner / leaf area right after the last rebuild
   std::vector<std::pair<std::int32_t, std::int32_t>> stack_;
   std::vector<std::uint32_t> moved_;  // objects outside their fat boxes this frame
   struct Item {
