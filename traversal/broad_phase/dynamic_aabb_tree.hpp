@@ -86,10 +86,10 @@ class DynamicAabbTree {
 
   /// Leaves removed and reinserted because their object left its fat box, since registration.
   [[nodiscard]] std::uint64_t reinsertions() const { return reinsertions_; }
-  /// Frames in which most objects moved and the tree was refitted rather than rebuilt.
-  [[nodiscard]] std::uint64_t refits() const { return refits_; }
   /// The same, in the last update only.
   [[nodiscard]] std::uint64_t last_reinsertions() const { return last_reinsertions_; }
+  /// Frames in which most objects moved and the tree was refitted rather than rebuilt.
+  [[nodiscard]] std::uint64_t refits() const { return refits_; }
   /// Edges on the longest root-to-leaf path (0 for a single leaf or none).
   [[nodiscard]] int height() const { return root_ == kNull ? 0 : nodes_[root_].height; }
   /// The fattened box object i's leaf holds.
@@ -98,7 +98,8 @@ class DynamicAabbTree {
 
  private:
   static constexpr std::int32_t kNull = -1;
-  /// When more than this share of the objects left their fat boxes in one frame, the tree is rebuilt.
+  /// When more than this share of the objects left their fat boxes in one frame, the tree is refitted or
+  /// rebuilt instead of reinserting them one by one.
   static constexpr double kRebuildShare = 0.25;
   /// How much the inner boxes' total area (relative to the leaves') may grow under refits before a rebuild.
   static constexpr double kRefitSlack = 1.25;
