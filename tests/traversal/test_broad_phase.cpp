@@ -239,6 +239,32 @@ TEST(DynamicAabbTree, SkipsUpdatesWhileTheFatBoxHolds) {
   EXPECT_EQ(tree.pairs(), reference.pairs());
 }
 
+TEST(DynamicAabbTree, RefitsUnderCoherentMotionAndRebuildsWhenScattered) {
+  std::mt19937_64 rng(12);
+  std::vector<Box> boxes = random_boxes(800, false, rng);
+  DynamicAabbTree tree;
+  BruteForce reference;
+  tree.update(boxes);
+  // Every box a little further along one direction: all leave their fat boxes, the tree shape stays good.
+  for (int frame = 0; frame < 5; ++frame) {
+    for (Box& b : boxes) {
+      const Vec3 shift(b.extent().maxCoeff(), 0, 0);
+      b = {b.min + shift, b.max + shift};
+    }
+    tree.update(boxes);
+    reference.update(boxes);
+    EXPECT_EQ(tree.last_reinsertions(), boxes.size());
+    EXPECT_EQ(tree.pairs(), reference.pairs());
+  }
+  EXPECT_EQ(tree.refits(), 5u);
+  // Every box somewhere else: refitting the old shape would be poor, so it is rebuilt.
+  boxes = random_boxes(800, false, rng);
+  tree.update(boxes);
+  reference.update(boxes);
+  EXPECT_EQ(tree.refits(), 5u);
+  EXPECT_EQ(tree.pairs(), reference.pairs());
+}
+
 TEST(DynamicAabbTree, StaysBalancedUnderSortedInsertion) {
   // Registered scattered, then moved onto a line in order, a tenth of them per frame (so they are
   // reinserted one by one, not rebuilt): without rotations the line would grow into a list.
@@ -284,6 +310,24 @@ TEST(SweepAndPrune, SweepsAlongTheWidestSpread) {
   EXPECT_EQ(sap.axis_changes(), 1u);
   BruteForce reference;
   reference.update(boxes);
+  EXPECT_EQ(sap.pairs(), reference.pairs());
+}
+
+TEST(SweepAndPrune, IncoherentMotionFallsBackToAFullSort) {
+  std::mt19937_64 rng(4);
+  std::vector<Box> boxes = random_boxes(1000, false, rng);
+  SweepAndPrune sap;
+  BruteForce reference;
+  sap.update(boxes);
+  // Small steps: insertion sort only.
+  random_walk(boxes, rng);
+  sap.update(boxes);
+  EXPECT_EQ(sap.full_sorts(), 0u);
+  // Every box somewhere else: far more inversions than a sort costs.
+  boxes = random_boxes(1000, false, rng);
+  sap.update(boxes);
+  reference.update(boxes);
+  EXPECT_EQ(sap.full_sorts(), 1u);
   EXPECT_EQ(sap.pairs(), reference.pairs());
 }
 

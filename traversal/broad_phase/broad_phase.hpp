@@ -31,6 +31,7 @@
 
 #include "../../volumes/geometry.hpp"
 
+#include <cmath>
 #include <compare>
 #include <concepts>
 #include <cstdint>
@@ -73,10 +74,15 @@ inline void check_update(std::string_view who, std::span<const Box> boxes, std::
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const Box& box = boxes[i];
     // Empty first: the default Box (min = +inf, max = -inf) is an empty box, not an infinite one.
-    if (box.empty())
+    bool empty = false, finite = true;
+    for (int k = 0; k < 3; ++k) {
+      empty = empty || box.min[k] > box.max[k];
+      finite = finite && std::isfinite(box.min[k]) && std::isfinite(box.max[k]);
+    }
+    if (empty)
       throw std::invalid_argument(std::string(who) + ": object " + std::to_string(i) +
                                   "'s box is empty (min > max on some axis)");
-    if (!box.min.allFinite() || !box.max.allFinite())
+    if (!finite)
       throw std::invalid_argument(std::string(who) + ": object " + std::to_string(i) +
                                   "'s box has a NaN or infinite coordinate");
   }

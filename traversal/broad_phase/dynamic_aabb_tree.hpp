@@ -7,11 +7,13 @@
 // box stays inside that fat box, its update costs one containment test and nothing else; once it leaves, the
 // leaf is removed and reinserted with a fresh fat box (reinsertions() counts those).
 //
-// Registration builds the tree top-down (median splits), and so does a frame in which more than a quarter
-// of the objects left their fat boxes (reinserting most leaves one by one costs more than building anew).
-// Otherwise, insertion descends from the root by a surface-area cost: at each inner node it compares making a
-// new parent of the leaf and this node (twice the merged box's area) with descending into either child (the
-// child's area growth, plus the growth every ancestor on the way already pays). That is the greedy
+// Registration builds the tree over the leaves in Morton order. A frame in which more than a quarter of the
+// objects left their fat boxes (reinserting most leaves one by one costs more than building anew) first
+// refits the tree as it stands, which keeps it good under coherent motion, and rebuilds it only when the
+// inner boxes' total area, relative to the leaves', has grown by kRefitSlack (1.25) since the last build.
+// Otherwise, insertion descends from the root by a surface-area cost: at each inner node it compares
+// making a new parent of the leaf and this node (twice the merged box's area) with descending into either
+// child (the child's area growth, plus the growth every ancestor on the way already pays). That is the greedy
 // surface-area heuristic; it keeps boxes that are near each other under one parent. Every ancestor of a
 // changed leaf is then refitted and, where its children's heights differ by more than one, rotated (the
 // taller child moves up, AVL style), so the height stays O(log n) whatever the insertion order.
@@ -25,6 +27,7 @@
 #include "broad_phase.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <utility>
 
 namespace bvhlab {
@@ -59,7 +62,14 @@ class DynamicAabbTree {
       reinsertions_ += last_reinsertions_;
       if (moved_.size() > kRebuildShare * double(leaf_of_.size())) {
         for (std::uint32_t i : moved_) nodes_[leaf_of_[i]].box = fattened(tight_[i]);
-        rebuild();
+        // Coherent motion: the old topology, refitted, is usually still good. Rebuild only when its
+        // inner boxes have grown by kRefitSlack relative to the leaves since the last build.
+        double leaves = 0;
+        const double inner = refit_subtree(root_, leaves);
+        if (inner > kRefitSlack * built_quality_ * leaves)
+          rebuild();
+        else
+          ++refits_;
       } else {
         for (std::uint32_t i : moved_) {
           const std::int32_t leaf = leaf_of_[i];
@@ -78,6 +88,8 @@ class DynamicAabbTree {
   [[nodiscard]] std::uint64_t reinsertions() const { return reinsertions_; }
   /// The same, in the last update only.
   [[nodiscard]] std::uint64_t last_reinsertions() const { return last_reinsertions_; }
+  /// Frames in which most objects moved and the tree was refitted rather than rebuilt.
+  [[nodiscard]] std::uint64_t refits() const { return refits_; }
   /// Edges on the longest root-to-leaf path (0 for a single leaf or none).
   [[nodiscard]] int height() const { return root_ == kNull ? 0 : nodes_[root_].height; }
   /// The fattened box object i's leaf holds.
@@ -86,8 +98,11 @@ class DynamicAabbTree {
 
  private:
   static constexpr std::int32_t kNull = -1;
-  /// When more than this share of the objects left their fat boxes in one frame, the tree is rebuilt.
+  /// When more than this share of the objects left their fat boxes in one frame, the tree is refitted or
+  /// rebuilt instead of reinserting them one by one.
   static constexpr double kRebuildShare = 0.25;
+  /// How much the inner boxes' total area (relative to the leaves') may grow under refits before a rebuild.
+  static constexpr double kRefitSlack = 1.25;
 
   // Leaves have left == kNull and keep their object in `right`.
   struct Node {
@@ -136,39 +151,93 @@ class DynamicAabbTree {
     rebuild();
   }
 
-  // Drops every inner node and builds them again top-down over the leaves as they are: each range of
-  // leaves is split at the median of their centres along the axis where the centres spread most. O(n log n),
-  // balanced by construction; far cheaper than reinserting most leaves one by one.
+  // Drops every inner node and builds them again over the leaves as they are: the leaves sorted along a
+  // Morton (Z-order) curve through their centres (21 bits an axis over the centres' bounds), each range
+  // split where its codes' highest differing bit changes, i.e. on a plane of the implicit octree. O(n log n)
+  // for the sort and little else: far cheaper than reinserting most leaves one by one. The height is at most
+  // 63 plus log2 of the largest group of coincident centres.
   void rebuild() {
     const std::size_t n = leaf_of_.size();
     nodes_.resize(n);  // leaves are nodes 0 .. n-1 (register_objects), inner nodes follow
     free_.clear();
     root_ = kNull;
     if (n == 0) return;
-    order_.assign(leaf_of_.begin(), leaf_of_.end());
-    centres_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) centres_[i] = nodes_[i].box.center();
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 c = nodes_[i].box.min + nodes_[i].box.max;  // twice the centre: only the order matters
+      lo = lo.cwiseMin(c);
+      hi = hi.cwiseMax(c);
+    }
+    constexpr double kCells = (1 << 21) - 1;  // 21 bits per axis: a 63-bit code
+    const Vec3 scale = kCells * (hi - lo).cwiseMax(Vec3::Constant(1e-300)).cwiseInverse();
+    items_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 cell = ((nodes_[i].box.min + nodes_[i].box.max - lo).cwiseProduct(scale)).cwiseMin(kCells);
+      items_[i] = {spread_bits(std::uint64_t(cell.x())) | spread_bits(std::uint64_t(cell.y())) << 1 |
+                       spread_bits(std::uint64_t(cell.z())) << 2,
+                   static_cast<std::int32_t>(i)};
+    }
+    std::sort(items_.begin(), items_.end(), [](const Item& a, const Item& b) { return a.code < b.code; });
     nodes_.reserve(2 * n);
     root_ = build_range(0, n);
     nodes_[root_].parent = kNull;
+    double leaves = 0;
+    const double inner = subtree_area(root_, leaves);
+    built_quality_ = leaves > 0 ? inner / leaves : 0;
+  }
+
+  // Sum of the inner nodes' half areas below i (and of the leaves' into `leaves`), refitting on the way.
+  double refit_subtree(std::int32_t i, double& leaves) {
+    Node& n = nodes_[i];
+    if (n.left == kNull) {
+      leaves += half_area(n.box);
+      return 0;
+    }
+    const double below = refit_subtree(n.left, leaves) + refit_subtree(n.right, leaves);
+    n.box = merged(nodes_[n.left].box, nodes_[n.right].box);
+    return below + half_area(n.box);
+  }
+  // The same without refitting.
+  double subtree_area(std::int32_t i, double& leaves) const {
+    const Node& n = nodes_[i];
+    if (n.left == kNull) {
+      leaves += half_area(n.box);
+      return 0;
+    }
+    return subtree_area(n.left, leaves) + subtree_area(n.right, leaves) + half_area(n.box);
+  }
+
+  // The 21 low bits of x moved to every third bit (bit k to bit 3k).
+  static std::uint64_t spread_bits(std::uint64_t x) {
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffull;
+    x = (x | x << 16) & 0x1f0000ff0000ffull;
+    x = (x | x << 8) & 0x100f00f00f00f00full;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
   }
 
   std::int32_t build_range(std::size_t begin, std::size_t end) {
-    if (end - begin == 1) return order_[begin];
-    Box spread;
-    for (std::size_t k = begin; k < end; ++k) spread.extend(centres_[order_[k]]);
-    int axis = 0;
-    spread.extent().maxCoeff(&axis);
-    const std::size_t middle = begin + (end - begin) / 2;
-    std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
-                     [&](std::int32_t a, std::int32_t b) { return centres_[a][axis] < centres_[b][axis]; });
+    if (end - begin == 1) return items_[begin].node;
+    // Split where the highest bit in which the range's codes differ turns on: a plane of the implicit
+    // octree, so each child is one spatial cell. Equal codes (coincident centres) split in the middle.
+    std::size_t middle = begin + (end - begin) / 2;
+    const std::uint64_t first = items_[begin].code, last = items_[end - 1].code;
+    if (first != last) {
+      const std::uint64_t bit = std::uint64_t(1) << (63 - std::countl_zero(first ^ last));
+      middle = static_cast<std::size_t>(
+          std::partition_point(items_.begin() + begin, items_.begin() + end,
+                               [bit](const Item& item) { return (item.code & bit) == 0; }) -
+          items_.begin());
+    }
     const std::int32_t left = build_range(begin, middle), right = build_range(middle, end);
-    const std::int32_t parent = allocate();
-    nodes_[parent].left = left;
-    nodes_[parent].right = right;
+    // Appended whole (the free list is empty during a rebuild): no default box written and overwritten.
+    const auto parent = static_cast<std::int32_t>(nodes_.size());
+    nodes_.push_back({merged(nodes_[left].box, nodes_[right].box), kNull, left, right,
+                      1 + std::max(nodes_[left].height, nodes_[right].height)});
     nodes_[left].parent = parent;
     nodes_[right].parent = parent;
-    refit(parent);
     return parent;
   }
 
@@ -276,32 +345,38 @@ class DynamicAabbTree {
   void find_pairs() {
     pairs_.clear();
     if (root_ == kNull) return;
-    stack_.clear();
-    stack_.emplace_back(root_, root_);
-    while (!stack_.empty()) {
-      const auto [a, b] = stack_.back();
-      stack_.pop_back();
+    // Depth first, each pop pushes at most three pairs and each push goes a level deeper on one side, so
+    // the stack never holds more than 2 (2 height + 1) + 3 pairs: a fixed buffer, no growth checks.
+    stack_.resize(4 * static_cast<std::size_t>(nodes_[root_].height) + 8);
+    std::pair<std::int32_t, std::int32_t>* stack = stack_.data();
+    std::size_t top = 0;
+    // A pair is pushed only once its boxes are known to touch (a node with itself always does), so most
+    // separated pairs cost one test and no stack traffic.
+    auto touch = [this](std::int32_t x, std::int32_t y) {
+      return broad_phase_detail::boxes_touch(nodes_[x].box, nodes_[y].box);
+    };
+    if (nodes_[root_].left != kNull) stack[top++] = {root_, root_};
+    while (top > 0) {
+      const auto [a, b] = stack[--top];
       const Node& na = nodes_[a];
-      if (a == b) {
-        if (na.left == kNull) continue;
-        stack_.emplace_back(na.left, na.left);
-        stack_.emplace_back(na.right, na.right);
-        stack_.emplace_back(na.left, na.right);
+      if (a == b) {  // an inner node with itself
+        if (nodes_[na.left].left != kNull) stack[top++] = {na.left, na.left};
+        if (nodes_[na.right].left != kNull) stack[top++] = {na.right, na.right};
+        if (touch(na.left, na.right)) stack[top++] = {na.left, na.right};
         continue;
       }
       const Node& nb = nodes_[b];
-      if (!broad_phase_detail::boxes_touch(na.box, nb.box)) continue;
       const bool a_leaf = na.left == kNull, b_leaf = nb.left == kNull;
       if (a_leaf && b_leaf) {
         const auto oa = static_cast<std::uint32_t>(na.right), ob = static_cast<std::uint32_t>(nb.right);
         if (broad_phase_detail::boxes_touch(tight_[oa], tight_[ob]))
           pairs_.push_back(broad_phase_detail::ordered_pair(oa, ob));
       } else if (b_leaf || (!a_leaf && na.height >= nb.height)) {
-        stack_.emplace_back(na.left, b);
-        stack_.emplace_back(na.right, b);
+        if (touch(na.left, b)) stack[top++] = {na.left, b};
+        if (touch(na.right, b)) stack[top++] = {na.right, b};
       } else {
-        stack_.emplace_back(a, nb.left);
-        stack_.emplace_back(a, nb.right);
+        if (touch(a, nb.left)) stack[top++] = {a, nb.left};
+        if (touch(a, nb.right)) stack[top++] = {a, nb.right};
       }
     }
     std::sort(pairs_.begin(), pairs_.end());
@@ -316,10 +391,15 @@ class DynamicAabbTree {
   std::int32_t root_ = kNull;
   std::uint64_t reinsertions_ = 0;
   std::uint64_t last_reinsertions_ = 0;
+  std::uint64_t refits_ = 0;
+  double built_quality_ = 0;  // inner / leaf area right after the last rebuild
   std::vector<std::pair<std::int32_t, std::int32_t>> stack_;
   std::vector<std::uint32_t> moved_;  // objects outside their fat boxes this frame
-  std::vector<std::int32_t> order_;   // rebuild: leaves, partitioned
-  std::vector<Vec3> centres_;         // rebuild: leaf box centres
+  struct Item {
+    std::uint64_t code;  // Morton code of the leaf's centre
+    std::int32_t node;
+  };
+  std::vector<Item> items_;  // rebuild: the leaves in Morton order
   std::vector<ObjectPair> pairs_;
 };
 

@@ -3,7 +3,8 @@
 //
 // Incremental across frames: the sorted order is kept, and each frame's boxes are written into it in
 // place and the order repaired by insertion sort. Under coherent motion few boxes pass each other, so the
-// repair costs O(n + swaps), not O(n log n). The sweep costs O(n + s), s the pairs overlapping on the
+// repair costs O(n + swaps), not O(n log n); when the swaps pass about what a full sort would cost
+// (4 n log2 n moves), the repair finishes with one. The sweep costs O(n + s), s the pairs overlapping on the
 // sweep axis.
 //
 // The sweep axis is the one along which the box centres spread most (largest variance): that axis
@@ -17,6 +18,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 
 namespace bvhlab {
 
@@ -53,6 +55,8 @@ class SweepAndPrune {
   [[nodiscard]] std::uint64_t axis_changes() const { return axis_changes_; }
   /// Entries moved by the insertion sort in the last update: the cost of the frame's repair.
   [[nodiscard]] std::uint64_t last_moves() const { return last_moves_; }
+  /// Frames whose repair exceeded its budget of moves and fell back to a full sort.
+  [[nodiscard]] std::uint64_t full_sorts() const { return full_sorts_; }
 
  private:
   // One box in the sweep axis's terms: [lo, hi] on the sweep axis, then the other two axes.
@@ -98,10 +102,14 @@ class SweepAndPrune {
     }
   }
 
-  // Insertion sort on lo: linear in n plus the number of inversions motion introduced.
+  // Insertion sort on lo: linear in n plus the number of inversions motion introduced. Incoherent motion
+  // (objects passing many others) would make that quadratic, so past a budget of moves the rest of the
+  // work is left to a full sort.
   void repair_order() {
+    const std::size_t n = entries_.size();
+    const std::uint64_t budget = 4 * n * (std::bit_width(n) + 1);  // about what a full sort costs
     std::uint64_t moves = 0;
-    for (std::size_t i = 1; i < entries_.size(); ++i) {
+    for (std::size_t i = 1; i < n; ++i) {
       if (!(entries_[i].lo < entries_[i - 1].lo)) continue;
       const Entry moving = entries_[i];
       std::size_t j = i;
@@ -111,6 +119,12 @@ class SweepAndPrune {
       } while (j > 0 && moving.lo < entries_[j - 1].lo);
       entries_[j] = moving;
       moves += i - j;
+      if (moves > budget) {
+        std::sort(entries_.begin(), entries_.end(),
+                  [](const Entry& a, const Entry& b) { return a.lo < b.lo; });
+        ++full_sorts_;
+        break;
+      }
     }
     last_moves_ = moves;
   }
@@ -135,6 +149,7 @@ class SweepAndPrune {
   int axis_ = 0;
   std::uint64_t axis_changes_ = 0;
   std::uint64_t last_moves_ = 0;
+  std::uint64_t full_sorts_ = 0;
   std::vector<Entry> entries_;  // sorted by lo
   std::vector<ObjectPair> pairs_;
 };
