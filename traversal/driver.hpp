@@ -49,10 +49,10 @@
 //   begin()  1. and 2. above, as one call;
 //   step()   one pass of 3. (a pop, then a leaf pair or an expansion), without limit.allows_pop(): the
 //            caller decides when to step;
-//   each answers StepProgress::Running (pairs left), Done (a hook decided, or the queue ran empty and finish
-//   was called with QueueEmpty) or Stopped (the limit refused a BV test; as in 3., an unexpanded parent goes
-//   back onto the queue). A stopped traversal may be stepped again under a new limit, or ended by stop(),
-//   which calls finish with Ended::BudgetExhausted.
+//   each answers TraversalState::Running (pairs left), Done (a hook decided, or the queue ran empty and
+//   finish was called with QueueEmpty) or Stopped (the limit refused a BV test; as in 3., an unexpanded
+//   parent goes back onto the queue). A stopped traversal may be stepped again under a new limit, or ended by
+//   stop(), which calls finish with Ended::BudgetExhausted.
 //
 // Hooks: an object with, for Pair = QueuedPair<BV, Key, Tag> (Key: the queue key, or NoKey for a stack;
 // Tag: data the strategy keeps with a queued pair, or NoTag):
@@ -147,7 +147,7 @@ enum class Step { Continue, Decided };
 enum class Ended { QueueEmpty, BudgetExhausted };
 /// Where a step-wise traversal stands: pairs left to take, ended (decided, or finished on an empty queue),
 /// or stopped by its limit before a BV test (not finished: Traversal::stop gives the best-effort answer).
-enum class StepProgress { Running, Done, Stopped };
+enum class TraversalState { Running, Done, Stopped };
 
 /// The two trees of one query, the pose, the volumes' pair context (Walker::make_context(b_to_a)), and the
 /// query's counters. Only references: the context is a separate local of the query, so passing it to an
@@ -484,33 +484,33 @@ class Traversal {
   // The step-wise form repeats run()'s body rather than run() calling it: written as begin() and a loop of
   // step(), run() cost up to 4% more instructions (ADB on the restricted boxtree).
   /// The step-wise form (header comment, "Resumable"): the root pair evaluated and admitted.
-  [[gnu::always_inline]] StepProgress begin() {
-    if (!limit_.allows_test(trees_.counters)) return StepProgress::Stopped;
+  [[gnu::always_inline]] TraversalState begin() {
+    if (!limit_.allows_test(trees_.counters)) return TraversalState::Stopped;
     if (Pair root = trees_.template root<Pair>(); file(root, hooks_.evaluate(root)))
-      return StepProgress::Done;
+      return TraversalState::Done;
     return settled();
   }
 
   /// One pair taken off the (non-empty) queue: a leaf pair tested, any other expanded and its children filed.
-  [[gnu::always_inline]] StepProgress step() {
+  [[gnu::always_inline]] TraversalState step() {
     const Pair top = queue_.pop();
     ++trees_.counters.nodes_visited;
     if (trees_.is_leaf_pair(top)) {
-      if (hooks_.leaf_pair(top) == Step::Decided) return StepProgress::Done;
+      if (hooks_.leaf_pair(top) == Step::Decided) return TraversalState::Done;
       return settled();
     }
     staged_.count = 0;
     if (!Descent::expand(trees_, top, *this)) {
-      if constexpr (!kStaged) return StepProgress::Done;  // a child decided
+      if constexpr (!kStaged) return TraversalState::Done;  // a child decided
       queue_.push(top);  // unexpanded: it keeps its key for a best-effort answer
-      return StepProgress::Stopped;
+      return TraversalState::Stopped;
     }
     if constexpr (kStaged) {
       if constexpr (driver_detail::HasChildrenHook<Hooks, Pair, Score>)
         if (hooks_.children_evaluated(top, staged_.scores, staged_.count) == Step::Decided)
-          return StepProgress::Done;
+          return TraversalState::Done;
       for (int c = 0; c < staged_.count; ++c)
-        if (file(staged_.pairs.at[c], staged_.scores[c])) return StepProgress::Done;
+        if (file(staged_.pairs.at[c], staged_.scores[c])) return TraversalState::Done;
     }
     return settled();
   }
@@ -537,10 +537,10 @@ class Traversal {
 
  private:
   /// Running while pairs are queued; otherwise the traversal ends with an empty queue.
-  [[gnu::always_inline]] StepProgress settled() {
-    if (!queue_.empty()) return StepProgress::Running;
+  [[gnu::always_inline]] TraversalState settled() {
+    if (!queue_.empty()) return TraversalState::Running;
     hooks_.finish(queue_, Ended::QueueEmpty);
-    return StepProgress::Done;
+    return TraversalState::Done;
   }
   /// Files an evaluated pair; true when the hook decided.
   [[gnu::always_inline]] bool file(Pair& p, Score s) {

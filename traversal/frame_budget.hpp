@@ -19,9 +19,9 @@
 //      pair is taken off its queue and expanded (up to four BV tests), or tested as a leaf pair. Then:
 //        - a pair whose estimate exceeds p_min (one BV pair's, or its children's / leaf pairs' combined
 //          evidence, as ADB's options say) is decided colliding: its remaining entries are dropped;
-//        - a pair whose queue runs empty is decided not colliding: exactly when every BV pair was disproved
-//        by
-//          its volumes (or, with exact leaves, by the triangle tests), otherwise from estimates below p_min;
+//        - a pair whose queue runs empty is decided not colliding: exactly when every BV pair was
+//          disproved by its volumes (or, with exact leaves, by the triangle tests), otherwise from
+//          estimates below p_min;
 //        - with exact leaves, a leaf pair whose triangles intersect decides "collision" exactly.
 //   4. Exhaustion: when the budget runs out (the cap of BV tests is reached, or the deadline passes), every
 //      undecided pair answers from its best remaining estimate, as ADB's best effort does: the highest
@@ -44,12 +44,12 @@
 //                         of its two nodes (SplitBoth descends both at once, up to four tests per level). A
 //                         node's levels are estimated from its size: its triangles taken as the tree's times
 //                         (box volume / root box volume)^(2/3) (a surface's area scales as volume^(2/3)), and
-//                         log2 of that. Nearly settled pairs (p near 0 or 1) and deep ones wait.
-//   equal_split           every pair gets an equal share: max_bv_tests / n tests (the first max_bv_tests mod
-//   n
-//                         pairs one more) and deadline_us / n microseconds from when its turn begins; the
-//                         pairs run one after the other, in order, each as the single-pair time-critical ADB
-//                         would under its share. A share left unspent is not passed on.
+//                         log2 of that. Nearly settled pairs (p near 0 or 1) and pairs far above their
+//                         leaves wait.
+//   equal_split           every pair gets an equal share: max_bv_tests / n tests (the first
+//                         max_bv_tests mod n pairs one more) and deadline_us / n microseconds from when its
+//                         turn begins; the pairs run one after the other, in order, each as the single-pair
+//                         time-critical ADB would under its share. A share left unspent is not passed on.
 //   round_robin           one step per undecided pair in turn, in the order given.
 #pragma once
 
@@ -183,27 +183,27 @@ class PairRun {
         trees_(pair.a->bvh, pair.b->bvh, pair.b_to_a, context_, result_.counters),
         estimate_{density_estimator(*pair.a, *pair.b, pair.b_to_a)},
         hooks_(trees_, result_, options, estimate_),
-        progress_(pair.a->bvh.empty() || pair.b->bvh.empty() ? StepProgress::Done : StepProgress::Stopped) {}
+        state_(pair.a->bvh.empty() || pair.b->bvh.empty() ? TraversalState::Done : TraversalState::Stopped) {}
   PairRun(const PairRun&) = delete;
   PairRun& operator=(const PairRun&) = delete;
 
   /// The root test, with at most `allowance` BV tests.
-  StepProgress begin(std::uint64_t allowance) {
-    if (progress_ == StepProgress::Done) return progress_;  // an empty tree: no contact (query_adb's answer)
+  TraversalState begin(std::uint64_t allowance) {
+    if (state_ == TraversalState::Done) return state_;  // an empty tree: no contact (query_adb's answer)
     TestCap cap = cap_after(allowance);
-    return progress_ = steps(cap).begin();
+    return state_ = steps(cap).begin();
   }
   /// One step, with at most `allowance` BV tests. Only while running (or stopped, to resume).
-  StepProgress step(std::uint64_t allowance) {
+  TraversalState step(std::uint64_t allowance) {
     TestCap cap = cap_after(allowance);
-    return progress_ = steps(cap).step();
+    return state_ = steps(cap).step();
   }
   /// The best-effort answer of a pair still undecided; a decided pair keeps its answer.
   void end() {
-    if (progress_ == StepProgress::Done) return;
+    if (state_ == TraversalState::Done) return;
     TestCap none{0};
     steps(none).stop();
-    progress_ = StepProgress::Done;
+    state_ = TraversalState::Done;
   }
 
   [[nodiscard]] std::uint64_t bv_tests() const { return result_.counters.bv_tests; }
@@ -235,7 +235,7 @@ class PairRun {
   Hooks hooks_;
   typename Steps::Queue queue_;
   typename Steps::Staged staged_;
-  StepProgress progress_;  ///< Stopped until begun; Done at once for an empty tree
+  TraversalState state_;  ///< Stopped until begun; Done at once for an empty tree
 };
 
 /// Checks one pair (header comment, 1.); `index` names it.
@@ -307,11 +307,11 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   const auto advance = [&](std::size_t k, bool root) {
     Run& run = runs[k];
     const std::uint64_t before = run.bv_tests();
-    const StepProgress progress =
+    const TraversalState progress =
         root ? run.begin(tests.allowance(k, before)) : run.step(tests.allowance(k, before));
     tests.spend(run.bv_tests() - before);
-    if (progress == StepProgress::Running) rank(k);
-    return progress == StepProgress::Stopped && !policy.equal_shares;
+    if (progress == TraversalState::Running) rank(k);
+    return progress == TraversalState::Stopped && !policy.equal_shares;
   };
 
   bool exhausted = false;
