@@ -48,6 +48,29 @@ inline std::string read_text(const std::filesystem::path& file) {
   return s.str();
 }
 
+/// A test that parses scene texts in its own folder; `source` names the text in messages.
+class SceneParsing : public ::testing::Test {
+ protected:
+  explicit SceneParsing(std::string source) : source_(std::move(source)) {}
+  Scene parse(const std::string& text) { return parse_scene(text, dir.path(), source_); }
+
+  /// Parses `text`, expects a SceneError, and returns its message.
+  std::string error_of(const std::string& text) {
+    try {
+      parse(text);
+    } catch (const SceneError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no SceneError for: " << text;
+    return {};
+  }
+
+  TempDir dir;
+
+ private:
+  std::string source_;
+};
+
 /// Writes `mesh` as an OBJ file (1-based indices, full precision).
 inline void write_obj(const Mesh& mesh, const std::filesystem::path& file) {
   std::ofstream out(file, std::ios::trunc);

@@ -11,24 +11,10 @@ namespace {
 
 using testing::TempDir;
 
-class SceneTest : public ::testing::Test {
+class SceneTest : public testing::SceneParsing {
  protected:
+  SceneTest() : SceneParsing("test.json") {}
   void SetUp() override { testing::write_obj(testing::make_torus(0.7, 0.25, 12, 8), dir / "torus.obj"); }
-
-  Scene parse(const std::string& text) { return parse_scene(text, dir.path(), "test.json"); }
-
-  /// Parses `text`, expects a SceneError, and returns its message.
-  std::string error_of(const std::string& text) {
-    try {
-      parse(text);
-    } catch (const SceneError& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no SceneError for: " << text;
-    return {};
-  }
-
-  TempDir dir;
 };
 
 // A minimal valid scene with one replaceable part, so each error case changes exactly one field.

@@ -18,23 +18,13 @@ namespace {
 
 using testing::TempDir;
 
-class WorldTest : public ::testing::Test {
+class WorldTest : public testing::SceneParsing {
  protected:
+  WorldTest() : SceneParsing("world.json") {}
   void SetUp() override {
     testing::write_obj(testing::make_torus(0.7, 0.25, 12, 8), dir / "torus.obj");
     testing::write_obj(testing::make_torus(0.3, 0.1, 8, 6), dir / "ring.obj");
   }
-  Scene parse(const std::string& text) { return parse_scene(text, dir.path(), "world.json"); }
-  std::string error_of(const std::string& text) {
-    try {
-      parse(text);
-    } catch (const SceneError& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no SceneError for: " << text;
-    return {};
-  }
-  TempDir dir;
 };
 
 const std::string kObjects = R"("objects": [{"mesh": "torus.obj"}, {"mesh": "ring.obj"}])";
