@@ -6,6 +6,8 @@
 
 #include <chrono>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -20,6 +22,9 @@ struct BvhStats {
   double bytes_per_triangle = 0;   ///< node bytes / triangles, without polygons
   double build_seconds = 0;
 };
+
+/// How refit() bounds an inner node: merging its children's volumes, or fitting its triangles' vertices.
+enum class RefitMethod { Merge, Fit };
 
 template <TreeVolume BV>
 class Bvh {
@@ -41,7 +46,9 @@ class Bvh {
     for (std::uint32_t id : out.triangle_ids_) out.triangles_.push_back(mesh.triangle(id));
     out.depth_ = topology.depth;
     out.leaves_ = topology.leaves;
+    out.topology_ = topology_fingerprint(mesh);
     out.fit_volumes(options.threads ? options.threads : std::thread::hardware_concurrency());
+    out.built_spread_ = out.spread();
     out.build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
   }
@@ -57,8 +64,45 @@ class Bvh {
     out.triangles_ = std::move(triangles);
     out.recount();
     out.compute_sizes();
+    out.built_spread_ = out.spread();
     return out;
   }
+
+  /// Refits every node to new positions of the same triangles, bottom-up: a leaf is fitted to its triangles'
+  /// vertices, an inner node merges its children's volumes (a hierarchical volume then re-encodes each
+  /// child against its parent). O(nodes), single-threaded. The topology stays; see degradation() for when
+  /// to rebuild instead. Throws std::invalid_argument naming the problem (another topology, a non-finite
+  /// vertex) and leaves the tree as it was. RefitMethod::Fit fits every node to its vertices instead, as the
+  /// build does: O(triangles x depth), tighter for OBBs and spheres, whose merges loosen level by level.
+  void refit(const Mesh& deformed, RefitMethod method = RefitMethod::Merge) {
+    std::vector<TrianglePoints> moved = deformed_triangles(deformed);
+    if (method == RefitMethod::Fit) {
+      triangles_ = std::move(moved);
+      fit_volumes(1);
+      return;
+    }
+    std::vector<Fitted> fitted(nodes_.size(), Fitted{});
+    // Children are stored after their parent (build_topology), so a reverse sweep sees them first.
+    for (std::size_t i = nodes_.size(); i-- > 0;) {
+      const TreeNode& n = nodes_[i];
+      if (n.is_leaf()) {
+        std::vector<Vec3> points;
+        for (std::uint32_t t = n.first; t < n.first + n.count; ++t)
+          points.insert(points.end(), moved[t].begin(), moved[t].end());
+        fitted[i] = Fitted::fit(points);
+      } else {
+        fitted[i] = Fitted::merge(fitted[n.left()], fitted[n.right()]);
+      }
+    }
+    triangles_ = std::move(moved);
+    store_volumes(std::move(fitted));
+  }
+
+  /// How much looser the tree is than when it was built: the summed surface area of all node bounding boxes
+  /// over that of the leaves' boxes, divided by the same ratio after the build. Scale-free, so a uniform
+  /// scaling leaves it at 1; refits of a mesh whose triangles drift apart let it grow. Rebuild when it
+  /// passes a factor such as kRebuildDegradation.
+  [[nodiscard]] double degradation() const { return built_spread_ > 0 ? spread() / built_spread_ : 1.0; }
 
   [[nodiscard]] const std::vector<TreeNode>& nodes() const { return nodes_; }
   [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
@@ -131,6 +175,12 @@ class Bvh {
     } else {
       fit_subtree(0);
     }
+    store_volumes(std::move(fitted));
+  }
+
+  // The fitted volumes become the stored ones: as they are, or re-encoded child by child for a
+  // hierarchical volume.
+  void store_volumes(std::vector<Fitted> fitted) {
     root_ = fitted[0];
     if constexpr (hierarchical) {
       // Children are encoded against the parent's *decoded* volume, the one the traversal will see.
@@ -178,6 +228,47 @@ class Bvh {
     }
   }
 
+  // Summed surface area of the node boxes over that of the leaf boxes: how far inner nodes bulge beyond
+  // what they hold. Areas, not volumes, so flat leaves (a triangle in a coordinate plane) still count.
+  [[nodiscard]] double spread() const {
+    if (nodes_.empty() || volumes_.size() != nodes_.size()) return 0;
+    double all = 0, leaves = 0;
+    const std::vector<Box> boxes = node_boxes();
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      if (boxes[i].empty()) continue;
+      const Vec3 e = boxes[i].extent();
+      const double area = double(e.x()) * e.y() + double(e.y()) * e.z() + double(e.z()) * e.x();
+      all += area;
+      if (nodes_[i].is_leaf()) leaves += area;
+    }
+    return leaves > 0 ? all / leaves : 0;
+  }
+
+  // The tree's triangles, in tree order, at the vertex positions of `deformed`; checked first, so a refused
+  // mesh changes nothing.
+  [[nodiscard]] std::vector<TrianglePoints> deformed_triangles(const Mesh& deformed) const {
+    if (deformed.triangle_count() != triangle_ids_.size())
+      throw std::invalid_argument("refit: the mesh has " + std::to_string(deformed.triangle_count()) +
+                                  " triangles, the tree was built over " +
+                                  std::to_string(triangle_ids_.size()));
+    if (topology_ != 0 && topology_fingerprint(deformed) != topology_)
+      throw std::invalid_argument(
+          "refit: the mesh's vertex count or triangle indices differ from the mesh the "
+          "tree was built from (a deformation must keep the topology)");
+    for (std::size_t v = 0; v < deformed.vertices.size(); ++v)
+      if (!deformed.vertices[v].allFinite())
+        throw std::invalid_argument("refit: vertex " + std::to_string(v) + " is not finite");
+    std::vector<TrianglePoints> out;
+    out.reserve(triangle_ids_.size());
+    for (std::uint32_t id : triangle_ids_) {
+      for (std::uint32_t v : deformed.triangles[id])
+        if (v >= deformed.vertices.size())
+          throw std::invalid_argument("refit: triangle " + std::to_string(id) + " names a missing vertex");
+      out.push_back(deformed.triangle(id));
+    }
+    return out;
+  }
+
   void recount() {
     leaves_ = 0;
     depth_ = 0;
@@ -205,6 +296,11 @@ class Bvh {
   std::uint32_t depth_ = 0;
   std::size_t leaves_ = 0;
   double build_seconds_ = 0;
+  std::uint64_t topology_ = 0;  ///< topology_fingerprint of the source mesh; 0 for a tree from saved parts
+  double built_spread_ = 0;
 };
+
+/// A degradation() past which a refitted tree is better rebuilt (measured: bench_refit).
+inline constexpr double kRebuildDegradation = 2.0;
 
 }  // namespace bvhlab

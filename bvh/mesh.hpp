@@ -29,4 +29,18 @@ struct Mesh {
   }
 };
 
+/// A fingerprint of a mesh's topology (vertex count and triangle indices, not positions): equal for two
+/// frames of one deforming mesh. FNV-1a over the indices; not cryptographic.
+inline std::uint64_t topology_fingerprint(const Mesh& mesh) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  auto mix = [&h](std::uint64_t word) {
+    h ^= word;
+    h *= 0x100000001b3ULL;
+  };
+  mix(mesh.vertices.size());
+  for (const auto& t : mesh.triangles)
+    for (std::uint32_t v : t) mix(v);
+  return h | 1;  // never 0, which stands for "unknown"
+}
+
 }  // namespace bvhlab
