@@ -30,9 +30,10 @@
 
 #include <benchmark/benchmark.h>
 #ifdef BVHLAB_HAVE_FCL
+#include "bench/core/fcl_model.hpp"
+
 #include <fcl/broadphase/broadphase_SaP.h>
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
-#include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/collision.h>
 #endif
 
@@ -90,15 +91,7 @@ Scene make_scene(const std::string& label, std::size_t objects, std::size_t fram
     s.fcl_frames.push_back(std::move(tfs));
   }
   for (const Mesh& mesh : s.env.shapes) {
-    auto model = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
-    std::vector<fcl::Vector3d> points(mesh.vertices.begin(), mesh.vertices.end());
-    std::vector<fcl::Triangle> triangles;
-    for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-    model->beginModel();
-    model->addSubModel(points, triangles);
-    model->endModel();
-    model->computeLocalAABB();
-    s.models.push_back(model);
+    s.models.push_back(make_fcl_model<fcl::OBBRSSd>(mesh));
   }
 #endif
   return s;

@@ -10,8 +10,8 @@
 #include "traversal/strategies.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
-#include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/collision.h>
+#include "bench/core/fcl_model.hpp"
 #endif
 
 #include <algorithm>
@@ -184,14 +184,7 @@ class TreeStore {
     }
     log_("building " + h.bv + " model of " + object.spec->name);
     const auto start = Clock::now();
-    auto model = std::make_shared<Model>();
-    std::vector<fcl::Vector3d> points(object.mesh.vertices.begin(), object.mesh.vertices.end());
-    std::vector<fcl::Triangle> triangles;
-    triangles.reserve(object.mesh.triangles.size());
-    for (const auto& t : object.mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-    model->beginModel();
-    model->addSubModel(points, triangles);
-    model->endModel();
+    const auto model = make_fcl_model<FclBV>(object.mesh);
     ++stats_.fcl_models_built;
     ModelInfo m;
     m.object = object.spec->name;

@@ -1,13 +1,13 @@
 // bvhlab's colliding pairs among many objects (broad phase + exact narrow phase) equal FCL's (its dynamic
 // AABB tree manager's collide with fcl::collide on every candidate), on FCL's broad-phase environment.
 #include "bench/core/broad_phase_env.hpp"
+#include "bench/core/fcl_model.hpp"
 #include "traversal/broad_phase/registry.hpp"
 #include "traversal/broad_phase/world_box.hpp"
 #include "traversal/exact.hpp"
 #include "volumes/aabb.hpp"
 
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
-#include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/collision.h>
 #include <gtest/gtest.h>
 
@@ -44,15 +44,7 @@ std::size_t expect_same_collisions(std::size_t count, double extent, std::size_t
   for (const Mesh& mesh : env.shapes) {
     trees.push_back(Bvh<Aabb>::build(mesh));
     balls.push_back(bounding_ball(trees.back()));
-    auto model = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
-    std::vector<fcl::Vector3d> points(mesh.vertices.begin(), mesh.vertices.end());
-    std::vector<fcl::Triangle> triangles;
-    for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-    model->beginModel();
-    model->addSubModel(points, triangles);
-    model->endModel();
-    model->computeLocalAABB();
-    models.push_back(model);
+    models.push_back(make_fcl_model<fcl::OBBRSSd>(mesh));
   }
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
   std::vector<fcl::CollisionObjectd*> pointers;
