@@ -3,6 +3,7 @@
 
 #include "adb/adb_density.hpp"
 #include "adb/tree.hpp"
+#include "bench/core/protocol.hpp"
 #include "bvh/bvh.hpp"
 #include "traversal/adb.hpp"
 #include "traversal/exact.hpp"
@@ -48,6 +49,21 @@ inline RigidTransform reframe(const RigidTransform& pose, double scale, const Ve
 inline Mesh moved(Mesh m, const RigidTransform& pose) {
   for (auto& v : m.vertices) v = pose.apply(v);
   return m;
+}
+
+/// A pose of the tumbling protocol and the distance it was drawn at.
+struct Query {
+  double distance;
+  RigidTransform pose;
+};
+
+/// `steps` protocol poses at each distance (the protocol's own distances when none are given).
+inline std::vector<Query> protocol_queries(int steps, std::vector<double> distances = {}) {
+  if (distances.empty()) distances = ProtocolOptions{}.distances;
+  std::vector<Query> out;
+  for (double d : distances)
+    for (int k = 0; k < steps; ++k) out.push_back({d, protocol_pose(d, k, steps)});
+  return out;
 }
 
 constexpr int kGrid = 2;

@@ -1,143 +1,19 @@
-// The same protocol scene described in a far-away or rescaled frame: both meshes and the pose are moved by
-// F(x) = scale x + offset, so the true answer of every query is unchanged. Any answer that changes must be
-// one whose exact answer is itself within the frame's rounding (flagged: it flips under a perturbation of
-// that size); every other difference is a precision bug. The loader's side of the same question (a file
-// whose coordinates are far from the origin) is at the end.
+// Far frames: the ADB strategies on a scene moved far from the origin stay honest, and the loader warns or
+// refuses where a file's coordinates lose the model. The exact protocol in far and rescaled frames, for every
+// volume, is test_far_frame_protocol.cpp (label `protocol`).
 #include "bench/core/ground_truth.hpp"
 #include "bench/core/mesh_catalog.hpp"
-#include "bench/core/protocol.hpp"
-#include "bench/core/registry.hpp"
 #include "bvh/mesh_io.hpp"
 #include "robust_support.hpp"
 #include "support/generated_meshes.hpp"
 
 #include <gtest/gtest.h>
 
-#include <cctype>
-#include <chrono>
 #include <cstdio>
 #include <sstream>
 
 namespace bvhlab::robust {
 namespace {
-
-struct Frame {
-  const char* name;  // a literal (a std::string here trips a false -Wmaybe-uninitialized in GCC 12)
-  double scale;
-  Vec3 offset;
-};
-
-// Rounding of the reframed query, in the units of the original scene: a few ulps of the largest
-// coordinate involved (offset plus model size), divided by the scale.
-double rounding_in_scene_units(const Frame& f) {
-  const double largest = f.offset.cwiseAbs().maxCoeff() + 4 * f.scale;
-  const double ulp = std::nextafter(largest, 2 * largest) - largest;
-  return 64 * ulp / f.scale;
-}
-
-struct Query {
-  double distance;
-  RigidTransform pose;
-};
-
-std::vector<Query> protocol_queries(int steps, std::vector<double> distances = {}) {
-  if (distances.empty()) distances = ProtocolOptions{}.distances;
-  std::vector<Query> out;
-  for (double d : distances)
-    for (int k = 0; k < steps; ++k) out.push_back({d, protocol_pose(d, k, steps)});
-  return out;
-}
-
-// Whether the exact answer of `pose` flips when B is pushed by up to 2 * eps along any axis.
-bool within_rounding(const CgalGroundTruth& truth, RigidTransform pose, bool answer, double eps) {
-  for (int axis = 0; axis < 3; ++axis)
-    for (double sign : {-2.0, 2.0}) {
-      RigidTransform nudged = pose;
-      nudged.translation[axis] += sign * eps;
-      if (truth.collides(nudged) != answer) return true;
-    }
-  return false;
-}
-
-// Note on 1e9: Aabb (and the other float-stored volumes) round node bounds outwards to float, whose spacing
-// at 1e9 is 64, so every node box of a size-2 model is about 128 wide and the tree culls nothing: each
-// non-colliding query tests all triangle pairs (2e6 for the jeep, against 33 near the origin). The answers
-// stay exact (the triangle tests run in double); only the speed collapses (some volumes keep culling: the
-// k-DOPs with 18 or more directions test ~1.4e4 pairs), so at 1e9 the jeep gets three poses, one of them
-// apart, and a small torus the full sweep.
-struct FrameCase {
-  std::string model;  // "jeep" or "torus"
-  Frame frame;
-  int poses_per_distance;
-  std::vector<double> distances = {};  // empty: the protocol's nine
-};
-
-void PrintTo(const FrameCase& c, std::ostream* os) {
-  *os << c.model << ", " << c.frame.name;
-}
-
-class FarFrameProtocol : public ::testing::TestWithParam<FrameCase> {};
-
-TEST_P(FarFrameProtocol, AnswersSurviveTheFrameChange) {
-  const FrameCase& c = GetParam();
-  const Mesh model =
-      c.model == "jeep" ? load_protocol_mesh("jeep1.ms3d") : testing::make_torus(0.7, 0.25, 12, 6);
-  {
-    const Frame& frame = c.frame;
-    const CgalGroundTruth truth(model, model);
-    const auto queries = protocol_queries(c.poses_per_distance, c.distances);
-    std::vector<bool> expected;
-    for (const Query& q : queries) expected.push_back(truth.collides(q.pose));
-    const Mesh far = reframe(model, frame.scale, frame.offset);
-    const double eps = rounding_in_scene_units(frame);
-    with_each_volume([&](auto id) {
-      using BV = typename decltype(id)::type;
-      const auto tree = Bvh<BV>::build(far);
-      int flagged = 0, wrong = 0, colliding = 0;
-      std::uint64_t triangle_tests = 0;
-      const auto start = std::chrono::steady_clock::now();
-      for (std::size_t k = 0; k < queries.size(); ++k) {
-        const Result r = query_exact(tree, tree, reframe(queries[k].pose, frame.scale, frame.offset));
-        colliding += expected[k];
-        triangle_tests += r.counters.triangle_tests;
-        if (r.collides == expected[k]) continue;
-        if (within_rounding(truth, queries[k].pose, expected[k], eps)) {
-          ++flagged;
-        } else {
-          ++wrong;
-          ADD_FAILURE() << BV::name() << ": d " << queries[k].distance << " query " << k << " answers "
-                        << r.collides << ", the unmoved scene " << expected[k] << ", and no perturbation of "
-                        << 2 * eps << " flips it";
-        }
-      }
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::printf(
-          "[far frames] %-20s %-7s queries %zu colliding %d flagged-within-rounding %d wrong %d "
-          "triangle tests/query %.0f, %.2f s\n",
-          (c.model + " " + frame.name).c_str(), std::string(BV::name()).c_str(), queries.size(), colliding,
-          flagged, wrong, double(triangle_tests) / double(queries.size()), seconds);
-      // Flags are for the rare pose at contact; many of them would mean the frame itself loses the answer.
-      EXPECT_LE(flagged, static_cast<int>(queries.size()) / 100 + 1) << BV::name();
-      EXPECT_GT(colliding, 0);
-      EXPECT_LT(colliding, static_cast<int>(queries.size()));
-    });
-  }
-}
-
-INSTANTIATE_TEST_SUITE_P(
-    Frames, FarFrameProtocol,
-    ::testing::Values(FrameCase{"jeep", {"translate 1e6", 1.0, Vec3(1e6, -1e6, 0.5e6)}, 200},
-                      FrameCase{"jeep", {"translate 1e9", 1.0, Vec3(1e9, -1e9, 0.5e9)}, 1, {0.4, 1.2, 2.4}},
-                      FrameCase{"torus", {"translate 1e9", 1.0, Vec3(1e9, -1e9, 0.5e9)}, 40},
-                      FrameCase{"jeep", {"scale 1e-6", 1e-6, Vec3::Zero()}, 200},
-                      FrameCase{"jeep", {"scale 1e6", 1e6, Vec3::Zero()}, 200},
-                      FrameCase{"jeep", {"scale 1e-6 at 1e-3", 1e-6, Vec3(1e-3, 0, 0)}, 200}),
-    [](const ::testing::TestParamInfo<FrameCase>& info) {
-      std::string name = info.param.model + "_" + info.param.frame.name;
-      for (char& ch : name)
-        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-      return name;
-    });
 
 // The ADB strategies in a far frame: probabilities stay probabilities, exact answers stay right. At 1e9 a
 // small torus stands in for the jeep, since nothing is culled there (see above).
