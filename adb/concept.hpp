@@ -45,6 +45,28 @@
 //                                   The same for a density whose estimate depends on the pair's relative
 //                                   orientation ("adb_normal"): rotation maps B's frame into A's. The ADB
 //                                   traversal calls this form when D has it.
+//
+// Concept `DensityUpdate<U, D>`: how the annotation of density D follows a deforming mesh
+// ------------------------------------------------------------------------------------------
+// A tree refitted to new vertex positions of the same triangles (Bvh<BV>::refit) keeps its topology, but
+// its annotation describes the old shape. An update policy U rewrites the annotation (or keeps it) after
+// each refit; the query-time density stays D. The policies and their registry are in adb/update.hpp.
+//
+// Types
+//   U::Params    Run-time parameters (possibly none). Equality-comparable.
+//   U::State     What U keeps between frames (the boxes at the last count, fixed surface samples, ...).
+//                Copyable; made by start() for one tree and valid for that tree's refits only.
+//
+// Operations (bvh: const Bvh<BV>&; storage: D::Storage; state: U::State&)
+//   U::name()                       Stable identifier ("stale", "recount_all", ...).
+//   U::parameters()                 std::span<const ParamSpec>, as for densities (adb/parameters.hpp).
+//   U::make_params(values)          Params from resolved values (update_params<U> resolves and checks).
+//   U::start(bvh, storage, params)  The State for a tree whose `storage` holds the exact annotation of its
+//                                   current (rest) shape.
+//   U::update(bvh, storage, state, context, stats)
+//                                   After bvh was refitted: rewrites `storage` for the new shape, the way U
+//                                   does (stats: DensityUpdateStats* or null). Throws std::invalid_argument
+//                                   for a tree other than the one the state was started on.
 #pragma once
 
 #include "../bvh/bvh.hpp"
@@ -118,6 +140,40 @@ concept ProbabilityDensity = Density<D> &&
 template <Density D>
 typename D::Params density_params(const ParamValues& given = {}) {
   return D::make_params(resolve_parameters(D::parameters(), given, D::name()));
+}
+
+/// What one density update did (DensityUpdate::update).
+struct DensityUpdateStats {
+  double seconds = 0;
+  std::size_t nodes = 0;            ///< nodes of the tree
+  std::size_t recounted_nodes = 0;  ///< nodes counted anew by exact clipping
+  std::size_t samples = 0;          ///< surface samples moved and binned
+  AnnotateStats annotate;           ///< the exact recount's counters, when one ran
+};
+
+template <class U, class D>
+concept DensityUpdate = Density<D> && std::equality_comparable<typename U::Params> &&
+    std::copyable<typename U::State> && requires(const ParamValues& values) {
+  { U::name() } -> std::convertible_to<std::string_view>;
+  { U::parameters() } -> std::same_as<std::span<const ParamSpec>>;
+  { U::make_params(values) } -> std::same_as<typename U::Params>;
+};
+
+/// U can update D's annotation of trees of BV.
+template <class U, class D, class BV>
+concept DensityUpdateFor = DensityUpdate<U, D> &&
+    requires(const Bvh<BV>& bvh, const typename D::Storage& rest, typename D::Storage& storage,
+             typename U::State& state, const typename U::Params& params, const AnnotationContext& context,
+             DensityUpdateStats* stats) {
+  { U::start(bvh, rest, params) } -> std::same_as<typename U::State>;
+  { U::update(bvh, storage, state, context, stats) } -> std::same_as<void>;
+};
+
+/// The parameters of update policy U from name/value pairs: checked against U::parameters(), defaults
+/// filled in. Throws std::invalid_argument naming the policy and the problem.
+template <class U>
+typename U::Params update_params(const ParamValues& given = {}) {
+  return U::make_params(resolve_parameters(U::parameters(), given, U::name()));
 }
 
 }  // namespace bvhlab

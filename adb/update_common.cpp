@@ -1,0 +1,42 @@
+#include "adb/update_common.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace bvhlab::density_update {
+
+void check_tree(std::string_view policy, std::size_t state_nodes, std::size_t tree_nodes,
+                std::size_t storage_counts) {
+  const std::string who = "density update '" + std::string(policy) + "': ";
+  if (tree_nodes != state_nodes)
+    throw std::invalid_argument(who + "the state was started on a tree of " + std::to_string(state_nodes) +
+                                " nodes, this tree has " + std::to_string(tree_nodes));
+  if (storage_counts != tree_nodes)
+    throw std::invalid_argument(who + "the annotation holds " + std::to_string(storage_counts) +
+                                " counts for a tree of " + std::to_string(tree_nodes) + " nodes");
+}
+
+AnnotateStats recount(std::span<const Box> boxes, const NodeRanges& ranges,
+                      std::span<const TrianglePoints> triangles, std::span<const std::uint32_t> selected,
+                      AdbStorage& storage, const AnnotationContext& context) {
+  if (selected.empty()) return {};
+  // annotate_counts takes any list of (box, triangle range): the selected nodes, compacted.
+  std::vector<Box> chosen_boxes;
+  NodeRanges chosen_ranges;
+  chosen_boxes.reserve(selected.size());
+  chosen_ranges.reserve(selected.size());
+  for (const std::uint32_t node : selected) {
+    chosen_boxes.push_back(boxes[node]);
+    chosen_ranges.push_back(ranges[node]);
+  }
+  AnnotateOptions options;
+  options.tau = storage.params.tau;
+  options.threads = context.threads;
+  options.progress = context.progress;
+  CellCounts result = annotate_counts(chosen_boxes, chosen_ranges, triangles, storage.params.grid, options);
+  for (std::size_t k = 0; k < selected.size(); ++k)
+    storage.possible_collision_cells[selected[k]] = result.counts[k];
+  return result.stats;
+}
+
+}  // namespace bvhlab::density_update

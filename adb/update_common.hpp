@@ -1,0 +1,32 @@
+// What the density-update policies (adb/update.hpp) share: checks that a state belongs to the tree it is
+// applied to, and the exact recount of a chosen set of nodes with the annotation's own clipping.
+#pragma once
+
+#include "adb_density.hpp"
+
+#include <chrono>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <utility>
+
+namespace bvhlab::density_update {
+
+using NodeRanges = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+/// Throws std::invalid_argument naming `policy` unless the tree has `state_nodes` nodes and the storage one
+/// count per node: a state is valid only for the tree (and its refits) it was started on.
+void check_tree(std::string_view policy, std::size_t state_nodes, std::size_t tree_nodes,
+                std::size_t storage_counts);
+
+/// Counts the nodes `selected` anew, exactly as the annotation does (adb/annotate.hpp), into
+/// storage.possible_collision_cells; the other nodes keep their counts. Returns the recount's statistics.
+AnnotateStats recount(std::span<const Box> boxes, const NodeRanges& ranges,
+                      std::span<const TrianglePoints> triangles, std::span<const std::uint32_t> selected,
+                      AdbStorage& storage, const AnnotationContext& context);
+
+inline double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace bvhlab::density_update
