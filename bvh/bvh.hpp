@@ -47,6 +47,7 @@ class Bvh {
     out.depth_ = topology.depth;
     out.leaves_ = topology.leaves;
     out.topology_ = topology_fingerprint(mesh);
+    out.vertex_count_ = mesh.vertices.size();
     out.fit_volumes(options.threads ? options.threads : std::thread::hardware_concurrency());
     out.built_spread_ = out.spread();
     out.build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -71,9 +72,10 @@ class Bvh {
   /// Refits every node to new positions of the same triangles, bottom-up: a leaf is fitted to its triangles'
   /// vertices, an inner node merges its children's volumes (a hierarchical volume then re-encodes each
   /// child against its parent). O(nodes), single-threaded. The topology stays; see degradation() for when
-  /// to rebuild instead. Throws std::invalid_argument naming the problem (another topology, a non-finite
-  /// vertex) and leaves the tree as it was. RefitMethod::Fit fits every node to its vertices instead, as the
-  /// build does: O(triangles x depth), tighter for OBBs and spheres, whose merges loosen level by level.
+  /// to rebuild instead. Throws std::invalid_argument naming the problem (another vertex count, other
+  /// triangle indices, a non-finite vertex) and leaves the tree as it was. RefitMethod::Fit fits every node
+  /// to its vertices instead, as the build does: O(triangles x depth), tighter for OBBs and spheres, whose
+  /// merges loosen level by level.
   void refit(const Mesh& deformed, RefitMethod method = RefitMethod::Merge) {
     std::vector<TrianglePoints> moved = deformed_triangles(deformed);
     if (method == RefitMethod::Fit) {
@@ -82,11 +84,12 @@ class Bvh {
       return;
     }
     std::vector<Fitted> fitted(nodes_.size(), Fitted{});
+    std::vector<Vec3> points;  // reused: no allocation per leaf
     // Children are stored after their parent (build_topology), so a reverse sweep sees them first.
     for (std::size_t i = nodes_.size(); i-- > 0;) {
       const TreeNode& n = nodes_[i];
       if (n.is_leaf()) {
-        std::vector<Vec3> points;
+        points.clear();
         for (std::uint32_t t = n.first; t < n.first + n.count; ++t)
           points.insert(points.end(), moved[t].begin(), moved[t].end());
         fitted[i] = Fitted::fit(points);
@@ -98,10 +101,11 @@ class Bvh {
     store_volumes(std::move(fitted));
   }
 
-  /// How much looser the tree is than when it was built: the summed surface area of all node bounding boxes
-  /// over that of the leaves' boxes, divided by the same ratio after the build. Scale-free, so a uniform
-  /// scaling leaves it at 1; refits of a mesh whose triangles drift apart let it grow. Rebuild when it
-  /// passes a factor such as kRebuildDegradation.
+  /// How much the topology has degraded since the build: its surface-area cost (the summed surface area of
+  /// every node's box around its triangles over the root box's), divided by the same cost at build time. It
+  /// depends on the triangles only, not on the volume type or the RefitMethod, and is scale-free: a uniform
+  /// scaling leaves it at 1 (a rotation changes axis-aligned areas a little), a deformation that drives the
+  /// triangles of one subtree apart lets it grow. Rebuild when it passes kRebuildDegradation. O(nodes).
   [[nodiscard]] double degradation() const { return built_spread_ > 0 ? spread() / built_spread_ : 1.0; }
 
   [[nodiscard]] const std::vector<TreeNode>& nodes() const { return nodes_; }
@@ -228,33 +232,58 @@ class Bvh {
     }
   }
 
-  // Summed surface area of the node boxes over that of the leaf boxes: how far inner nodes bulge beyond
-  // what they hold. Areas, not volumes, so flat leaves (a triangle in a coordinate plane) still count.
+  // The tree's surface-area cost: the summed surface area of the node boxes over the root box's (the
+  // expected number of nodes a random line through the root box meets, as in the SAH the builder uses).
+  // Scale-free. The boxes are those of the triangles below each node (merged bottom-up), or, for a tree
+  // without polygons, the stored volumes' boxes.
   [[nodiscard]] double spread() const {
-    if (nodes_.empty() || volumes_.size() != nodes_.size()) return 0;
-    double all = 0, leaves = 0;
-    const std::vector<Box> boxes = node_boxes();
-    for (std::size_t i = 0; i < boxes.size(); ++i) {
-      if (boxes[i].empty()) continue;
-      const Vec3 e = boxes[i].extent();
-      const double area = double(e.x()) * e.y() + double(e.y()) * e.z() + double(e.z()) * e.x();
-      all += area;
-      if (nodes_[i].is_leaf()) leaves += area;
+    if (nodes_.empty()) return 0;
+    std::vector<Box> boxes;
+    if (triangles_.size() == triangle_ids_.size() && !triangles_.empty()) {
+      boxes.resize(nodes_.size());
+      for (std::size_t i = nodes_.size(); i-- > 0;) {
+        const TreeNode& n = nodes_[i];
+        if (n.is_leaf()) {
+          if (std::size_t(n.first) + n.count > triangles_.size()) return 0;
+          for (std::uint32_t t = n.first; t < n.first + n.count; ++t)
+            for (const Vec3& v : triangles_[t]) boxes[i].extend(v);
+        } else {
+          if (n.left() <= i || std::size_t(n.right()) >= nodes_.size())
+            return 0;  // not children-after-parent
+          boxes[i] = boxes[n.left()];
+          boxes[i].extend(boxes[n.right()]);
+        }
+      }
+    } else if (volumes_.size() == nodes_.size()) {
+      boxes = node_boxes();
+    } else {
+      return 0;
     }
-    return leaves > 0 ? all / leaves : 0;
+    auto area = [](const Box& b) {
+      const Vec3 e = b.extent();
+      return b.empty() ? 0.0 : double(e.x()) * e.y() + double(e.y()) * e.z() + double(e.z()) * e.x();
+    };
+    double all = 0;
+    for (const Box& b : boxes) all += area(b);
+    const double root = area(boxes[0]);
+    return root > 0 ? all / root : 0;
   }
 
   // The tree's triangles, in tree order, at the vertex positions of `deformed`; checked first, so a refused
   // mesh changes nothing.
   [[nodiscard]] std::vector<TrianglePoints> deformed_triangles(const Mesh& deformed) const {
+    if (vertex_count_ != 0 && deformed.vertices.size() != vertex_count_)
+      throw std::invalid_argument("refit: the mesh has " + std::to_string(deformed.vertices.size()) +
+                                  " vertices, the tree was built over a mesh of " +
+                                  std::to_string(vertex_count_));
     if (deformed.triangle_count() != triangle_ids_.size())
       throw std::invalid_argument("refit: the mesh has " + std::to_string(deformed.triangle_count()) +
                                   " triangles, the tree was built over " +
                                   std::to_string(triangle_ids_.size()));
     if (topology_ != 0 && topology_fingerprint(deformed) != topology_)
       throw std::invalid_argument(
-          "refit: the mesh's vertex count or triangle indices differ from the mesh the "
-          "tree was built from (a deformation must keep the topology)");
+          "refit: the mesh's triangle indices differ from those of the mesh the tree was built from (a "
+          "deformation must keep the topology)");
     for (std::size_t v = 0; v < deformed.vertices.size(); ++v)
       if (!deformed.vertices[v].allFinite())
         throw std::invalid_argument("refit: vertex " + std::to_string(v) + " is not finite");
@@ -296,7 +325,8 @@ class Bvh {
   std::uint32_t depth_ = 0;
   std::size_t leaves_ = 0;
   double build_seconds_ = 0;
-  std::uint64_t topology_ = 0;  ///< topology_fingerprint of the source mesh; 0 for a tree from saved parts
+  std::uint64_t topology_ = 0;    ///< topology_fingerprint of the source mesh; 0 for a tree from saved parts
+  std::size_t vertex_count_ = 0;  ///< of the source mesh; 0 for a tree from saved parts
   double built_spread_ = 0;
 };
 

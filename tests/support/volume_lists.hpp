@@ -38,4 +38,9 @@ struct IsSelfContained : std::bool_constant<BoundingVolume<BV>> {};
 /// Every shipped self-contained model.
 using ShippedBoundingVolumes = SelectTypes<IsSelfContained, ShippedVolumes>::type;
 
+/// Every shipped model, the hierarchical ones (restricted boxtree) included.
+template <class BV>
+struct AnyVolume : std::true_type {};
+using AllShippedVolumes = SelectTypes<AnyVolume, ShippedVolumes>::type;
+
 }  // namespace bvhlab::testing
