@@ -3,6 +3,7 @@
 #include "bench/world.hpp"
 
 #include "bench/report.hpp"
+#include "bench/report_tables.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -16,23 +17,9 @@ namespace bvhlab {
 
 namespace {
 
-std::ofstream open_csv(const std::filesystem::path& file) {
-  std::ofstream out(file, std::ios::trunc);
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
-  return out;
-}
-
-/// The value below which `share` of `values` lie (nearest rank); 0 for none.
-double quantile(std::vector<double> values, double share) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  const auto rank = static_cast<std::size_t>(share * static_cast<double>(values.size() - 1) + 0.5);
-  return values[std::min(rank, values.size() - 1)];
-}
-
-std::string percent(std::size_t part, std::size_t whole) {
-  return whole ? fmt::format("{:.2f}", 100.0 * static_cast<double>(part) / static_cast<double>(whole)) : "-";
-}
+using report_tables::open_csv;
+using report_tables::percent;
+using report_tables::quantile;
 
 /// One summary line per (hierarchy, series), in first-seen order.
 struct SeriesTotals {

@@ -3,6 +3,7 @@
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
 #include "bench/run.hpp"
+#include "bench/deform.hpp"
 #include "bench/world.hpp"
 #include "bench/write.hpp"
 #include "python/bindings.hpp"
@@ -46,13 +47,15 @@ py::object run(const py::object& scene_argument, const py::object& cache, int th
   options.log = [quiet](const std::string& line) {
     if (!quiet) std::cerr << line << '\n';
   };
-  if (scene.world && options.per_pose != PerPose::none)
-    throw py::value_error("per_pose: does not apply to a world scene (its rows are per frame)");
+  if ((scene.world || scene.deform) && options.per_pose != PerPose::none)
+    throw py::value_error("per_pose: does not apply to a world or deform scene (its rows are per frame)");
   nlohmann::json document;
   {
     py::gil_scoped_release release;
     if (scene.world) {
       document = world_document(run_world(scene, options));
+    } else if (scene.deform) {
+      document = deform_document(run_deform(scene, options));
     } else {
       const RunOutput output = run_scene(scene, options);
       document = results_document(output);
@@ -75,7 +78,8 @@ void bind_scenes(py::module_& m) {
         "per_pose=\"all\" or \"wrong\" adds \"poses\", the records of poses.csv (`bvhlab run --per-pose`), "
         "one dict per query or per wrong answer. A world scene (\"world\") returns its rows instead: "
         "\"series\" (per frame, hierarchy and series: candidates, colliding, missed, false_pairs, flagged, "
-        "micros), \"broad_phase\" and \"scaling\", keyed like the columns of its CSV files.");
+        "micros), \"broad_phase\" and \"scaling\", keyed like the columns of its CSV files. A deform scene "
+        "(\"deform\") returns \"rows\" (per frame, hierarchy, update and strategy), keyed like deform_frames.csv.");
   m.def(
       "policies", [] { return from_json(policies_json()); },
       "The registered densities and strategies with their parameters (what `bvhlab policies` prints).");

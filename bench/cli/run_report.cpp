@@ -1,6 +1,7 @@
 // bvhlab run, report and demo: run a scene and write its results, or its report folder.
 #include "bench/cli/cli.hpp"
 #include "bench/report.hpp"
+#include "bench/deform.hpp"
 #include "bench/world.hpp"
 #include "bench/write.hpp"
 
@@ -95,11 +96,23 @@ int run_world_scene(const Scene& scene, const RunOptions& options, const fs::pat
   return figures && !plot_error.empty() ? 4 : 0;
 }
 
+/// A deform scene's run, written like a world scene's.
+int run_deform_scene(const Scene& scene, const RunOptions& options, const fs::path& dir, bool figures,
+                     bool quiet) {
+  const DeformOutput output = run_deform(scene, options);
+  const std::string plot_error = write_deform_report(output, dir, figures);
+  if (!quiet) std::fputs(deform_readme(output).c_str(), stderr);
+  if (figures && !plot_error.empty()) std::fprintf(stderr, "bvhlab: %s\n", plot_error.c_str());
+  std::printf("%s\n", fs::absolute(dir / "README.md").c_str());
+  return figures && !plot_error.empty() ? 4 : 0;
+}
+
 int run_command(const SceneArgs& args) {
   const RunOptions options = scene_run_options(args);
   const Scene scene = load_scene(args.scene_file);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / scene.name : fs::path(args.out_dir);
   if (scene.world) return run_world_scene(scene, options, dir, false, args.quiet);
+  if (scene.deform) return run_deform_scene(scene, options, dir, false, args.quiet);
   const RunOutput output = run_scene(scene, options);
   write_results_csv(output, dir / "results.csv");
   write_results_json(output, dir / "results.json");
@@ -124,6 +137,7 @@ struct ReportJob {
 /// figures were asked for and could not be drawn.
 int run_report(const ReportJob& job) {
   if (job.scene.world) return run_world_scene(job.scene, job.options, job.dir, job.figures, job.quiet);
+  if (job.scene.deform) return run_deform_scene(job.scene, job.options, job.dir, job.figures, job.quiet);
   const RunOutput output = run_scene(job.scene, job.options);
   ReportOptions report_options;
   report_options.figures = job.figures;

@@ -1,5 +1,7 @@
 #include "bench/core/scene.hpp"
 
+#include "adb/update.hpp"
+
 #include "bench/core/scene_json.hpp"
 
 #include "bench/core/content_hash.hpp"
@@ -238,6 +240,14 @@ std::vector<std::string> hierarchy_bv_names() {
 
 std::string DensitySpec::label() const {
   return density_label(name, values);
+}
+
+std::string DensityUpdateSpec::label() const {
+  return with_density_update(name, [&]<class U>(std::type_identity<U>) {
+    const std::string params =
+        describe_parameters(U::parameters(), values, [](const ParamSpec&) { return true; });
+    return name + (params.empty() ? "" : " " + params);
+  });
 }
 
 std::string StrategyVariant::budget_label() const {
@@ -653,10 +663,21 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   const json document = parse_json(json_text, source);
   const Node root(document, "", source);
   root.expect_object({"name", "description", "objects", "pairs", "hierarchies", "annotation", "strategies",
-                      "workload", "report", "world"});
+                      "workload", "report", "world", "deform"});
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : "scene";
   parse_objects(root, base_dir, scene);
+  if (root.has("world") && root.has("deform"))
+    root.child("deform").fail("a scene is a world or a deform scene");
+  if (root.has("deform")) {
+    parse_hierarchies(root, scene);
+    parse_density(root, scene);
+    parse_strategies(root, scene);
+    if (root.has("report")) root.child("report").fail("does not apply to a deform scene");
+    parse_deform(root, base_dir, scene);
+    check_densities_needed(root, scene);
+    return scene;
+  }
   if (root.has("world")) {
     parse_hierarchies(root, scene);
     parse_density(root, scene);

@@ -184,6 +184,26 @@ struct WorldSpec {
   std::string identity;
 };
 
+/// One density-update policy of a deform scene, with its resolved parameters (adb/update.hpp).
+struct DensityUpdateSpec {
+  std::string name;
+  ParamValues values;
+  [[nodiscard]] std::string label() const;  ///< "recount_moved fraction=0.25 ignore_translation=0"
+};
+
+/// A deforming object against a rigid one over frames ("deform" in the file; format: bench/scenes/README.md).
+struct DeformSpec {
+  std::string object;       ///< the deforming scene object (A)
+  std::string other;        ///< the rigid scene object B; default: a rigid copy of A at rest
+  std::string deformation;  ///< a procedural deformation (bvh/deform.hpp parse_deformation); or frame files
+  std::vector<std::filesystem::path> frame_files;  ///< one mesh per frame, all of one topology
+  int frames = 0;                                  ///< procedural: frames over one period
+  std::vector<PoseGroup> poses;                    ///< B's poses against A, the same in every frame
+  bool refit_by_fit = false;                       ///< refit by fitting every node (else by merging)
+  double rebuild_degradation = 2.0;                ///< refit trees past it are rebuilt (Bvh::degradation)
+  std::vector<DensityUpdateSpec> density_updates;  ///< for the hierarchies with an ADB density
+};
+
 struct Scene {
   std::string name;
   std::filesystem::path file;  ///< where it was read from (empty for a string)
@@ -196,6 +216,8 @@ struct Scene {
   ReportSpec report;
   /// Set for a world scene: many instances over frames, in place of "pairs" and "workload".
   std::optional<WorldSpec> world;
+  /// Set for a deform scene: one deforming object against a rigid one, in place of "pairs" and "workload".
+  std::optional<DeformSpec> deform;
   /// What the parser left out on purpose (an optional hierarchy this build cannot provide), for the report.
   std::vector<std::string> notes;
 

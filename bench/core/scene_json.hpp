@@ -130,4 +130,8 @@ std::vector<Budget> parse_budgets(const Node& budgets);
 /// The "world" section (bench/core/world.cpp): instances, their motion, broad phases and frame budgets.
 void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene& scene);
 
+/// The "deform" section (bench/core/deform.cpp): the deforming object, its frames, B's poses, the refit and
+/// the density updates.
+void parse_deform(const Node& root, const std::filesystem::path& base_dir, Scene& scene);
+
 }  // namespace bvhlab::scene_json
