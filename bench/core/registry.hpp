@@ -27,12 +27,16 @@
 namespace bvhlab {
 
 /// The shipped volume models, listed once in volumes/shipped.hpp (the typed volume tests use that list too).
-#ifndef BVHLAB_TEST_POLICIES
-using RegisteredVolumes = ShippedVolumes;
-#else
+#if defined(BVHLAB_TEST_POLICIES)
 /// The test variant proves the density and strategy axes, not the volumes: two volumes keep its second copy
 /// of the runner and CLI cheap to compile (every volume multiplies the density x strategy instantiations).
 using RegisteredVolumes = TypeList<Aabb, Obb>;
+#elif defined(BVHLAB_LEAN_VOLUMES)
+/// The sanitizer builds (BVHLAB_LEAN_VOLUMES): one k-DOP stands for its family, the same template with other
+/// direction tables. The runner's instantiations are most of a sanitized build's time.
+using RegisteredVolumes = TypeList<Aabb, Dop24, Obb, Sphere, RestrictedBox>;
+#else
+using RegisteredVolumes = ShippedVolumes;
 #endif
 
 #ifndef BVHLAB_TEST_POLICIES
