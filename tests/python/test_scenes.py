@@ -129,5 +129,39 @@ def test_world_scene_rows(gear, gear_file, cli, tmp_path):
     with open(tmp_path / "out" / "world_frames.csv") as f:
         rows = [r for r in csv.DictReader(f) if r["series"] == "exact"]
     assert [int(r["colliding"]) for r in rows] == [r["colliding"] for r in exact]
-    with pytest.raises(ValueError, match="per_pose: does not apply to a world scene"):
+    with pytest.raises(ValueError, match="per_pose: does not apply to a world or deform scene"):
         bvhlab.run_scene(world_scene(gear_file), per_pose="all")
+
+
+def deform_scene(gear_file):
+    return {
+        "objects": [{"mesh": str(gear_file), "name": "gear", "normalize": True}],
+        "hierarchies": [{"bv": "aabb"}, {"bv": "obb"}],
+        "annotation": {"type": "adb"},
+        "strategies": [{"type": "exact"}, {"type": "adb", "p_min": 0.9, "hierarchies": ["aabb"]}],
+        "deform": {"object": "gear", "deformation": "bend", "frames": 2,
+                   "poses": {"distances": [1.0, 1.8], "steps": 4},
+                   "density_updates": [{"type": "stale"}, {"type": "recount_all"}]},
+    }
+
+
+def test_deform_scene_rows(gear_file, cli, tmp_path):
+    deform = bvhlab.run_scene(deform_scene(gear_file))
+    assert deform["frames"] == 2 and deform["poses"] == 8
+    rows = deform["rows"]
+    exact = [r for r in rows if r["exact_strategy"]]
+    assert {(r["hierarchy"], r["update"]) for r in exact} == {
+        ("aabb", "refit"), ("aabb", "rebuild"), ("obb", "refit"), ("obb", "rebuild")}
+    assert all(r["missed"] == r["false_pairs"] == 0 for r in exact)
+    recounted = [r for r in rows if r["update"] == "refit + recount_all"]
+    assert recounted and all(r["count_error"] == 0 for r in recounted)
+    # The CLI writes the same rows.
+    file = tmp_path / "deform.json"
+    file.write_text(json.dumps(deform_scene(gear_file)))
+    cli("run", file, "-o", tmp_path / "out", "--quiet", parse_json=False)
+    with open(tmp_path / "out" / "deform_frames.csv") as f:
+        written = list(csv.DictReader(f))
+    assert [(r["hierarchy"], r["update"], int(r["colliding"])) for r in written] == [
+        (r["hierarchy"], r["update"], r["colliding"]) for r in rows]
+    with pytest.raises(ValueError, match="per_pose: does not apply to a world or deform scene"):
+        bvhlab.run_scene(deform_scene(gear_file), per_pose="all")
