@@ -13,8 +13,7 @@
 
 #include <benchmark/benchmark.h>
 #ifdef BVHLAB_HAVE_FCL
-#include <fcl/geometry/bvh/BVH_model.h>
-#include <fcl/narrowphase/collision.h>
+#include "bench/fcl_models.hpp"
 #endif
 
 #include <cstdio>
@@ -84,13 +83,7 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
 template <class FclBV>
 void register_fcl(const std::string& mesh_name, const std::string& bv_name,
                   const std::shared_ptr<const Mesh>& mesh, const std::vector<PoseSet>& sets) {
-  auto model = std::make_shared<fcl::BVHModel<FclBV>>();
-  std::vector<fcl::Vector3d> points(mesh->vertices.begin(), mesh->vertices.end());
-  std::vector<fcl::Triangle> triangles;
-  for (const auto& t : mesh->triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  model->beginModel();
-  model->addSubModel(points, triangles);
-  model->endModel();
+  const auto model = make_fcl_model<FclBV>(*mesh);
   for (const auto& set : sets) {
     const std::string name = "fcl/" + mesh_name + "/" + bv_name + "/d:" + set.label;
     benchmark::RegisterBenchmark(name.c_str(), [model, &set](benchmark::State& state) {
@@ -99,11 +92,9 @@ void register_fcl(const std::string& mesh_name, const std::string& bv_name,
       for (auto _ : state) {
         colliding = 0;
         for (const auto& pose : set.poses) {
-          fcl::Transform3d tf = fcl::Transform3d::Identity();
-          tf.linear() = pose.rotation;
-          tf.translation() = pose.translation;
           fcl::CollisionResultd result;
-          fcl::collide(model.get(), fcl::Transform3d::Identity(), model.get(), tf, request, result);
+          fcl::collide(model.get(), fcl::Transform3d::Identity(), model.get(), fcl_transform(pose), request,
+                       result);
           colliding += result.isCollision();
         }
         benchmark::DoNotOptimize(colliding);
