@@ -32,6 +32,12 @@ class Bvh {
   using Volume = BV;
   using Fitted = fitted_volume_t<BV>;  ///< BV itself, or its Decoded form for hierarchical volumes
   static constexpr bool hierarchical = HierarchicalVolume<BV>;
+  /// A volume whose orientation is part of the fit (OBB) may offer fit_in_frame_of / merge_in_frame_of:
+  /// refit() then keeps each node's orientation instead of re-solving for it (see Obb).
+  static constexpr bool refits_in_frame = requires(const BV& v, std::span<const Vec3> p) {
+    { BV::fit_in_frame_of(v, p) } -> std::same_as<BV>;
+    { BV::merge_in_frame_of(v, v, v) } -> std::same_as<BV>;
+  };
 
   Bvh() = default;
 
@@ -71,11 +77,11 @@ class Bvh {
 
   /// Refits every node to new positions of the same triangles, bottom-up: a leaf is fitted to its triangles'
   /// vertices, an inner node merges its children's volumes (a hierarchical volume then re-encodes each
-  /// child against its parent). O(nodes), single-threaded. The topology stays; see degradation() for when
-  /// to rebuild instead. Throws std::invalid_argument naming the problem (another vertex count, other
-  /// triangle indices, a non-finite vertex) and leaves the tree as it was. RefitMethod::Fit fits every node
-  /// to its vertices instead, as the build does: O(triangles x depth), tighter for OBBs and spheres, whose
-  /// merges loosen level by level.
+  /// child against its parent; an OBB keeps each node's orientation, see refits_in_frame). O(nodes),
+  /// single-threaded. The topology stays; see degradation() for when to rebuild instead. Throws
+  /// std::invalid_argument naming the problem (another vertex count, other triangle indices, a non-finite
+  /// vertex) and leaves the tree as it was. RefitMethod::Fit fits every node to its vertices instead, as the
+  /// build does: O(triangles x depth), tighter for OBBs and spheres, whose merges loosen level by level.
   void refit(const Mesh& deformed, RefitMethod method = RefitMethod::Merge) {
     std::vector<TrianglePoints> moved = deformed_triangles(deformed);
     if (method == RefitMethod::Fit) {
@@ -92,7 +98,13 @@ class Bvh {
         points.clear();
         for (std::uint32_t t = n.first; t < n.first + n.count; ++t)
           points.insert(points.end(), moved[t].begin(), moved[t].end());
-        fitted[i] = Fitted::fit(points);
+        if constexpr (refits_in_frame) {
+          fitted[i] = BV::fit_in_frame_of(volumes_[i], points);
+        } else {
+          fitted[i] = Fitted::fit(points);
+        }
+      } else if constexpr (refits_in_frame) {
+        fitted[i] = BV::merge_in_frame_of(volumes_[i], fitted[n.left()], fitted[n.right()]);
       } else {
         fitted[i] = Fitted::merge(fitted[n.left()], fitted[n.right()]);
       }

@@ -66,6 +66,23 @@ struct Obb {
                            (kFrameRounding + 16 * std::numeric_limits<double>::epsilon()) * magnitude);
   }
 
+  /// Refitting a deformed mesh (Bvh::refit): the box of the points, or of boxes a and b, in `previous`'s
+  /// orientation. No eigen-solve, and tighter than merge() for a deformation that keeps the local
+  /// orientation; a deformation that turns the parts stales the orientation (RefitMethod::Fit renews it).
+  static Obb fit_in_frame_of(const Obb& previous, std::span<const Vec3> points) {
+    return box_in_frame(points, axes_of(previous.orientation), 0);
+  }
+  static Obb merge_in_frame_of(const Obb& previous, const Obb& a, const Obb& b) {
+    if (a.empty()) return b;
+    if (b.empty()) return a;
+    std::array<Vec3, 16> corners;
+    a.write_corners(corners.data());
+    b.write_corners(corners.data() + 8);
+    const double magnitude = std::max(a.magnitude(), b.magnitude());
+    return box_in_frame(corners, axes_of(previous.orientation),
+                        (kFrameRounding + 16 * std::numeric_limits<double>::epsilon()) * magnitude);
+  }
+
   static PairContext make_context(const RigidTransform& pose) {
     return {PlainMat3::from(pose.rotation), to_double3(pose.translation),
             pose.translation.cwiseAbs().maxCoeff()};
