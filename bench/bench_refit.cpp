@@ -14,6 +14,7 @@
 //   endUpdateModel bvhlab/rebuild      Bvh::build(frame, 1 thread) + query_exact                (refit,
 //   bottom-up) + collide
 //                                                                   fcl/rebuild  a new BVHModel + collide
+// plus bvhlab/refit_only and fcl/refit_only: the merge refit and FCL's update alone, without a query.
 // FCL pairs: aabb with AABB, obb with OBB, dop24 with KDOP<24> (other directions, the same count). Before
 // timing, every frame's answer is checked for every series against CGAL: a bvhlab answer that differs ends
 // the run with status 1, an FCL one is reported. After the run, the ratio bvhlab/FCL per volume (medians
@@ -129,6 +130,13 @@ void register_bvhlab(const std::shared_ptr<const Scene>& scene, int& bvhlab_wron
       set_frame_counters(state, *scene, colliding);
     })->Unit(benchmark::kMillisecond);
   }
+  // The refit alone, without the query: what the per-frame update itself costs.
+  benchmark::RegisterBenchmark(("bvhlab/refit_only/" + bv).c_str(), [scene](benchmark::State& state) {
+    auto tree = Bvh<BV>::build(scene->rest);
+    for (auto _ : state)
+      for (const Mesh& frame : scene->frames) tree.refit(frame);
+    set_frame_counters(state, *scene, 0);
+  })->Unit(benchmark::kMillisecond);
 }
 
 #ifdef BVHLAB_HAVE_FCL
@@ -179,6 +187,16 @@ void register_fcl(const std::shared_ptr<const Scene>& scene, const std::string& 
       set_frame_counters(state, *scene, colliding);
     })->Unit(benchmark::kMillisecond);
   }
+  benchmark::RegisterBenchmark(("fcl/refit_only/" + bv).c_str(), [scene](benchmark::State& state) {
+    auto a = make_fcl_model<FclBV>(scene->rest);
+    for (auto _ : state)
+      for (const auto& frame : scene->fcl_frames) {
+        a->beginUpdateModel();
+        a->updateSubModel(frame);
+        a->endUpdateModel(true, true);
+      }
+    set_frame_counters(state, *scene, 0);
+  })->Unit(benchmark::kMillisecond);
 }
 #endif
 
@@ -339,16 +357,17 @@ int main(int argc, char** argv) {
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   std::printf("\nbvhlab / FCL per frame (median ms per pass of %d frames):\n", frames);
-  std::printf("%-6s %12s %12s %12s %12s %12s %12s %12s\n", "bv", "refit_merge", "refit_fit", "fcl_refit",
-              "merge/fcl", "fit/fcl", "rebuild", "fcl_rebuild");
+  std::printf("%-6s %12s %12s %12s %12s %12s %12s %12s %12s %12s\n", "bv", "refit_merge", "refit_fit",
+              "fcl_refit", "merge/fcl", "fit/fcl", "rebuild", "fcl_rebuild", "refit_only", "fcl_ref_only");
   for (const auto& v : volumes) {
     const double merge = reporter.median("bvhlab/refit_merge/" + v),
                  fit = reporter.median("bvhlab/refit_fit/" + v);
     const double fcl = reporter.median("fcl/refit/" + v);
     const double rebuild = reporter.median("bvhlab/rebuild/" + v),
                  fcl_rebuild = reporter.median("fcl/rebuild/" + v);
-    std::printf("%-6s %12.2f %12.2f %12.2f %12.3f %12.3f %12.2f %12.2f\n", v.c_str(), merge, fit, fcl,
-                fcl > 0 ? merge / fcl : 0.0, fcl > 0 ? fit / fcl : 0.0, rebuild, fcl_rebuild);
+    std::printf("%-6s %12.2f %12.2f %12.2f %12.3f %12.3f %12.2f %12.2f %12.2f %12.2f\n", v.c_str(), merge,
+                fit, fcl, fcl > 0 ? merge / fcl : 0.0, fcl > 0 ? fit / fcl : 0.0, rebuild, fcl_rebuild,
+                reporter.median("bvhlab/refit_only/" + v), reporter.median("fcl/refit_only/" + v));
   }
   benchmark::Shutdown();
   return 0;

@@ -32,11 +32,10 @@ class Bvh {
   using Volume = BV;
   using Fitted = fitted_volume_t<BV>;  ///< BV itself, or its Decoded form for hierarchical volumes
   static constexpr bool hierarchical = HierarchicalVolume<BV>;
-  /// A volume whose orientation is part of the fit (OBB) may offer fit_in_frame_of / merge_in_frame_of:
-  /// refit() then keeps each node's orientation instead of re-solving for it (see Obb).
-  static constexpr bool refits_in_frame = requires(const BV& v, std::span<const Vec3> p) {
-    { BV::fit_in_frame_of(v, p) } -> std::same_as<BV>;
-    { BV::merge_in_frame_of(v, v, v) } -> std::same_as<BV>;
+  /// A volume whose orientation is part of the fit (OBB) may offer fit_in_frame_of: refit() then fits
+  /// each node in its own orientation instead of merging (see Obb).
+  static constexpr bool refits_in_frame = requires(const BV& v, std::span<const TrianglePoints> t) {
+    { BV::fit_in_frame_of(v, t) } -> std::same_as<BV>;
   };
 
   Bvh() = default;
@@ -77,7 +76,8 @@ class Bvh {
 
   /// Refits every node to new positions of the same triangles, bottom-up: a leaf is fitted to its triangles'
   /// vertices, an inner node merges its children's volumes (a hierarchical volume then re-encodes each
-  /// child against its parent; an OBB keeps each node's orientation, see refits_in_frame). O(nodes),
+  /// child against its parent; an OBB is instead fitted, in each node's orientation from the build, to the
+  /// node's vertices: O(triangles x depth) but no eigen-solve, see refits_in_frame). O(nodes),
   /// single-threaded. The topology stays; see degradation() for when to rebuild instead. Throws
   /// std::invalid_argument naming the problem (another vertex count, other triangle indices, a non-finite
   /// vertex) and leaves the tree as it was. RefitMethod::Fit fits every node to its vertices instead, as the
@@ -90,23 +90,27 @@ class Bvh {
       return;
     }
     std::vector<Fitted> fitted(nodes_.size(), Fitted{});
-    std::vector<Vec3> points;  // reused: no allocation per leaf
-    // Children are stored after their parent (build_topology), so a reverse sweep sees them first.
-    for (std::size_t i = nodes_.size(); i-- > 0;) {
-      const TreeNode& n = nodes_[i];
-      if (n.is_leaf()) {
-        points.clear();
-        for (std::uint32_t t = n.first; t < n.first + n.count; ++t)
-          points.insert(points.end(), moved[t].begin(), moved[t].end());
-        if constexpr (refits_in_frame) {
-          fitted[i] = BV::fit_in_frame_of(volumes_[i], points);
-        } else {
+    if constexpr (refits_in_frame) {
+      // Each node's box in its own orientation around its vertices: merging children's corners would
+      // compound their bulges level by level.
+      const auto ranges = node_triangle_ranges(nodes_);
+      for (std::size_t i = 0; i < nodes_.size(); ++i)
+        fitted[i] =
+            BV::fit_in_frame_of(volumes_[i], std::span<const TrianglePoints>(moved).subspan(
+                                                 ranges[i].first, ranges[i].second - ranges[i].first));
+    } else {
+      std::vector<Vec3> points;  // reused: no allocation per leaf
+      // Children are stored after their parent (build_topology), so a reverse sweep sees them first.
+      for (std::size_t i = nodes_.size(); i-- > 0;) {
+        const TreeNode& n = nodes_[i];
+        if (n.is_leaf()) {
+          points.clear();
+          for (std::uint32_t t = n.first; t < n.first + n.count; ++t)
+            points.insert(points.end(), moved[t].begin(), moved[t].end());
           fitted[i] = Fitted::fit(points);
+        } else {
+          fitted[i] = Fitted::merge(fitted[n.left()], fitted[n.right()]);
         }
-      } else if constexpr (refits_in_frame) {
-        fitted[i] = BV::merge_in_frame_of(volumes_[i], fitted[n.left()], fitted[n.right()]);
-      } else {
-        fitted[i] = Fitted::merge(fitted[n.left()], fitted[n.right()]);
       }
     }
     triangles_ = std::move(moved);
