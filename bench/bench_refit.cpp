@@ -208,13 +208,14 @@ class RatioReporter : public benchmark::ConsoleReporter {
     for (const Run& run : runs) {
       const std::string name = run.run_name.function_name;
       if (run.run_type == Run::RT_Aggregate && run.aggregate_name == "median")
-        median_[name] = run.GetAdjustedRealTime();
+        median_[name] = run.GetAdjustedCPUTime();
       else if (run.run_type == Run::RT_Iteration)
-        times_[name].push_back(run.GetAdjustedRealTime());
+        times_[name].push_back(run.GetAdjustedCPUTime());
     }
     ConsoleReporter::ReportRuns(runs);
   }
-  /// Milliseconds per iteration, or a negative number for a benchmark that did not run.
+  /// CPU milliseconds per iteration (every series runs on one thread; CPU time is less disturbed by other
+  /// load than wall time), or a negative number for a benchmark that did not run.
   [[nodiscard]] double median(const std::string& name) const {
     if (auto it = median_.find(name); it != median_.end()) return it->second;
     auto it = times_.find(name);
@@ -356,7 +357,7 @@ int main(int argc, char** argv) {
   }
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  std::printf("\nbvhlab / FCL per frame (median ms per pass of %d frames):\n", frames);
+  std::printf("\nbvhlab / FCL (median CPU ms per pass of %d frames):\n", frames);
   std::printf("%-6s %12s %12s %12s %12s %12s %12s %12s %12s %12s\n", "bv", "refit_merge", "refit_fit",
               "fcl_refit", "merge/fcl", "fit/fcl", "rebuild", "fcl_rebuild", "refit_only", "fcl_ref_only");
   for (const auto& v : volumes) {
