@@ -346,7 +346,9 @@ class Bvh {
   double built_spread_ = 0;
 };
 
-/// A degradation() past which a refitted tree is better rebuilt (measured: bench_refit).
+/// A degradation() past which queries on a refitted tree are measurably slower than on a rebuilt one (1.3 to
+/// 3 times on the twisted bunny: README, "Deforming objects: refit", bench_refit --crossover). Whether a
+/// rebuild pays depends on how many queries follow it.
 inline constexpr double kRebuildDegradation = 2.0;
 
 }  // namespace bvhlab
