@@ -14,8 +14,6 @@
 #include <benchmark/benchmark.h>
 #ifdef BVHLAB_HAVE_FCL
 #include "bench/core/fcl_model.hpp"
-
-#include <fcl/narrowphase/collision.h>
 #endif
 
 #include <cstdio>
@@ -85,7 +83,7 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
 template <class FclBV>
 void register_fcl(const std::string& mesh_name, const std::string& bv_name,
                   const std::shared_ptr<const Mesh>& mesh, const std::vector<PoseSet>& sets) {
-  std::shared_ptr<const fcl::BVHModel<FclBV>> model = make_fcl_model<FclBV>(*mesh);
+  const auto model = make_fcl_model<FclBV>(*mesh);
   for (const auto& set : sets) {
     const std::string name = "fcl/" + mesh_name + "/" + bv_name + "/d:" + set.label;
     benchmark::RegisterBenchmark(name.c_str(), [model, &set](benchmark::State& state) {
@@ -94,11 +92,9 @@ void register_fcl(const std::string& mesh_name, const std::string& bv_name,
       for (auto _ : state) {
         colliding = 0;
         for (const auto& pose : set.poses) {
-          fcl::Transform3d tf = fcl::Transform3d::Identity();
-          tf.linear() = pose.rotation;
-          tf.translation() = pose.translation;
           fcl::CollisionResultd result;
-          fcl::collide(model.get(), fcl::Transform3d::Identity(), model.get(), tf, request, result);
+          fcl::collide(model.get(), fcl::Transform3d::Identity(), model.get(), fcl_transform(pose), request,
+                       result);
           colliding += result.isCollision();
         }
         benchmark::DoNotOptimize(colliding);

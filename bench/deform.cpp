@@ -293,14 +293,8 @@ class FclDeform final : public DeformHierarchy {
     row.tree_micros = micros;
     std::vector<QueryRecord> answers;
     timed_series(truth.poses, warmup_, answers, [&](const RigidTransform& pose) {
-      fcl::Transform3d tf = fcl::Transform3d::Identity();
-      tf.linear() = pose.rotation;
-      tf.translation() = pose.translation;
-      fcl::CollisionResultd result;
-      fcl::collide(&model, fcl::Transform3d::Identity(), other_.get(), tf, fcl::CollisionRequestd(1, false),
-                   result);
       Result r;
-      r.collides = result.isCollision();
+      r.collides = fcl_collides(model, *other_, pose);
       return r;
     });
     score(row, truth, answers);

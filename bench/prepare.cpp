@@ -105,14 +105,8 @@ class FclHierarchy final : public PreparedHierarchy {
 
  private:
   Result query(const RigidTransform& pose) const {
-    const fcl::CollisionRequestd request(1, false);
-    fcl::Transform3d tf = fcl::Transform3d::Identity();
-    tf.linear() = pose.rotation;
-    tf.translation() = pose.translation;
-    fcl::CollisionResultd result;
-    fcl::collide(a_.get(), fcl::Transform3d::Identity(), b_.get(), tf, request, result);
     Result r;
-    r.collides = result.isCollision();
+    r.collides = fcl_collides(*a_, *b_, pose);
     r.probability = r.collides ? 1 : 0;
     return r;
   }

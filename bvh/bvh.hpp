@@ -32,6 +32,11 @@ class Bvh {
   using Volume = BV;
   using Fitted = fitted_volume_t<BV>;  ///< BV itself, or its Decoded form for hierarchical volumes
   static constexpr bool hierarchical = HierarchicalVolume<BV>;
+  /// A volume whose orientation is part of the fit (OBB) may offer fit_in_frame_of: refit() then fits
+  /// each node in its own orientation instead of merging (see Obb).
+  static constexpr bool refits_in_frame = requires(const BV& v, std::span<const TrianglePoints> t) {
+    { BV::fit_in_frame_of(v, t) } -> std::same_as<BV>;
+  };
 
   Bvh() = default;
 
@@ -71,11 +76,12 @@ class Bvh {
 
   /// Refits every node to new positions of the same triangles, bottom-up: a leaf is fitted to its triangles'
   /// vertices, an inner node merges its children's volumes (a hierarchical volume then re-encodes each
-  /// child against its parent). O(nodes), single-threaded. The topology stays; see degradation() for when
-  /// to rebuild instead. Throws std::invalid_argument naming the problem (another vertex count, other
-  /// triangle indices, a non-finite vertex) and leaves the tree as it was. RefitMethod::Fit fits every node
-  /// to its vertices instead, as the build does: O(triangles x depth), tighter for OBBs and spheres, whose
-  /// merges loosen level by level.
+  /// child against its parent; an OBB is instead fitted, in each node's orientation from the build, to the
+  /// node's vertices: O(triangles x depth) but no eigen-solve, see refits_in_frame). O(nodes),
+  /// single-threaded. The topology stays; see degradation() for when to rebuild instead. Throws
+  /// std::invalid_argument naming the problem (another vertex count, other triangle indices, a non-finite
+  /// vertex) and leaves the tree as it was. RefitMethod::Fit fits every node to its vertices instead, as the
+  /// build does: O(triangles x depth), tighter for OBBs and spheres, whose merges loosen level by level.
   void refit(const Mesh& deformed, RefitMethod method = RefitMethod::Merge) {
     std::vector<TrianglePoints> moved = deformed_triangles(deformed);
     if (method == RefitMethod::Fit) {
@@ -84,17 +90,27 @@ class Bvh {
       return;
     }
     std::vector<Fitted> fitted(nodes_.size(), Fitted{});
-    std::vector<Vec3> points;  // reused: no allocation per leaf
-    // Children are stored after their parent (build_topology), so a reverse sweep sees them first.
-    for (std::size_t i = nodes_.size(); i-- > 0;) {
-      const TreeNode& n = nodes_[i];
-      if (n.is_leaf()) {
-        points.clear();
-        for (std::uint32_t t = n.first; t < n.first + n.count; ++t)
-          points.insert(points.end(), moved[t].begin(), moved[t].end());
-        fitted[i] = Fitted::fit(points);
-      } else {
-        fitted[i] = Fitted::merge(fitted[n.left()], fitted[n.right()]);
+    if constexpr (refits_in_frame) {
+      // Each node's box in its own orientation around its vertices: merging children's corners would
+      // compound their bulges level by level.
+      const auto ranges = node_triangle_ranges(nodes_);
+      for (std::size_t i = 0; i < nodes_.size(); ++i)
+        fitted[i] =
+            BV::fit_in_frame_of(volumes_[i], std::span<const TrianglePoints>(moved).subspan(
+                                                 ranges[i].first, ranges[i].second - ranges[i].first));
+    } else {
+      std::vector<Vec3> points;  // reused: no allocation per leaf
+      // Children are stored after their parent (build_topology), so a reverse sweep sees them first.
+      for (std::size_t i = nodes_.size(); i-- > 0;) {
+        const TreeNode& n = nodes_[i];
+        if (n.is_leaf()) {
+          points.clear();
+          for (std::uint32_t t = n.first; t < n.first + n.count; ++t)
+            points.insert(points.end(), moved[t].begin(), moved[t].end());
+          fitted[i] = Fitted::fit(points);
+        } else {
+          fitted[i] = Fitted::merge(fitted[n.left()], fitted[n.right()]);
+        }
       }
     }
     triangles_ = std::move(moved);
@@ -330,7 +346,9 @@ class Bvh {
   double built_spread_ = 0;
 };
 
-/// A degradation() past which a refitted tree is better rebuilt (measured: bench_refit).
+/// A degradation() past which queries on a refitted tree are measurably slower than on a rebuilt one (1.3 to
+/// 3 times on the twisted bunny: README, "Deforming objects: refit", bench_refit --crossover). Whether a
+/// rebuild pays depends on how many queries follow it.
 inline constexpr double kRebuildDegradation = 2.0;
 
 }  // namespace bvhlab

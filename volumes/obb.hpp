@@ -66,6 +66,37 @@ struct Obb {
                            (kFrameRounding + 16 * std::numeric_limits<double>::epsilon()) * magnitude);
   }
 
+  /// Refitting a deformed mesh (Bvh::refit): the box of the triangles in `previous`'s orientation, kept
+  /// bit for bit. One pass and no eigen-solve; as tight as fit() while the deformation keeps local
+  /// orientations, looser when it turns the parts (RefitMethod::Fit renews the orientations).
+  static Obb fit_in_frame_of(const Obb& previous, std::span<const TrianglePoints> triangles) {
+    if (triangles.empty()) return {};
+    const Mat3 axes = axes_of(previous.orientation);
+    const Mat3 to_local = axes.transpose();
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    double reach = 0;  // largest |coordinate| of a point
+    for (const TrianglePoints& t : triangles)
+      for (const Vec3& p : t) {
+        if (!p.allFinite()) throw std::invalid_argument("obb::fit: a point has a NaN or infinite coordinate");
+        const Vec3 s = to_local * p;
+        lo = lo.cwiseMin(s);
+        hi = hi.cwiseMax(s);
+        reach = std::max(reach, p.cwiseAbs().maxCoeff());
+      }
+    Obb out;
+    out.orientation = previous.orientation;  // the frame is exactly axes_of(orientation): no frame rounding
+    const Vec3 center = axes * ((lo + hi) * 0.5);
+    out.center = {float(center.x()), float(center.y()), float(center.z())};
+    // Storing the centre as float moves it by up to 2^-24 |c|; contains() measures p - c in the frame, which
+    // differs from the projections above by a few roundings of |p| and |c| (32 ulps is generous).
+    const double magnitude = reach + center.cwiseAbs().maxCoeff();
+    const double widen =
+        0x1p-24 * center.norm() + 32 * std::numeric_limits<double>::epsilon() * magnitude + 1e-44;
+    out.half = float3_up(
+        Vec3((((hi - lo) * 0.5).array() + widen) * (1 + 8 * std::numeric_limits<double>::epsilon())));
+    return out;
+  }
+
   static PairContext make_context(const RigidTransform& pose) {
     return {PlainMat3::from(pose.rotation), to_double3(pose.translation),
             pose.translation.cwiseAbs().maxCoeff()};
