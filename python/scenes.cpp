@@ -2,8 +2,8 @@
 // policies' tables.
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
-#include "bench/run.hpp"
 #include "bench/deform.hpp"
+#include "bench/run.hpp"
 #include "bench/world.hpp"
 #include "bench/write.hpp"
 #include "python/bindings.hpp"
@@ -79,7 +79,8 @@ void bind_scenes(py::module_& m) {
         "one dict per query or per wrong answer. A world scene (\"world\") returns its rows instead: "
         "\"series\" (per frame, hierarchy and series: candidates, colliding, missed, false_pairs, flagged, "
         "micros), \"broad_phase\" and \"scaling\", keyed like the columns of its CSV files. A deform scene "
-        "(\"deform\") returns \"rows\" (per frame, hierarchy, update and strategy), keyed like deform_frames.csv.");
+        "(\"deform\") returns \"rows\" (per frame, hierarchy, update and strategy), keyed like "
+        "deform_frames.csv.");
   m.def(
       "policies", [] { return from_json(policies_json()); },
       "The registered densities and strategies with their parameters (what `bvhlab policies` prints).");

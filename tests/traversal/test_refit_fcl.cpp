@@ -1,7 +1,7 @@
 // Refit side by side with FCL: its update-and-refit (beginUpdateModel / updateSubModel / endUpdateModel)
 // on the same frames and poses gives the same exact answers as bvhlab's refitted trees and CGAL.
-#include "bench/core/ground_truth.hpp"
 #include "bench/core/fcl_model.hpp"
+#include "bench/core/ground_truth.hpp"
 #include "bvh/deform.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/exact.hpp"
