@@ -149,9 +149,8 @@ struct UpdatedTree {
 template <class BV>
 UpdatedTree<BV> make_updated(const DensityUpdateSpec& spec, const Tree<BV, AdbDensity>& rest) {
   return with_density_update(spec.name, [&]<class U>(std::type_identity<U>) {
-    auto state =
-        std::make_shared<typename U::State>(U::start(rest.bvh, rest.density, U::make_params(spec.values)));
     const auto params = U::make_params(spec.values);
+    auto state = std::make_shared<typename U::State>(U::start(rest.bvh, rest.density, params));
     UpdatedTree<BV> out{spec.label(), rest, {}, {}};
     out.update = [state](Tree<BV, AdbDensity>& t) {
       DensityUpdateStats stats;

@@ -669,21 +669,17 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   parse_objects(root, base_dir, scene);
   if (root.has("world") && root.has("deform"))
     root.child("deform").fail("a scene is a world or a deform scene");
-  if (root.has("deform")) {
+  // A world or deform scene names its own motion: no pairs, workload or report.
+  if (root.has("world") || root.has("deform")) {
+    const char* kind = root.has("world") ? "world" : "deform";
     parse_hierarchies(root, scene);
     parse_density(root, scene);
     parse_strategies(root, scene);
-    if (root.has("report")) root.child("report").fail("does not apply to a deform scene");
-    parse_deform(root, base_dir, scene);
-    check_densities_needed(root, scene);
-    return scene;
-  }
-  if (root.has("world")) {
-    parse_hierarchies(root, scene);
-    parse_density(root, scene);
-    parse_strategies(root, scene);
-    if (root.has("report")) root.child("report").fail("does not apply to a world scene");
-    parse_world(root, base_dir, scene);
+    if (root.has("report")) root.child("report").fail(std::string("does not apply to a ") + kind + " scene");
+    if (root.has("world"))
+      parse_world(root, base_dir, scene);
+    else
+      parse_deform(root, base_dir, scene);
     check_densities_needed(root, scene);
     return scene;
   }
