@@ -43,4 +43,13 @@ template <class BV>
 struct AnyVolume : std::true_type {};
 using AllShippedVolumes = SelectTypes<AnyVolume, ShippedVolumes>::type;
 
+/// The volumes the traversal tests run over. The sanitizer builds (BVHLAB_LEAN_VOLUMES) keep one k-DOP for
+/// the family: the k-DOPs share one template, their volume tests still cover every direction table, and the
+/// other four would double the sanitized compile and run time of these tests. Release runs them all.
+#ifdef BVHLAB_LEAN_VOLUMES
+using TraversalTestVolumes = ::testing::Types<Aabb, Dop24, Obb, Sphere, RestrictedBox>;
+#else
+using TraversalTestVolumes = AllShippedVolumes;
+#endif
+
 }  // namespace bvhlab::testing

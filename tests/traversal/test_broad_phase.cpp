@@ -1,6 +1,7 @@
 // The broad phases against brute force (and brute force against Box::overlaps), their input rules, the
 // dynamic tree's fattened boxes, and world boxes against every transformed vertex.
 #include "bench/core/generators.hpp"
+#include "support/volume_lists.hpp"
 #include "traversal/broad_phase/registry.hpp"
 #include "traversal/broad_phase/world_box.hpp"
 #include "volumes/shipped.hpp"
@@ -335,13 +336,7 @@ TEST(SweepAndPrune, IncoherentMotionFallsBackToAFullSort) {
 
 template <class BV>
 class WorldBox : public ::testing::Test {};
-template <class T>
-struct ToTypes;
-template <class... Ts>
-struct ToTypes<TypeList<Ts...>> {
-  using type = ::testing::Types<Ts...>;
-};
-TYPED_TEST_SUITE(WorldBox, ToTypes<ShippedVolumes>::type);
+TYPED_TEST_SUITE(WorldBox, testing::TraversalTestVolumes);
 
 // The rotated bounding box, computed independently: the AABB of its eight transformed corners.
 Box rotated_corners(const Box& local, const RigidTransform& pose) {

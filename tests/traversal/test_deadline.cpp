@@ -42,10 +42,7 @@ AdbOptions with_deadline(double deadline_us, double p_min = 0.9) {
 
 template <class BV>
 class Deadline : public ::testing::Test {};
-template <class BV>
-struct Any : std::true_type {};
-using AllVolumes = testing::SelectTypes<Any, ShippedVolumes>::type;
-TYPED_TEST_SUITE(Deadline, AllVolumes);
+TYPED_TEST_SUITE(Deadline, testing::TraversalTestVolumes);
 
 TYPED_TEST(Deadline, ATinyDeadlineIsAlwaysFlagged) {
   const Scene<TypeParam> scene;

@@ -18,7 +18,7 @@ namespace {
 
 template <class BV>
 class Refit : public ::testing::Test {};
-TYPED_TEST_SUITE(Refit, testing::AllShippedVolumes);
+TYPED_TEST_SUITE(Refit, testing::TraversalTestVolumes);
 
 constexpr RefitMethod kMethods[] = {RefitMethod::Merge, RefitMethod::Fit};
 const char* name_of(RefitMethod m) {
