@@ -7,7 +7,7 @@
 //   bench_adb [--meshes=a,b] [--steps=200] [--p-min=0.5,0.7,...] [--exact=aabb,dop24] [--grid=2]
 //             [--tau=0.5] [--distances=1.2,1.4,...] [benchmark flags]
 #include "adb/adb_density.hpp"
-#include "bench/core/arguments.hpp"
+#include "bench/core/bench_flags.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
@@ -168,34 +168,23 @@ void print_summary(const std::vector<std::string>& exact_names) {
 
 int main(int argc, char** argv) {
   using namespace bvhlab;
-  benchmark::Initialize(&argc, argv);
   std::vector<std::string> meshes{"injector_pipes.stl", "occt_tr12j_housing.stl"};
   std::vector<std::string> exact{"aabb", "dop24"};
   std::vector<double> p_mins{0.5, 0.7, 0.8, 0.9, 0.95, 0.99};
   std::vector<double> distances = ProtocolOptions{}.distances;
   int steps = 200, grid = 2;
   double tau = kDefaultAdbTau;
+  if (auto exit = initialize_benchmark("bench_adb",
+                                       {{"meshes", &meshes, "meshes to run"},
+                                        {"exact", &exact, "exact hierarchies to compare with"},
+                                        {"p-min", &p_mins, "ADB's p_min values"},
+                                        {"distances", &distances, "protocol distances"},
+                                        {"steps", &steps, "poses per distance"},
+                                        {"grid", &grid, "ADB grid (2, 3 or 4)"},
+                                        {"tau", &tau, "ADB's tau"}},
+                                       argc, argv))
+    return *exit;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto value = [&](const char* prefix) { return arg.substr(std::string(prefix).size()); };
-      if (arg.rfind("--meshes=", 0) == 0)
-        meshes = split_list(value("--meshes="));
-      else if (arg.rfind("--exact=", 0) == 0)
-        exact = split_list(value("--exact="));
-      else if (arg.rfind("--p-min=", 0) == 0)
-        p_mins = split_numbers(value("--p-min="));
-      else if (arg.rfind("--distances=", 0) == 0)
-        distances = split_numbers(value("--distances="));
-      else if (arg.rfind("--steps=", 0) == 0)
-        steps = std::stoi(value("--steps="));
-      else if (arg.rfind("--grid=", 0) == 0)
-        grid = std::stoi(value("--grid="));
-      else if (arg.rfind("--tau=", 0) == 0)
-        tau = std::stod(value("--tau="));
-      else
-        throw std::invalid_argument("unknown argument '" + arg + "'");
-    }
     if (steps < 1) throw std::invalid_argument("--steps must be at least 1");
     if (grid < 2 || grid > 4) throw std::invalid_argument("--grid must be 2, 3 or 4");
     for (const auto& file : meshes) {

@@ -12,6 +12,7 @@
 // needs no file. Annotation runs on 2 threads unless --threads=N is given before the benchmark flags.
 #include "adb/adb_density.hpp"
 #include "adb/saved_tree.hpp"
+#include "bench/core/bench_flags.hpp"
 #include "bench/core/generators.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "volumes/aabb.hpp"
@@ -153,13 +154,9 @@ void BM_SavedBytes(benchmark::State& state, const std::string& name, std::uint32
 }  // namespace bvhlab
 
 int main(int argc, char** argv) {
-  std::vector<char*> args;
-  for (int i = 0; i < argc; ++i) {
-    if (std::strncmp(argv[i], "--threads=", 10) == 0)
-      bvhlab::g_threads = static_cast<unsigned>(std::stoul(argv[i] + 10));
-    else
-      args.push_back(argv[i]);
-  }
+  if (auto exit = bvhlab::initialize_benchmark(
+          "bench_annotate", {{"threads", &bvhlab::g_threads, "annotation threads"}}, argc, argv))
+    return *exit;
   for (const auto& name : bvhlab::kMeshes)
     benchmark::RegisterBenchmark(("BM_Annotate/" + name).c_str(), bvhlab::BM_Annotate, name)
         ->Iterations(1)
@@ -172,9 +169,6 @@ int main(int argc, char** argv) {
           ->Iterations(1)
           ->Unit(benchmark::kSecond)
           ->UseRealTime();
-  int count = static_cast<int>(args.size());
-  benchmark::Initialize(&count, args.data());
-  if (benchmark::ReportUnrecognizedArguments(count, args.data())) return 1;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

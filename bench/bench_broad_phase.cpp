@@ -21,6 +21,7 @@
 // `exact` strategy on bvhlab's pairs, fcl::collide on FCL's candidates) must find the same colliding pairs.
 // A failed check ends the program with status 1. After the run, the medians (of --benchmark_repetitions)
 // and the ratios bvhlab / FCL per environment are printed.
+#include "bench/core/bench_flags.hpp"
 #include "bench/core/broad_phase_env.hpp"
 #include "traversal/broad_phase/dynamic_aabb_tree.hpp"
 #include "traversal/broad_phase/sweep_and_prune.hpp"
@@ -363,23 +364,19 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
 int main(int argc, char** argv) {
   using namespace bvhlab;
-  benchmark::Initialize(&argc, argv);
   std::size_t frames = 50;
-  Motion motion = Motion::Fcl;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg.rfind("--frames=", 0) == 0) {
-      frames = std::stoul(arg.substr(9));
-    } else if (arg == "--motion=fcl") {
-      motion = Motion::Fcl;
-    } else if (arg == "--motion=local") {
-      motion = Motion::Local;
-    } else {
-      std::fprintf(stderr, "bench_broad_phase: unknown argument '%s' (--frames=N, --motion=fcl|local)\n",
-                   arg.c_str());
-      return 2;
-    }
+  std::string motion_name = "fcl";
+  if (auto exit = initialize_benchmark(
+          "bench_broad_phase",
+          {{"frames", &frames, "frames per environment"},
+           {"motion", &motion_name, "fcl (FCL's update motion) or local (turning in place)"}},
+          argc, argv))
+    return *exit;
+  if (motion_name != "fcl" && motion_name != "local") {
+    std::fprintf(stderr, "bench_broad_phase: --motion must be fcl or local, not '%s'\n", motion_name.c_str());
+    return 2;
   }
+  const Motion motion = motion_name == "fcl" ? Motion::Fcl : Motion::Local;
   if (frames < 2) {
     std::fprintf(stderr, "bench_broad_phase: --frames must be at least 2\n");
     return 2;

@@ -8,7 +8,7 @@
 //   bench_deadline [--meshes=injector_pipes.stl] [--bv=aabb,obb] [--deadlines=2,5,10,20]
 //                  [--distances=1.2,1.4,1.6,1.8] [--steps=500] [--min-pops=40] [benchmark flags]
 #include "adb/adb_density.hpp"
-#include "bench/core/arguments.hpp"
+#include "bench/core/bench_flags.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
@@ -128,29 +128,19 @@ void register_mesh(const std::string& label, const Mesh& mesh, const Setup& setu
 
 int main(int argc, char** argv) {
   using namespace bvhlab;
-  benchmark::Initialize(&argc, argv);
   std::vector<std::string> meshes{"injector_pipes.stl"};
   std::vector<std::string> volumes{"aabb", "obb"};
   Setup setup;
+  if (auto exit = initialize_benchmark("bench_deadline",
+                                       {{"meshes", &meshes, "meshes to run"},
+                                        {"bv", &volumes, "bounding volumes"},
+                                        {"deadlines", &setup.deadlines, "deadlines in microseconds"},
+                                        {"distances", &setup.distances, "protocol distances"},
+                                        {"steps", &setup.steps, "poses per distance"},
+                                        {"min-pops", &setup.min_pops, "pops between clock reads"}},
+                                       argc, argv))
+    return *exit;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto value = [&](const char* prefix) { return arg.substr(std::string(prefix).size()); };
-      if (arg.rfind("--meshes=", 0) == 0)
-        meshes = split_list(value("--meshes="));
-      else if (arg.rfind("--bv=", 0) == 0)
-        volumes = split_list(value("--bv="));
-      else if (arg.rfind("--deadlines=", 0) == 0)
-        setup.deadlines = split_numbers(value("--deadlines="));
-      else if (arg.rfind("--distances=", 0) == 0)
-        setup.distances = split_numbers(value("--distances="));
-      else if (arg.rfind("--steps=", 0) == 0)
-        setup.steps = std::stoi(value("--steps="));
-      else if (arg.rfind("--min-pops=", 0) == 0)
-        setup.min_pops = std::stoull(value("--min-pops="));
-      else
-        throw std::invalid_argument("unknown argument '" + arg + "'");
-    }
     if (setup.steps < 1) throw std::invalid_argument("--steps must be at least 1");
     for (double d : setup.deadlines)
       if (!(d > 0 && d < 1e9)) throw std::invalid_argument("--deadlines must lie in (0, 1e9) microseconds");

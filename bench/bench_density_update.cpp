@@ -16,6 +16,7 @@
 // frames.
 #include "adb/adb_density.hpp"
 #include "adb/update.hpp"
+#include "bench/core/bench_flags.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
 #include "traversal/adb.hpp"
@@ -286,24 +287,15 @@ void BM_DensityUpdate(benchmark::State& state) {
 
 int main(int argc, char** argv) {
   using bvhlab::g_settings;
-  std::vector<char*> args;
+  if (auto exit = bvhlab::initialize_benchmark("bench_density_update",
+                                               {{"mesh", &g_settings.mesh, "the twisting mesh"},
+                                                {"frames", &g_settings.frames, "frames"},
+                                                {"twist", &g_settings.twist_degrees, "twist in degrees"},
+                                                {"poses", &g_settings.poses, "poses per frame"},
+                                                {"threads", &g_settings.threads, "annotation threads"}},
+                                               argc, argv))
+    return *exit;
   try {
-    for (int i = 0; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto value = [&](const char* flag) { return arg.substr(std::strlen(flag)); };
-      if (arg.rfind("--mesh=", 0) == 0)
-        g_settings.mesh = value("--mesh=");
-      else if (arg.rfind("--frames=", 0) == 0)
-        g_settings.frames = std::stoi(value("--frames="));
-      else if (arg.rfind("--twist=", 0) == 0)
-        g_settings.twist_degrees = std::stod(value("--twist="));
-      else if (arg.rfind("--poses=", 0) == 0)
-        g_settings.poses = std::stoi(value("--poses="));
-      else if (arg.rfind("--threads=", 0) == 0)
-        g_settings.threads = static_cast<unsigned>(std::stoul(value("--threads=")));
-      else
-        args.push_back(argv[i]);
-    }
     if (g_settings.frames < 1) throw std::invalid_argument("--frames must be at least 1");
     if (g_settings.poses < 4) throw std::invalid_argument("--poses must be at least 4");
     if (!std::isfinite(g_settings.twist_degrees)) throw std::invalid_argument("--twist must be finite");
@@ -315,9 +307,6 @@ int main(int argc, char** argv) {
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
-  int count = static_cast<int>(args.size());
-  benchmark::Initialize(&count, args.data());
-  if (benchmark::ReportUnrecognizedArguments(count, args.data())) return 1;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -14,7 +14,7 @@
 // --threshold: the best-effort rule on exhaustion ("collision" iff the best estimate left is at least it;
 // set it to p_min for the strict rule).
 #include "adb/adb_density.hpp"
-#include "bench/core/arguments.hpp"
+#include "bench/core/bench_flags.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "traversal/exact.hpp"
 #include "traversal/frame_budget.hpp"
@@ -190,33 +190,23 @@ void print_summary() {
 
 int main(int argc, char** argv) {
   using namespace bvhlab;
-  benchmark::Initialize(&argc, argv);
   std::vector<double> pair_counts{20, 50, 100}, fractions{0.0625, 0.125, 0.25, 0.5},
       deadlines{25, 50, 100, 200};
   int frames = 10;
   std::uint64_t seed = 1;
   FrameOptions options;
+  if (auto exit = initialize_benchmark(
+          "bench_frame_budget",
+          {{"pairs", &pair_counts, "pairs per frame"},
+           {"frames", &frames, "frames per set"},
+           {"fractions", &fractions, "BV-test budgets, as fractions of ADB's unbudgeted cost"},
+           {"deadlines", &deadlines, "frame deadlines in microseconds"},
+           {"p-min", &options.p_min, "p_min of every schedule"},
+           {"threshold", &options.adb.best_effort_threshold, "best-effort answer threshold"},
+           {"seed", &seed, "seed of the frames"}},
+          argc, argv))
+    return *exit;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto value = [&](const char* prefix) { return arg.substr(std::string(prefix).size()); };
-      if (arg.rfind("--pairs=", 0) == 0)
-        pair_counts = split_numbers(value("--pairs="));
-      else if (arg.rfind("--frames=", 0) == 0)
-        frames = std::stoi(value("--frames="));
-      else if (arg.rfind("--fractions=", 0) == 0)
-        fractions = split_numbers(value("--fractions="));
-      else if (arg.rfind("--deadlines=", 0) == 0)
-        deadlines = split_numbers(value("--deadlines="));
-      else if (arg.rfind("--p-min=", 0) == 0)
-        options.p_min = std::stod(value("--p-min="));
-      else if (arg.rfind("--threshold=", 0) == 0)
-        options.adb.best_effort_threshold = std::stod(value("--threshold="));
-      else if (arg.rfind("--seed=", 0) == 0)
-        seed = std::stoull(value("--seed="));
-      else
-        throw std::invalid_argument("unknown argument '" + arg + "'");
-    }
     if (frames < 1) throw std::invalid_argument("--frames must be at least 1");
     for (double n : pair_counts)
       if (!(n >= 1)) throw std::invalid_argument("--pairs must be at least 1");

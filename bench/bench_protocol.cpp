@@ -5,7 +5,7 @@
 //
 // Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
 // protocol's mean time per query. Counters: BV tests and triangle tests per query, bytes per triangle.
-#include "bench/core/arguments.hpp"
+#include "bench/core/bench_flags.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
@@ -110,23 +110,15 @@ void register_fcl(const std::string& mesh_name, const std::string& bv_name,
 
 int main(int argc, char** argv) {
   using namespace bvhlab;
-  benchmark::Initialize(&argc, argv);
   std::vector<std::string> meshes{"injector_pipes.stl", "occt_tr12j_housing.stl", "jeep1.ms3d", "bunny.obj"};
   std::vector<std::string> volumes = volume_names();
   int steps = 500;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg.rfind("--meshes=", 0) == 0)
-      meshes = split_list(arg.substr(9));
-    else if (arg.rfind("--volumes=", 0) == 0)
-      volumes = split_list(arg.substr(10));
-    else if (arg.rfind("--steps=", 0) == 0)
-      steps = std::stoi(arg.substr(8));
-    else {
-      std::fprintf(stderr, "bench_protocol: unknown argument '%s'\n", arg.c_str());
-      return 2;
-    }
-  }
+  if (auto exit = initialize_benchmark("bench_protocol",
+                                       {{"meshes", &meshes, "meshes to run"},
+                                        {"volumes", &volumes, "bounding volumes"},
+                                        {"steps", &steps, "poses per distance"}},
+                                       argc, argv))
+    return *exit;
   if (steps < 1) {
     std::fprintf(stderr, "bench_protocol: --steps must be at least 1\n");
     return 2;

@@ -23,7 +23,7 @@
 // --crossover measures, instead, what a refitted tree costs against a rebuilt one as the deformation
 // grows (amplitude x 0.25 .. 8 at a quarter period): degradation(), refit and rebuild times, and the mean
 // exact query time over protocol poses on both trees; that is how kRebuildDegradation was chosen.
-#include "bench/core/arguments.hpp"
+#include "bench/core/bench_flags.hpp"
 #include "bench/core/ground_truth.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
@@ -280,30 +280,21 @@ void crossover(const Mesh& rest, Deformation d) {
 
 int main(int argc, char** argv) {
   using namespace bvhlab;
-  benchmark::Initialize(&argc, argv);
   std::string mesh_name = "bunny.obj", spec = "twist";
   std::vector<std::string> volumes{"aabb", "obb", "dop24"};
   int frames = 24;
   double distance = 1.6;
   bool run_crossover = false;
+  if (auto exit = initialize_benchmark("bench_refit",
+                                       {{"mesh", &mesh_name, "the deforming mesh"},
+                                        {"deformation", &spec, "a deformation (\"twist:amplitude=1.5\")"},
+                                        {"frames", &frames, "frames per pass"},
+                                        {"volumes", &volumes, "bounding volumes"},
+                                        {"distance", &distance, "distance of the second object"},
+                                        {"crossover", &run_crossover, "measure refit against rebuild only"}},
+                                       argc, argv))
+    return *exit;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (arg.rfind("--mesh=", 0) == 0)
-        mesh_name = arg.substr(7);
-      else if (arg.rfind("--deformation=", 0) == 0)
-        spec = arg.substr(14);
-      else if (arg.rfind("--frames=", 0) == 0)
-        frames = std::stoi(arg.substr(9));
-      else if (arg.rfind("--volumes=", 0) == 0)
-        volumes = split_list(arg.substr(10));
-      else if (arg.rfind("--distance=", 0) == 0)
-        distance = std::stod(arg.substr(11));
-      else if (arg == "--crossover")
-        run_crossover = true;
-      else
-        throw std::invalid_argument("unknown argument '" + arg + "'");
-    }
     if (frames < 1) throw std::invalid_argument("--frames must be at least 1");
     for (const auto& v : volumes) with_volume(v, [](auto) {});  // refuses unknown names
   } catch (const std::exception& e) {
