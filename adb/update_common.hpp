@@ -29,4 +29,25 @@ inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// The part of a policy without parameters whose state is only the tree it belongs to (CRTP: Policy
+/// provides name() and update()).
+template <class Policy>
+struct StatelessPolicy {
+  struct Params {
+    friend bool operator==(const Params&, const Params&) = default;
+  };
+  struct State {
+    std::size_t nodes = 0;
+  };
+
+  static std::span<const ParamSpec> parameters() { return {}; }
+  static Params make_params(const ParamValues&) { return {}; }
+
+  template <TreeVolume BV>
+  static State start(const Bvh<BV>& bvh, const AdbStorage& rest, const Params&) {
+    check_tree(Policy::name(), bvh.nodes().size(), bvh.nodes().size(), rest.possible_collision_cells.size());
+    return {bvh.nodes().size()};
+  }
+};
+
 }  // namespace bvhlab::density_update

@@ -6,24 +6,8 @@
 
 namespace bvhlab {
 
-struct RecountAllUpdate {
-  struct Params {
-    friend bool operator==(const Params&, const Params&) = default;
-  };
-  struct State {
-    std::size_t nodes = 0;
-  };
-
+struct RecountAllUpdate : density_update::StatelessPolicy<RecountAllUpdate> {
   static constexpr std::string_view name() { return "recount_all"; }
-  static std::span<const ParamSpec> parameters() { return {}; }
-  static Params make_params(const ParamValues&) { return {}; }
-
-  template <TreeVolume BV>
-  static State start(const Bvh<BV>& bvh, const AdbStorage& rest, const Params&) {
-    density_update::check_tree(name(), bvh.nodes().size(), bvh.nodes().size(),
-                               rest.possible_collision_cells.size());
-    return {bvh.nodes().size()};
-  }
 
   template <TreeVolume BV>
   static void update(const Bvh<BV>& bvh, AdbStorage& storage, State& state, const AnnotationContext& context,
