@@ -35,19 +35,14 @@ Scalar half_area(const Box& b) {
 
 class Builder {
  public:
-  Builder(const Mesh& mesh, std::span<const Vec3> directions, const BuildOptions& options)
-      : directions_(directions), options_(options) {
-    const std::size_t n = mesh.triangle_count();
-    centroids_.resize(n);
-    boxes_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto t = mesh.triangle(i);
-      Box b;
-      for (const auto& v : t) b.extend(v);
-      boxes_[i] = b;
-      centroids_[i] = (t[0] + t[1] + t[2]) / Scalar(3);
-    }
-  }
+  /// One primitive per centroid, with its box (a point's box is the point).
+  Builder(std::vector<Vec3> centroids, std::vector<Box> boxes, std::uint32_t max_leaf,
+          std::span<const Vec3> directions, const BuildOptions& options)
+      : directions_(directions),
+        options_(options),
+        max_leaf_(max_leaf),
+        centroids_(std::move(centroids)),
+        boxes_(std::move(boxes)) {}
 
   Topology run(unsigned threads) {
     const std::size_t n = centroids_.size();
@@ -56,7 +51,7 @@ class Builder {
     for (std::size_t i = 0; i < n; ++i) out.triangle_order[i] = static_cast<std::uint32_t>(i);
     order_ = out.triangle_order.data();
 
-    if (threads < 2 || n < 2 * kParallelThreshold || n <= options_.max_leaf_triangles) {
+    if (threads < 2 || n < 2 * kParallelThreshold || n <= max_leaf_) {
       Local whole = build_range(0, n);
       out.nodes = std::move(whole.nodes);
       out.depth = whole.depth;
@@ -95,7 +90,7 @@ class Builder {
       stack.pop_back();
       local.depth = std::max(local.depth, w.depth);
       const std::size_t count = w.end - w.begin;
-      if (count <= options_.max_leaf_triangles) {
+      if (count <= max_leaf_) {
         local.nodes[w.node] = {static_cast<std::uint32_t>(w.begin), static_cast<std::uint32_t>(count)};
         ++local.leaves;
         report_progress(count, false);
@@ -225,12 +220,17 @@ class Builder {
 
   std::span<const Vec3> directions_;
   const BuildOptions& options_;
+  std::uint32_t max_leaf_;
   std::vector<Vec3> centroids_;
   std::vector<Box> boxes_;
   std::uint32_t* order_ = nullptr;
   std::atomic<std::size_t> placed_{0};
   std::mutex progress_mutex_;
 };
+
+unsigned thread_count(const BuildOptions& options) {
+  return options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+}
 
 }  // namespace
 
@@ -259,10 +259,35 @@ Topology build_topology(const Mesh& mesh, std::span<const Vec3> split_directions
   if (mesh.triangles.size() >= std::numeric_limits<std::uint32_t>::max() / 2)
     throw std::invalid_argument("build: mesh '" + mesh.name +
                                 "' has too many triangles for 32-bit node indices");
-  const unsigned threads =
-      options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  Builder builder(mesh, split_directions, options);
-  return builder.run(threads);
+  const std::size_t n = mesh.triangle_count();
+  std::vector<Vec3> centroids(n);
+  std::vector<Box> boxes(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto t = mesh.triangle(i);
+    for (const auto& v : t) boxes[i].extend(v);
+    centroids[i] = (t[0] + t[1] + t[2]) / Scalar(3);
+  }
+  Builder builder(std::move(centroids), std::move(boxes), options.max_leaf_triangles, split_directions,
+                  options);
+  return builder.run(thread_count(options));
+}
+
+Topology build_topology(std::span<const Vec3> points, std::span<const Vec3> split_directions,
+                        const BuildOptions& options) {
+  if (points.empty()) throw std::invalid_argument("build: the point cloud has no points");
+  if (options.max_leaf_points == 0) throw std::invalid_argument("build: max_leaf_points must be at least 1");
+  if (split_directions.empty()) throw std::invalid_argument("build: no split directions");
+  if (points.size() >= std::numeric_limits<std::uint32_t>::max() / 2)
+    throw std::invalid_argument("build: too many points for 32-bit node indices");
+  std::vector<Box> boxes(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite())
+      throw std::invalid_argument("build: point " + std::to_string(i) + " is not finite");
+    boxes[i].extend(points[i]);
+  }
+  Builder builder(std::vector<Vec3>(points.begin(), points.end()), std::move(boxes), options.max_leaf_points,
+                  split_directions, options);
+  return builder.run(thread_count(options));
 }
 
 }  // namespace bvhlab

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "../volumes/concept.hpp"
+#include "point_cloud.hpp"
 #include "topology.hpp"
 
 #include <chrono>
@@ -18,6 +19,7 @@ struct BvhStats {
   std::size_t leaves = 0;
   std::uint32_t depth = 0;
   std::size_t triangles = 0;
+  std::size_t points = 0;          ///< of a tree over a point cloud (triangles is then 0)
   std::size_t bytes_per_node = 0;  ///< topology + volume, without polygons
   double bytes_per_triangle = 0;   ///< node bytes / triangles, without polygons
   double build_seconds = 0;
@@ -59,6 +61,26 @@ class Bvh {
     return out;
   }
 
+  /// A tree over a point cloud: the topology groups the points (options.max_leaf_points per leaf, see
+  /// build_topology), and each node's volume is fitted to the points below it. Such a tree holds points,
+  /// no polygons (has_points(), points(), point_ids()); refit() refuses it. Throws std::invalid_argument for
+  /// an empty cloud or a non-finite point.
+  static Bvh build(const PointCloud& cloud, const BuildOptions& options = {}) {
+    const auto start = std::chrono::steady_clock::now();
+    Bvh out;
+    Topology topology = build_topology(cloud.positions, split_directions_of<BV>(), options);
+    out.nodes_ = std::move(topology.nodes);
+    out.point_ids_ = std::move(topology.triangle_order);
+    out.points_.reserve(out.point_ids_.size());
+    for (std::uint32_t id : out.point_ids_) out.points_.push_back(cloud.positions[id]);
+    out.depth_ = topology.depth;
+    out.leaves_ = topology.leaves;
+    out.fit_volumes(options.threads ? options.threads : std::thread::hardware_concurrency());
+    out.built_spread_ = out.spread();
+    out.build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  }
+
   /// Assembles a tree from saved parts (no polygons: triangles may be empty).
   static Bvh from_parts(std::vector<TreeNode> nodes, std::vector<BV> volumes, std::vector<std::uint32_t> ids,
                         std::vector<TrianglePoints> triangles = {}, const Fitted& root = {}) {
@@ -83,6 +105,7 @@ class Bvh {
   /// vertex) and leaves the tree as it was. RefitMethod::Fit fits every node to its vertices instead, as the
   /// build does: O(triangles x depth), tighter for OBBs and spheres, whose merges loosen level by level.
   void refit(const Mesh& deformed, RefitMethod method = RefitMethod::Merge) {
+    if (has_points()) throw std::invalid_argument("refit: the tree was built over a point cloud, not a mesh");
     std::vector<TrianglePoints> moved = deformed_triangles(deformed);
     if (method == RefitMethod::Fit) {
       triangles_ = std::move(moved);
@@ -149,6 +172,11 @@ class Bvh {
   /// Tree order -> index of the triangle in the source mesh.
   [[nodiscard]] const std::vector<std::uint32_t>& triangle_ids() const { return triangle_ids_; }
   [[nodiscard]] bool empty() const { return nodes_.empty(); }
+  /// A tree over a point cloud: its points in tree order (a leaf's range indexes them), and tree order ->
+  /// index of the point in the cloud. Both empty for a tree over a mesh.
+  [[nodiscard]] bool has_points() const { return !points_.empty(); }
+  [[nodiscard]] const std::vector<Vec3>& points() const { return points_; }
+  [[nodiscard]] const std::vector<std::uint32_t>& point_ids() const { return point_ids_; }
 
   [[nodiscard]] BvhStats stats() const {
     BvhStats s;
@@ -156,6 +184,7 @@ class Bvh {
     s.leaves = leaves_;
     s.depth = depth_;
     s.triangles = triangle_ids_.size();
+    s.points = point_ids_.size();
     s.bytes_per_node = sizeof(TreeNode) + sizeof(BV);
     s.bytes_per_triangle = s.triangles ? double(s.nodes * s.bytes_per_node) / double(s.triangles) : 0;
     s.build_seconds = build_seconds_;
@@ -169,6 +198,9 @@ class Bvh {
     std::vector<Fitted> fitted(nodes_.size(), Fitted{});
     const auto ranges = node_triangle_ranges(nodes_);
     auto fit_range = [this, &ranges](std::uint32_t i) {
+      if (!points_.empty())
+        return Fitted::fit(
+            std::span<const Vec3>(points_).subspan(ranges[i].first, ranges[i].second - ranges[i].first));
       std::vector<Vec3> points;
       points.reserve(3 * (ranges[i].second - ranges[i].first));
       for (std::uint32_t t = ranges[i].first; t < ranges[i].second; ++t)
@@ -187,7 +219,7 @@ class Bvh {
         }
       }
     };
-    if (threads >= 2 && !nodes_[0].is_leaf() && triangles_.size() > 20'000) {
+    if (threads >= 2 && !nodes_[0].is_leaf() && triangles_.size() + points_.size() / 4 > 20'000) {
       fitted[0] = fit_range(0);
       std::thread worker(fit_subtree, nodes_[0].left());
       fit_subtree(nodes_[0].right());
@@ -338,6 +370,8 @@ class Bvh {
   std::vector<float> sizes_;
   std::vector<std::uint32_t> triangle_ids_;
   std::vector<TrianglePoints> triangles_;
+  std::vector<Vec3> points_;              ///< tree order; a tree over a point cloud only
+  std::vector<std::uint32_t> point_ids_;  ///< tree order -> cloud index
   std::uint32_t depth_ = 0;
   std::size_t leaves_ = 0;
   double build_seconds_ = 0;

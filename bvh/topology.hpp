@@ -32,6 +32,7 @@ SplitMethod split_method_from_string(std::string_view s);
 struct BuildOptions {
   SplitMethod split = SplitMethod::Sah;
   std::uint32_t max_leaf_triangles = 1;  ///< the DOP-tree uses one polygon per leaf
+  std::uint32_t max_leaf_points = 16;    ///< for trees over point clouds: 8 to 32 keeps leaf tests cheap
   unsigned threads = 0;                  ///< 0: hardware concurrency
   /// Called now and then with (triangles placed in leaves, total); may be called from worker threads,
   /// but never concurrently.
@@ -40,7 +41,7 @@ struct BuildOptions {
 
 struct Topology {
   std::vector<TreeNode> nodes;                ///< root at 0
-  std::vector<std::uint32_t> triangle_order;  ///< tree order -> mesh triangle index
+  std::vector<std::uint32_t> triangle_order;  ///< tree order -> mesh triangle (or cloud point) index
   std::uint32_t depth = 0;                    ///< edges on the longest root-leaf path
   std::uint32_t leaves = 0;
 };
@@ -52,6 +53,12 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> node_triangle_ranges(std::s
 /// Builds the topology over the triangles' centroids, trying the given split directions.
 /// Throws std::invalid_argument for an empty mesh or max_leaf_triangles == 0.
 Topology build_topology(const Mesh& mesh, std::span<const Vec3> split_directions,
+                        const BuildOptions& options);
+
+/// The same over points (each point its own centroid), max_leaf_points per leaf; leaves then hold points
+/// and triangle_order maps tree order to point indices. Throws std::invalid_argument for no points, a
+/// non-finite point (naming its index) or max_leaf_points == 0.
+Topology build_topology(std::span<const Vec3> points, std::span<const Vec3> split_directions,
                         const BuildOptions& options);
 
 }  // namespace bvhlab
