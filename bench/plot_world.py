@@ -6,7 +6,9 @@
                                     the per-pair strategies as horizontal references
   world_broad_phase_vs_objects.png  broad-phase time per frame (world boxes plus update and pair finding)
                                     against the object count, log-log (from world_scaling.csv; the scene's
-                                    own count when the scene asks for no scaling)
+                                    own count when the scene asks for no scaling, else as points beside the
+                                    lines); FCL's managers (rows of the hierarchy fcl_obbrss, timed at the
+                                    scene's own count only) as single points
 """
 import argparse
 import csv
@@ -78,6 +80,18 @@ def figure_errors_vs_budget(rows, out):
     plt.close(fig)
 
 
+FCL_HIERARCHY = "fcl_obbrss"  # world.hpp: kFclWorldHierarchy
+
+
+def scene_medians(broad):
+    """{(hierarchy, broad phase): {objects: median µs per frame of world boxes + update}} at the scene's count."""
+    points = defaultdict(dict)
+    for key, group in totals_by(broad, lambda r: (r["hierarchy"], r["broad_phase"])).items():
+        times = sorted(float(r["boxes_micros"]) + float(r["update_micros"]) for r in group)
+        points[key][int(group[0]["objects"])] = times[len(times) // 2]
+    return points
+
+
 def figure_broad_phase_vs_objects(scaling, broad, out):
     fig, ax = plt.subplots(figsize=(6.2, 4.4))
     points = defaultdict(dict)
@@ -86,12 +100,18 @@ def figure_broad_phase_vs_objects(scaling, broad, out):
             r["update_micros"]
         )
     if not points:
-        for key, group in totals_by(broad, lambda r: (r["hierarchy"], r["broad_phase"])).items():
-            times = sorted(float(r["boxes_micros"]) + float(r["update_micros"]) for r in group)
-            points[key][int(group[0]["objects"])] = times[len(times) // 2]
+        points = scene_medians(broad)
+    else:
+        # The scene's own frames as points apart (timed amid the narrow phases, not in a loop of their own),
+        # so that FCL's points have bvhlab's beside them.
+        for (hierarchy, name), by_count in scene_medians(broad).items():
+            if hierarchy == FCL_HIERARCHY or (hierarchy, name) in points:
+                points[(hierarchy + ", scene", name)] = by_count
     for (hierarchy, name), by_count in sorted(points.items()):
         xs = sorted(by_count)
-        ax.plot(xs, [by_count[x] for x in xs], marker="o", label=f"{name} ({hierarchy})")
+        alone = len(xs) == 1
+        ax.plot(xs, [by_count[x] for x in xs], marker="s" if hierarchy.startswith(FCL_HIERARCHY) else "o",
+                linestyle="none" if alone else "-", label=f"{name} ({hierarchy})")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("objects")

@@ -8,9 +8,15 @@
 #include "traversal/broad_phase/registry.hpp"
 #include "traversal/frame_budget.hpp"
 
+#ifdef BVHLAB_HAVE_FCL
+#include "bench/core/fcl_model.hpp"
+#endif
+
 #include <algorithm>
+#include <array>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -250,6 +256,114 @@ std::vector<Candidate> with_truth(WorldHierarchy& h, const Scene& scene, std::sp
   return out;
 }
 
+#ifdef BVHLAB_HAVE_FCL
+/// FCL's side of a world, once per frame (its models are not one of the scene's hierarchies): its managers
+/// on its own world boxes, timed as bvhlab's broad phases are (boxes, then update plus pair finding), and
+/// its narrow phase on the dynamic tree's pairs, each pair timed alone as run_variant times bvhlab's. Rows
+/// under the hierarchy kFclWorldHierarchy.
+class FclSide {
+ public:
+  FclSide(const Scene& scene, Preparation& preparation) : scene_(scene), world_(models(scene, preparation)) {}
+
+  void frame(int frame, std::span<const RigidTransform> poses,
+             const std::map<std::pair<std::uint32_t, std::uint32_t>, bool>& truth, int warmup,
+             WorldOutput& output) {
+    const auto start = Clock::now();
+    world_.place(poses);
+    const double boxes_micros = micros_since(start);
+    std::array<std::vector<ObjectPair>, FclWorld::kManagers.size()> pairs;
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const auto begin = Clock::now();
+      const std::vector<ObjectPair>& found = world_.pairs(k);
+      const double update_micros = micros_since(begin);
+      pairs[k] = found;
+      std::sort(pairs[k].begin(), pairs[k].end());
+      output.broad.push_back({frame, std::string(kFclWorldHierarchy), FclWorld::kManagers[k], world_.size(),
+                              pairs[k].size(), boxes_micros, update_micros});
+    }
+    output.series.push_back(narrow_phase(frame, pairs[0], truth, warmup));
+    check(frame, pairs, truth);
+  }
+
+ private:
+  /// One model per object (FCL's OBBRSS, as the pair runner's fcl_obbrss), shared by its instances.
+  static std::vector<std::shared_ptr<fcl::CollisionGeometryd>> models(const Scene& scene,
+                                                                      Preparation& preparation) {
+    std::map<std::string, std::shared_ptr<fcl::CollisionGeometryd>> by_object;
+    std::vector<std::shared_ptr<fcl::CollisionGeometryd>> out;
+    for (const WorldInstance& instance : scene.world->instances) {
+      auto& model = by_object[instance.object];
+      if (!model)
+        model = make_fcl_model<fcl::OBBRSSd>(preparation.object(*scene.object(instance.object)).mesh);
+      out.push_back(model);
+    }
+    return out;
+  }
+
+  static bool truth_of(const std::map<std::pair<std::uint32_t, std::uint32_t>, bool>& truth, ObjectPair p) {
+    const auto it = truth.find({p.a, p.b});
+    return it != truth.end() && it->second;  // not a candidate of bvhlab's: boxes apart
+  }
+
+  WorldSeriesRow narrow_phase(int frame, const std::vector<ObjectPair>& pairs,
+                              const std::map<std::pair<std::uint32_t, std::uint32_t>, bool>& truth,
+                              int warmup) {
+    WorldSeriesRow row;
+    row.frame = frame;
+    row.hierarchy = kFclWorldHierarchy;
+    row.series = "exact";
+    row.exact_strategy = true;
+    row.candidates = pairs.size();
+    colliding_.clear();
+    bool sink = false;
+    for (const ObjectPair& p : pairs) {
+      if (warmup > 0) sink ^= world_.collides(p);
+      const auto start = Clock::now();
+      const bool answer = world_.collides(p);
+      row.micros += micros_since(start);
+      const bool real = truth_of(truth, p);
+      row.colliding += real;
+      row.answered += answer;
+      row.missed += real && !answer;
+      row.false_pairs += !real && answer;
+      if (answer) colliding_.push_back(p);
+    }
+    if (sink && pairs.empty()) std::cerr << ' ';  // keeps the warm-up
+    return row;
+  }
+
+  /// FCL's colliding pairs (narrow phase on its dynamic tree's pairs) must be bvhlab's exact ones, and FCL's
+  /// SaP must have found each of them too.
+  void check(int frame, const std::array<std::vector<ObjectPair>, FclWorld::kManagers.size()>& pairs,
+             const std::map<std::pair<std::uint32_t, std::uint32_t>, bool>& truth) const {
+    std::vector<ObjectPair> ours;
+    for (const auto& [key, collides] : truth)
+      if (collides) ours.push_back({key.first, key.second});
+    std::vector<ObjectPair> only_fcl, only_ours;
+    std::set_difference(colliding_.begin(), colliding_.end(), ours.begin(), ours.end(),
+                        std::back_inserter(only_fcl));
+    std::set_difference(ours.begin(), ours.end(), colliding_.begin(), colliding_.end(),
+                        std::back_inserter(only_ours));
+    if (!only_fcl.empty())
+      fail(frame, only_fcl.front(), "FCL answers colliding, bvhlab's exact answer apart");
+    if (!only_ours.empty()) fail(frame, only_ours.front(), "bvhlab's exact answer is colliding, FCL's apart");
+    for (const ObjectPair& p : ours)
+      if (!std::binary_search(pairs[1].begin(), pairs[1].end(), p))
+        fail(frame, p, "colliding, but not a pair of FCL's SaP manager");
+  }
+
+  [[noreturn]] void fail(int frame, ObjectPair p, const std::string& what) const {
+    const auto& instances = scene_.world->instances;
+    throw std::runtime_error("world " + scene_.name + ", frame " + std::to_string(frame) + ": instances " +
+                             instances[p.a].name + " and " + instances[p.b].name + ": " + what);
+  }
+
+  const Scene& scene_;
+  FclWorld world_;
+  std::vector<ObjectPair> colliding_;  ///< FCL's colliding pairs of the frame, sorted
+};
+#endif
+
 }  // namespace
 
 WorldOutput run_world(const Scene& scene, const RunOptions& options) {
@@ -265,6 +379,9 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
   std::vector<std::unique_ptr<WorldHierarchy>> hierarchies;
   for (const PlannedHierarchy& planned : plan.hierarchies)
     hierarchies.push_back(std::make_unique<WorldHierarchy>(scene, planned, preparation));
+#ifdef BVHLAB_HAVE_FCL
+  FclSide fcl(scene, preparation);
+#endif
   for (int frame = 0; frame < scene.world->frames; ++frame) {
     const auto& poses = scene.world->poses[static_cast<std::size_t>(frame)];
     std::map<std::pair<std::uint32_t, std::uint32_t>, bool> truth;
@@ -281,6 +398,9 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
         output.series.push_back(std::move(row));
       }
     }
+#ifdef BVHLAB_HAVE_FCL
+    fcl.frame(frame, poses, truth, options.warmup_queries, output);
+#endif
   }
   for (int count : scene.world->scaling) {
     log("broad phases alone at " + std::to_string(count) + " objects");

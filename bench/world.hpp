@@ -2,7 +2,9 @@
 // the world box of every instance from its tree's root, each broad phase's candidate pairs (timed; all must
 // agree), the exact answer on every candidate pair (the ground truth: a pair the broad phase leaves out is
 // apart), then every per-pair strategy on every candidate pair and every frame budget shared across them,
-// each counted against the truth in pairs: missed (false negatives) and false (false positives).
+// each counted against the truth in pairs: missed (false negatives) and false (false positives). Where FCL
+// is built (BVHLAB_HAVE_FCL), FCL's broad-phase managers and narrow phase run on the same instances and
+// poses each frame, as rows of the hierarchy kFclWorldHierarchy, and must find the same colliding pairs.
 #pragma once
 
 #include "bench/core/scene.hpp"
@@ -13,9 +15,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace bvhlab {
+
+/// The hierarchy of FCL's rows in a world run: one OBBRSS model per object, in FCL's dynamic AABB tree and
+/// SaP managers (broad phases "fcl_dynamic_aabb_tree", "fcl_sap") and FCL's narrow phase (series "exact").
+inline constexpr std::string_view kFclWorldHierarchy = "fcl_obbrss";
 
 /// One frame of one series on one hierarchy.
 struct WorldSeriesRow {
@@ -40,8 +47,10 @@ struct BroadPhaseRow {
   int frame = 0;
   std::string hierarchy, broad_phase;
   std::size_t objects = 0, candidates = 0;
-  double boxes_micros = 0;   ///< the world boxes of every instance (shared by the broad phases)
-  double update_micros = 0;  ///< update plus pair finding
+  double boxes_micros = 0;   ///< the world boxes of every instance (shared by the broad phases); for FCL's
+                             ///< managers, setTransform and computeAABB of every object
+  double update_micros = 0;  ///< update plus pair finding (FCL: the manager's update or, in frame 0, its
+                             ///< registration, then its all-pairs collide collecting the pairs)
 };
 
 /// A broad phase alone at one object count (WorldSpec::scaling): medians over the frames.
