@@ -5,6 +5,7 @@
 #include "bench/core/registry.hpp"
 #include "bench/measure.hpp"
 #include "bench/prepare.hpp"
+#include "bench/report_tables.hpp"
 #include "bvh/deform.hpp"
 #include "bvh/mesh_sequence.hpp"
 
@@ -19,16 +20,6 @@
 namespace bvhlab {
 
 namespace {
-
-double micros_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
-  return values[values.size() / 2];
-}
 
 /// The deforming object's mesh in each frame: procedural or read from its files.
 class FrameSource {
@@ -72,7 +63,7 @@ void score(DeformRow& row, const FrameTruth& truth, const std::vector<QueryRecor
   }
   row.queries = answers.size();
   for (double m : micros) row.query_total_micros += m;
-  row.query_micros = median(std::move(micros));
+  row.query_micros = report_tables::median(std::move(micros));
 }
 
 /// Every variant of the scene's strategies that runs on `h`: exact ones on plain trees, the others on

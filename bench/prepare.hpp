@@ -23,6 +23,10 @@ namespace bvhlab {
 using LogFn = std::function<void(const std::string&)>;
 using Clock = std::chrono::steady_clock;
 
+inline double micros_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
+
 inline double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }

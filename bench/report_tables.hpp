@@ -1,4 +1,4 @@
-// Small helpers the report writers share: CSV files, nearest-rank quantiles and percentages for tables.
+// Small helpers the report writers and runners share: CSV files, nearest-rank quantiles and percentages.
 #pragma once
 
 #include <fmt/format.h>
@@ -24,6 +24,11 @@ inline double quantile(std::vector<double> values, double share) {
   std::sort(values.begin(), values.end());
   const auto rank = static_cast<std::size_t>(share * static_cast<double>(values.size() - 1) + 0.5);
   return values[std::min(rank, values.size() - 1)];
+}
+
+/// The median (the upper of the middle two for an even count: nearest rank); 0 for none.
+inline double median(std::vector<double> values) {
+  return quantile(std::move(values), 0.5);
 }
 
 /// part / whole in percent with two decimals, "-" for an empty whole.

@@ -5,6 +5,7 @@
 #include "bench/core/world_motion.hpp"
 #include "bench/plan.hpp"
 #include "bench/prepare.hpp"
+#include "bench/report_tables.hpp"
 #include "traversal/broad_phase/registry.hpp"
 #include "traversal/frame_budget.hpp"
 
@@ -26,20 +27,10 @@ namespace {
 
 constexpr int kScalingFrames = 10;
 
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
-  return values[values.size() / 2];
-}
-
 std::vector<std::string> instance_objects(const Scene& scene) {
   std::vector<std::string> objects;
   for (const WorldInstance& instance : scene.world->instances) objects.push_back(instance.object);
   return objects;
-}
-
-double micros_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
 }
 
 /// A candidate pair of one frame: the instances, the prepared trees of their objects and B's pose in A's.
@@ -137,8 +128,8 @@ class WorldHierarchy {
         update_micros.push_back(micros_since(begin));
       }
       rows.push_back({planned_.hierarchy->name, name, objects.size(),
-                      static_cast<std::size_t>(median(candidates)), median(boxes_micros),
-                      median(update_micros)});
+                      static_cast<std::size_t>(report_tables::median(candidates)),
+                      report_tables::median(boxes_micros), report_tables::median(update_micros)});
     }
     return rows;
   }
