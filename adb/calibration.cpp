@@ -14,9 +14,9 @@ namespace {
 constexpr std::string_view kMagic = "BVHLCAL1";
 constexpr std::size_t kHeaderBytes = 16, kKnotBytes = 16, kChecksumBytes = 8;
 
-/// A pooled run of samples: summed weight, reported probability and collisions.
+/// A pooled run of samples: its weight and collisions, and the range of probabilities it covers.
 struct Block {
-  double weight = 0, x_sum = 0, y_sum = 0;
+  double weight = 0, y_sum = 0, x_low = 0, x_high = 0;
   [[nodiscard]] double y() const { return y_sum / weight; }
 };
 
@@ -26,11 +26,10 @@ std::vector<Block> tied_blocks(std::span<const CalibrationSample> samples) {
             [](const auto& a, const auto& b) { return a.probability < b.probability; });
   std::vector<Block> blocks;
   for (std::size_t i = 0; i < sorted.size(); ++i) {
-    if (i == 0 || sorted[i].probability != sorted[i - 1].probability) blocks.push_back({});
-    Block& b = blocks.back();
-    b.weight += 1;
-    b.x_sum += sorted[i].probability;
-    b.y_sum += sorted[i].collided ? 1 : 0;
+    const double p = sorted[i].probability;
+    if (i == 0 || p != sorted[i - 1].probability) blocks.push_back({0, 0, p, p});
+    blocks.back().weight += 1;
+    blocks.back().y_sum += sorted[i].collided ? 1 : 0;
   }
   return blocks;
 }
@@ -44,8 +43,8 @@ std::vector<Block> pool_adjacent_violators(const std::vector<Block>& blocks) {
       const Block top = stack.back();
       stack.pop_back();
       stack.back().weight += top.weight;
-      stack.back().x_sum += top.x_sum;
       stack.back().y_sum += top.y_sum;
+      stack.back().x_high = top.x_high;
     }
   }
   return stack;
@@ -90,13 +89,15 @@ CalibrationMap CalibrationMap::fit(std::span<const CalibrationSample> samples) {
     if (!(s.probability >= 0 && s.probability <= 1))
       throw CalibrationError("calibration fit: probability " + std::to_string(s.probability) +
                              " is not a number in [0, 1]");
+  // A knot at each end of each block: every training probability maps to its block's frequency, as the
+  // fit says. (Knots at the block means alone would move answers far from their block's mean towards the
+  // neighbouring blocks, and ADB reports few distinct values, so a block's mass often sits at one end.)
   std::vector<Knot> knots;
-  for (const Block& b : pool_adjacent_violators(tied_blocks(samples)))
-    knots.push_back({std::clamp(b.x_sum / b.weight, 0.0, 1.0), std::clamp(b.y(), 0.0, 1.0)});
-  // Rounding in the mean of a pooled block could put two knots' x within an ulp; keep the map a function.
-  knots.erase(
-      std::unique(knots.begin(), knots.end(), [](const Knot& a, const Knot& b) { return b.x <= a.x; }),
-      knots.end());
+  for (const Block& b : pool_adjacent_violators(tied_blocks(samples))) {
+    const double y = std::clamp(b.y(), 0.0, 1.0);
+    knots.push_back({b.x_low, y});
+    if (b.x_high > b.x_low) knots.push_back({b.x_high, y});
+  }
   return CalibrationMap(std::move(knots));
 }
 

@@ -2,8 +2,10 @@
 // to the collision frequency observed for it, fitted by isotonic regression (pool adjacent violators) on
 // (probability, collided) samples of a training pose set.
 //
-// The map is piecewise linear through its knots (one per pooled block: the block's mean reported probability
-// and its observed frequency), non-decreasing and within [0, 1]. Where the training set had no samples it
+// The map is piecewise linear through its knots, non-decreasing and within [0, 1]: two per pooled block, at
+// the lowest and the highest probability the block holds, both at its observed frequency (one when the
+// block holds a single probability), so that every training answer maps to its block's frequency and the
+// map only interpolates between blocks. Where the training set had no samples it
 // falls back to the identity: below the first knot it runs linearly from (0, 0), above the last one to
 // (1, 1), and a map without knots is the identity. Monotone by construction: ranking answers by probability
 // is the same before and after the map (up to ties).

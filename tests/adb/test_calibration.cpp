@@ -18,7 +18,7 @@ using Knot = CalibrationMap::Knot;
 
 /// Isotonic regression by its closed form: the value at distinct probability i is
 /// max over j <= i of min over k >= i of the mean frequency of distinct probabilities j..k (weighted by
-/// their sample counts); runs of equal values become one knot at their mean probability.
+/// their sample counts); a run of equal values becomes knots at its lowest and highest probability.
 std::vector<Knot> reference_knots(std::vector<CalibrationSample> samples) {
   std::sort(samples.begin(), samples.end(),
             [](const auto& a, const auto& b) { return a.probability < b.probability; });
@@ -49,11 +49,10 @@ std::vector<Knot> reference_knots(std::vector<CalibrationSample> samples) {
   }
   std::vector<Knot> knots;
   for (std::size_t i = 0; i < n;) {
-    double w = 0, xw = 0;
     std::size_t end = i;
-    for (; end < n && std::abs(value[end] - value[i]) < 1e-12; ++end)
-      w += weight[end], xw += weight[end] * xs[end];
-    knots.push_back({xw / w, value[i]});
+    while (end < n && std::abs(value[end] - value[i]) < 1e-12) ++end;
+    knots.push_back({xs[i], value[i]});
+    if (end - 1 > i) knots.push_back({xs[end - 1], value[i]});
     i = end;
   }
   return knots;
