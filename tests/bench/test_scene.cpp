@@ -327,6 +327,11 @@ TEST_F(SceneTest, CalibrationDrawsHeldOutTrainingPoses) {
   };
   for (const auto& [text, expected] : bad)
     EXPECT_NE(error_of(text).find(expected), std::string::npos) << error_of(text);
+  testing::write_text(dir / "poses.json", R"({"poses": [{"translation": [1, 0, 0]}]})");
+  EXPECT_NE(error_of(with(R"("calibration": {"training_seed": 1, "training_steps": 5})",
+                          R"("workload": {"type": "poses", "file": "poses.json"})"))
+                .find("/calibration: needs a protocol or random workload"),
+            std::string::npos);
 }
 
 TEST_F(SceneTest, AdbRunsOnEveryRegisteredVolume) {
