@@ -295,10 +295,6 @@ GroupRecords Measurement::time_group(const PreparedPair& pair, std::size_t g) {
   return series;
 }
 
-}  // namespace bvhlab
-
-namespace bvhlab {
-
 SeriesMaps Measurement::calibration_maps(const PreparedPair& pair, Preparation& preparation) {
   const auto& planned = plan_.hierarchies;
   SeriesMaps maps(planned.size());
