@@ -46,7 +46,7 @@ std::vector<TruthSummary> summarize_truth(const std::string& label, const Worklo
 
 void Aggregation::add_group(const PreparedPair& pair, const RunPlan& plan, std::size_t g,
                             const std::vector<std::uint8_t>& truth, const GroupRecords& records,
-                            RunOutput& output) {
+                            RunOutput& output, const SeriesMaps& maps) {
   const PoseGroup& group = output.scene.workload.groups[g];
   for (std::size_t i = 0; i < plan.hierarchies.size(); ++i) {
     const HierarchySpec& h = *plan.hierarchies[i].hierarchy;
@@ -56,9 +56,15 @@ void Aggregation::add_group(const PreparedPair& pair, const RunPlan& plan, std::
       ResultRow row = series_row(pair.label, h, hierarchy.model, variant, group.distance);
       const std::string key = pair.label + "\x1f" + h.name + "\x1f" + variant.label();
       tally(records[i][v], truth, key, hierarchy.has_counters(), row, output.stats);
-      if (!row.exact_strategy && !series_.count(key)) {
-        series_[key] = CalibrationBin{pair.label, h.name, row.strategy, row.budget, row.p_min};
-        order_.push_back(key);
+      const CalibrationBin series{pair.label, h.name, row.strategy, row.budget, row.p_min};
+      if (!row.exact_strategy) register_series(key, series);
+      if (i < maps.size() && v < maps[i].size() && maps[i][v]) {
+        const std::string calibrated_key = key + "\x1f" + "calibrated";
+        CalibrationBin calibrated = series;
+        calibrated.calibrated = true;
+        register_series(calibrated_key, calibrated);
+        for (std::size_t k = 0; k < records[i][v].size(); ++k)
+          bin(calibrated_key, (*maps[i][v])(records[i][v][k].probability), truth[k] != 0);
       }
       if (per_pose_ != PerPose::none)
         keep_poses(records[i][v], truth, g, output.rows.size(), hierarchy.has_counters(), output.poses);
@@ -87,14 +93,7 @@ void Aggregation::tally(const std::vector<QueryRecord>& records, const std::vect
     sum_us += micros;
     max_us = std::max(max_us, micros);
     counters += r.counters;
-    if (calibrate) {
-      auto& acc = bins_[series_key];
-      const std::size_t bin =
-          std::min<std::size_t>(9, static_cast<std::size_t>(std::max(0.0, r.probability) * 10));
-      ++acc.count[bin];
-      acc.probability_sum[bin] += r.probability;
-      acc.colliding[bin] += truly;
-    }
+    if (calibrate) bin(series_key, r.probability, truly);
   }
   const double n = std::max<double>(1.0, double(records.size()));
   row.truth_colliding_rate = double(truth_yes) / n;
@@ -114,6 +113,20 @@ void Aggregation::tally(const std::vector<QueryRecord>& records, const std::vect
   }
   stats.queries += records.size();
   stats.query_seconds += sum_us * 1e-6;
+}
+
+void Aggregation::bin(const std::string& series_key, double probability, bool truly) {
+  auto& acc = bins_[series_key];
+  const std::size_t b = std::min<std::size_t>(9, static_cast<std::size_t>(std::max(0.0, probability) * 10));
+  ++acc.count[b];
+  acc.probability_sum[b] += probability;
+  acc.colliding[b] += truly;
+}
+
+void Aggregation::register_series(const std::string& key, const CalibrationBin& series) {
+  if (series_.count(key)) return;
+  series_[key] = series;
+  order_.push_back(key);
 }
 
 void Aggregation::keep_poses(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,

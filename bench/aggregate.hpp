@@ -26,9 +26,12 @@ class Aggregation {
       : clock_overhead_us_(clock_overhead_us), per_pose_(per_pose) {}
   /// One row per planned series of the pair on pose group `g` of the scene's workload (`truth`: its ground
   /// truth), appended to output.rows in plan order; the queries and their time are added to output.stats,
-  /// and the queries per_pose asks for to output.poses.
+  /// and the queries per_pose asks for to output.poses. A series with a map in `maps` is also binned a second
+  /// time, its probabilities through the map (a calibrated series: calibration bins only, since its answers,
+  /// times and counters are the raw series').
   void add_group(const PreparedPair& pair, const RunPlan& plan, std::size_t g,
-                 const std::vector<std::uint8_t>& truth, const GroupRecords& records, RunOutput& output);
+                 const std::vector<std::uint8_t>& truth, const GroupRecords& records, RunOutput& output,
+                 const SeriesMaps& maps = {});
   /// Ten probability bins per inexact series, series in the order they first appeared.
   [[nodiscard]] std::vector<CalibrationBin> calibration() const;
 
@@ -43,6 +46,10 @@ class Aggregation {
   /// bins if it is inexact.
   void tally(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,
              const std::string& series_key, bool has_counters, ResultRow& row, RunStats& stats);
+  /// Adds one answer to a series' bins.
+  void bin(const std::string& series_key, double probability, bool truly);
+  /// Registers a binned series (once), in order of first appearance.
+  void register_series(const std::string& key, const CalibrationBin& series);
 
   /// The queries of one series that per_pose_ asks for, as rows of poses.csv for output row `row`.
   void keep_poses(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,

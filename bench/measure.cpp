@@ -1,6 +1,7 @@
 #include "bench/measure.hpp"
 
 #include "bench/core/ground_truth.hpp"
+#include "bench/core/policies.hpp"
 #include "bench/core/tree_cache.hpp"
 
 #include <unistd.h>
@@ -124,6 +125,43 @@ std::filesystem::path TruthCache::file_of(const std::string& key) const {
 }
 
 // ---------------------------------------------------------------------------------------------------------
+// Calibration maps on disk.
+
+std::optional<CalibrationMap> CalibrationCache::load(const std::string& key, std::string* why) const {
+  if (dir_.empty()) return std::nullopt;
+  const auto file = file_of(key);
+  if (!std::filesystem::exists(file)) return std::nullopt;
+  try {
+    const std::vector<std::byte> bytes = tree_cache_detail::read_file_bytes(file);
+    Reader in{bytes};
+    if (in.u64() != ContentHash().update(key).digest())
+      throw std::runtime_error("stale: made for another key");
+    return CalibrationMap::decode(std::span(bytes).subspan(in.position), "map");
+  } catch (const std::exception& e) {
+    *why = file.filename().string() + ": " + e.what();
+    return std::nullopt;
+  }
+}
+
+void CalibrationCache::store(const std::string& key, const CalibrationMap& map, const LogFn& log) const {
+  if (dir_.empty()) return;
+  std::vector<std::byte> out;
+  const std::uint64_t digest = ContentHash().update(key).digest();
+  for (int i = 0; i < 8; ++i) out.push_back(static_cast<std::byte>((digest >> (8 * i)) & 0xff));
+  const std::vector<std::byte> body = map.encode();
+  out.insert(out.end(), body.begin(), body.end());
+  try {
+    tree_cache_detail::write_file_bytes(file_of(key), out);
+  } catch (const std::exception& e) {
+    log(std::string("calibration cache: could not store (") + e.what() + ")");
+  }
+}
+
+std::filesystem::path CalibrationCache::file_of(const std::string& key) const {
+  return dir_ / (ContentHash().update(key).hex() + ".calib");
+}
+
+// ---------------------------------------------------------------------------------------------------------
 // Progress.
 
 Progress::Progress(bool enabled, std::size_t total)
@@ -163,31 +201,38 @@ Measurement::Measurement(const Scene& scene, const RunPlan& plan, const RunOptio
       threads_(threads),
       warmup_(options.warmup_queries),
       truth_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "truth"),
+      calibration_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "calibration"),
       progress_(options.progress, plan.total_queries) {}
 
 Truth Measurement::ground_truth(const PreparedPair& pair, Preparation& preparation) {
   const auto truth_start = Clock::now();
-  const std::string truth_key =
-      "truth v1|A=" + pair.a->key + "|B=" + pair.b->key + "|" + scene_.workload.identity;
+  Truth truth = cached_truth(pair, preparation, scene_.workload);
+  cross_check(pair, truth);
+  stats_.truth_seconds += seconds_since(truth_start);
+  return truth;
+}
+
+Truth Measurement::cached_truth(const PreparedPair& pair, Preparation& preparation,
+                                const WorkloadSpec& workload) {
+  const std::string truth_key = "truth v1|A=" + pair.a->key + "|B=" + pair.b->key + "|" + workload.identity;
   std::string why;
-  std::optional<Truth> truth = truth_cache_.load(truth_key, scene_.workload, &why);
+  std::optional<Truth> truth = truth_cache_.load(truth_key, workload, &why);
   if (truth) {
     ++stats_.truth_cache_hits;
-  } else {
-    if (!why.empty()) {
-      ++stats_.truth_cache_rejected;
-      log_("truth cache: rejected " + why + "; recomputing");
-    }
-    truth = compute_truth(pair, preparation);
-    ++stats_.truth_computed;
-    truth_cache_.store(truth_key, *truth, log_);
+    return std::move(*truth);
   }
-  cross_check(pair, *truth);
-  stats_.truth_seconds += seconds_since(truth_start);
+  if (!why.empty()) {
+    ++stats_.truth_cache_rejected;
+    log_("truth cache: rejected " + why + "; recomputing");
+  }
+  truth = compute_truth(pair, preparation, workload);
+  ++stats_.truth_computed;
+  truth_cache_.store(truth_key, *truth, log_);
   return std::move(*truth);
 }
 
-Truth Measurement::compute_truth(const PreparedPair& pair, Preparation& preparation) {
+Truth Measurement::compute_truth(const PreparedPair& pair, Preparation& preparation,
+                                 const WorkloadSpec& workload) {
   const PreparedHierarchy* exact = nullptr;
   for (std::size_t i = 0; i < plan_.hierarchies.size() && !exact; ++i)
     if (!plan_.hierarchies[i].hierarchy->is_fcl()) exact = pair.hierarchies[i].get();
@@ -196,8 +241,9 @@ Truth Measurement::compute_truth(const PreparedPair& pair, Preparation& preparat
     fallback = preparation.plain_aabb(*pair.a, *pair.b);
     exact = fallback.get();
   }
-  log_("computing the ground truth of " + pair.label + " (exact traversal)");
-  return exact_truth(scene_.workload, *exact, threads_);
+  log_("computing the ground truth of " + pair.label +
+       (&workload == &scene_.workload ? "" : "'s training poses") + " (exact traversal)");
+  return exact_truth(workload, *exact, threads_);
 }
 
 // Against CGAL on poses spread evenly over the whole workload.
@@ -247,6 +293,46 @@ GroupRecords Measurement::time_group(const PreparedPair& pair, std::size_t g) {
     progress_.advance(done, pair.label + " d=" + distance);
   }
   return series;
+}
+
+SeriesMaps Measurement::calibration_maps(const PreparedPair& pair, Preparation& preparation) {
+  const auto& planned = plan_.hierarchies;
+  SeriesMaps maps(planned.size());
+  for (std::size_t i = 0; i < planned.size(); ++i) maps[i].resize(planned[i].variants.size());
+  if (!scene_.calibration) return maps;
+  const WorkloadSpec& training = scene_.calibration->training;
+  std::optional<Truth> truth;  // computed only when some map is not cached
+  std::vector<QueryRecord> records;
+  for (std::size_t i = 0; i < planned.size(); ++i) {
+    const HierarchySpec& h = *planned[i].hierarchy;
+    for (std::size_t v = 0; v < planned[i].variants.size(); ++v) {
+      const StrategyVariant& variant = planned[i].variants[v];
+      if (strategy_info(variant.strategy).exact) continue;
+      const std::string key = "calibration v1|A=" + pair.a->key + "|B=" + pair.b->key +
+                              "|hierarchy=" + h.name + "|bv=" + h.bv +
+                              "|split=" + std::string(to_string(h.build.split)) +
+                              "|leaf=" + std::to_string(h.build.max_leaf_triangles) +
+                              "|annotation=" + pair.hierarchies[i]->model.annotation +
+                              "|series=" + variant.label() + "|" + training.identity;
+      std::string why;
+      if ((maps[i][v] = calibration_cache_.load(key, &why))) {
+        ++stats_.calibration_cache_hits;
+        continue;
+      }
+      if (!why.empty()) log_("calibration cache: rejected " + why + "; fitting again");
+      if (!truth) truth = cached_truth(pair, preparation, training);
+      std::vector<CalibrationSample> samples;
+      for (std::size_t g = 0; g < training.groups.size(); ++g) {
+        pair.hierarchies[i]->run(variant, training.groups[g].poses, 0, records);
+        for (std::size_t k = 0; k < records.size(); ++k)
+          samples.push_back({std::clamp(records[k].probability, 0.0, 1.0), (*truth)[g][k] != 0});
+      }
+      maps[i][v] = CalibrationMap::fit(samples);
+      ++stats_.calibration_fitted;
+      calibration_cache_.store(key, *maps[i][v], log_);
+    }
+  }
+  return maps;
 }
 
 }  // namespace bvhlab

@@ -3,6 +3,7 @@
 // series timed on the same poses. Internal to the runner (bench/run.cpp).
 #pragma once
 
+#include "adb/calibration.hpp"
 #include "bench/prepare.hpp"
 
 #include <algorithm>
@@ -94,6 +95,24 @@ class Progress {
 /// One pose group's timed records: [planned hierarchy][variant][pose].
 using GroupRecords = std::vector<std::vector<std::vector<QueryRecord>>>;
 
+/// Per planned series, [hierarchy][variant]: its calibration map, or none (exact series, or no
+/// "calibration").
+using SeriesMaps = std::vector<std::vector<std::optional<CalibrationMap>>>;
+
+/// Calibration maps on disk, one file per key (the pair's trees, the series and the training poses): the
+/// key's hash, then the map's own checked encoding. An empty directory: nothing is read or written.
+class CalibrationCache {
+ public:
+  explicit CalibrationCache(std::filesystem::path dir) : dir_(std::move(dir)) {}
+  /// The cached map, or nothing; `why` names a file that was there but stale or corrupt.
+  std::optional<CalibrationMap> load(const std::string& key, std::string* why) const;
+  void store(const std::string& key, const CalibrationMap& map, const LogFn& log) const;
+  [[nodiscard]] std::filesystem::path file_of(const std::string& key) const;
+
+ private:
+  std::filesystem::path dir_;
+};
+
 /// The measure stage of one run.
 class Measurement {
  public:
@@ -104,9 +123,13 @@ class Measurement {
   Truth ground_truth(const PreparedPair& pair, Preparation& preparation);
   /// Every planned series of the pair on pose group `g`.
   GroupRecords time_group(const PreparedPair& pair, std::size_t g);
+  /// With the scene's "calibration": every inexact series' map, from the disk cache or fitted on the training
+  /// poses against their exact truth (itself cached like the workload's). Without: no maps.
+  SeriesMaps calibration_maps(const PreparedPair& pair, Preparation& preparation);
 
  private:
-  Truth compute_truth(const PreparedPair& pair, Preparation& preparation);
+  Truth compute_truth(const PreparedPair& pair, Preparation& preparation, const WorkloadSpec& workload);
+  Truth cached_truth(const PreparedPair& pair, Preparation& preparation, const WorkloadSpec& workload);
   void cross_check(const PreparedPair& pair, const Truth& truth);
 
   const Scene& scene_;
@@ -116,6 +139,7 @@ class Measurement {
   unsigned threads_;
   int warmup_;
   TruthCache truth_cache_;
+  CalibrationCache calibration_cache_;
   Progress progress_;
   std::vector<QueryRecord> block_records_;
 };

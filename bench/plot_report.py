@@ -313,17 +313,34 @@ def p_min_of(value):
 def calibration_series(calibration, rows):
     """{(mesh, series key): the series' bins by bin_low}, in first-appearance order. The key is results.csv's
     (hierarchy, label), found by (mesh, hierarchy, strategy, p_min, budget), so a series has the colour and
-    name it has in the other figures."""
+    name it has in the other figures; a calibrated series (calibration.csv's "calibrated" column) is its raw
+    series' key with " calibrated" after the label, drawn next to it."""
     labels = {(r["mesh"], r["hierarchy"], r["strategy"], p_min_of(r["p_min"]), r["budget"]): r
               for r in rows if not is_exact(r)}
     out = {}
     for b in calibration:
         row = labels.get((b["mesh"], b["hierarchy"], b["strategy"], p_min_of(b["p_min"]), b["budget"]))
         key = series_key(row) if row else series_key(b)
+        if is_calibrated(b):
+            key = (key[0], key[1] + " calibrated" if isinstance(key[1], str) else (*key[1], "calibrated"))
         out.setdefault((b["mesh"], key), []).append(b)
     for bins in out.values():
         bins.sort(key=lambda b: num(b["bin_low"]))
     return out
+
+
+def is_calibrated(b):
+    return str(b.get("calibrated", "0")).lower() in ("1", "true")
+
+
+def raw_series_key(key):
+    """The key of the raw series a calibrated series key was made from (calibration_series)."""
+    hierarchy, label = key
+    if isinstance(label, str) and label.endswith(" calibrated"):
+        return hierarchy, label[:-len(" calibrated")]
+    if isinstance(label, tuple) and label and label[-1] == "calibrated":
+        return hierarchy, label[:-1]
+    return key
 
 
 def calibration_line(bins):
@@ -410,7 +427,7 @@ def draw_calibration(calibration, rows, columns=4, size=3.1):
             ax = grid[first_row + i // columns][i % columns]
             axes_of[key] = ax
             hierarchy, label = key[1]
-            colour = colours.get(key[1], "black")
+            colour = colours.get(raw_series_key(key[1]), "black")
             draw_calibration_panel(ax, series[key], colour)
             name = series_label({"label": label}) if isinstance(label, str) else " ".join(label)
             ax.set_title(f"{mesh} · {hierarchy}\n{name}", fontsize=8, color=colour, pad=12)

@@ -244,19 +244,21 @@ namespace {
 
 bool same_series(const CalibrationBin& b, const CalibrationSummary& s) {
   return b.mesh == s.mesh && b.hierarchy == s.hierarchy && b.strategy == s.strategy && b.p_min == s.p_min &&
-         b.budget == s.budget;
+         b.budget == s.budget && b.calibrated == s.calibrated;
 }
 
-/// The label results.csv gives the series, or one made of its parts when the rows do not have it.
+/// The label results.csv gives the series, or one made of its parts when the rows do not have it; a
+/// calibrated series is its raw series' label followed by " calibrated".
 std::string calibration_label(const CalibrationBin& b, const std::vector<ResultRow>& rows) {
+  const std::string suffix = b.calibrated ? " calibrated" : "";
   for (const ResultRow& r : rows)
     if (r.mesh == b.mesh && r.hierarchy == b.hierarchy && r.strategy == b.strategy && r.p_min == b.p_min &&
         r.budget == b.budget)
-      return r.label;
+      return r.label + suffix;
   std::string label = b.strategy;
   if (b.p_min >= 0) label += " p_min=" + fmt("%g", b.p_min);
   if (!b.budget.empty()) label += " " + b.budget;
-  return label;
+  return label + suffix;
 }
 
 /// Folds one bin into its series' summary.
@@ -293,6 +295,7 @@ std::vector<CalibrationSummary> calibration_summary(const std::vector<Calibratio
       s.strategy = b.strategy;
       s.budget = b.budget;
       s.p_min = b.p_min;
+      s.calibrated = b.calibrated;
       s.label = calibration_label(b, rows);
       s.max_gap = std::numeric_limits<double>::quiet_NaN();
       it = out.insert(out.end(), s);
@@ -501,6 +504,14 @@ void readme_calibration(std::ostream& md, const RunOutput& run) {
     if (s.meets) meeting.push_back(s.mesh + " " + s.hierarchy + " " + s.label);
   }
   md << "\n";
+  if (const auto& c = run.scene.calibration) {
+    md << "A series marked *calibrated* is its raw series' answers with each probability passed through a "
+          "monotone map fitted on held-out training poses ("
+       << c->training_steps
+       << (run.scene.workload.kind == WorkloadSpec::Kind::Random ? " in all" : " per distance") << ", seed "
+       << c->training_seed
+       << ", scene field `calibration`): its decisions, times and errors are the raw series'.\n\n";
+  }
   if (meeting.empty()) {
     md << "No series meets the target.\n\n";
     return;

@@ -53,6 +53,7 @@ std::vector<OperatingPoint> operating_points(const RunOutput& run);
 struct CalibrationSummary {
   std::string mesh, hierarchy, strategy, label, budget;
   double p_min = -1;
+  bool calibrated = false;          ///< the series' probabilities through its calibration map
   std::size_t answers = 0;          ///< over all deciles
   std::size_t qualifying_bins = 0;  ///< deciles holding at least min_answers
   double max_gap = 0;               ///< largest |mean reported - observed| over those; NaN if none

@@ -129,10 +129,11 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
   for (const ScenePair* scene_pair : plan.pairs) {
     const PreparedPair pair = preparation.pair(scene, *scene_pair, plan);
     const Truth truth = measurement.ground_truth(pair, preparation);
+    const SeriesMaps maps = measurement.calibration_maps(pair, preparation);
     for (const TruthSummary& summary : summarize_truth(pair.label, scene.workload, truth))
       output.truth.push_back(summary);
     for (std::size_t g = 0; g < scene.workload.groups.size(); ++g)
-      aggregation.add_group(pair, plan, g, truth[g], measurement.time_group(pair, g), output);
+      aggregation.add_group(pair, plan, g, truth[g], measurement.time_group(pair, g), output, maps);
   }
 
   output.calibration = aggregation.calibration();

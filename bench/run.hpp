@@ -49,9 +49,11 @@ struct RunStats {
   std::size_t truth_computed = 0;  ///< pose sets whose ground truth was computed
   std::size_t truth_cache_hits = 0;
   std::size_t truth_cache_rejected = 0;
-  std::size_t cgal_checked = 0;     ///< poses cross-checked against CGAL
-  std::size_t cgal_mismatches = 0;  ///< of those, where CGAL disagreed with the ground truth
-  std::size_t queries = 0;          ///< timed queries
+  std::size_t calibration_fitted = 0;      ///< calibration maps fitted on training poses
+  std::size_t calibration_cache_hits = 0;  ///< calibration maps loaded from the disk cache
+  std::size_t cgal_checked = 0;            ///< poses cross-checked against CGAL
+  std::size_t cgal_mismatches = 0;         ///< of those, where CGAL disagreed with the ground truth
+  std::size_t queries = 0;                 ///< timed queries
   double preprocess_seconds = 0;
   double truth_seconds = 0;
   double query_seconds = 0;  ///< sum of the timed queries only
@@ -83,6 +85,8 @@ struct ResultRow {
 struct CalibrationBin {
   std::string mesh, hierarchy, strategy, budget;
   double p_min = -1;
+  /// The series' probabilities through its calibration map (the scene's "calibration"), not as reported.
+  bool calibrated = false;
   double bin_low = 0, bin_high = 0;
   std::size_t count = 0;
   double mean_probability = 0;

@@ -216,12 +216,13 @@ json poses_document(const RunOutput& run) {
 
 void write_calibration_csv(const RunOutput& run, const std::filesystem::path& file) {
   std::ofstream out = open_output(file);
-  out << "mesh,hierarchy,strategy,p_min,budget,bin_low,bin_high,count,mean_probability,collision_frequency\n";
+  out << "mesh,hierarchy,strategy,p_min,budget,calibrated,bin_low,bin_high,count,mean_probability,"
+         "collision_frequency\n";
   for (const CalibrationBin& c : run.calibration)
     out << csv_field(c.mesh) << ',' << csv_field(c.hierarchy) << ',' << c.strategy << ','
-        << csv_p_min(c.p_min) << ',' << csv_field(c.budget) << ',' << csv_number(c.bin_low) << ','
-        << csv_number(c.bin_high) << ',' << c.count << ',' << csv_number(c.mean_probability) << ','
-        << csv_number(c.collision_frequency) << '\n';
+        << csv_p_min(c.p_min) << ',' << csv_field(c.budget) << ',' << (c.calibrated ? 1 : 0) << ','
+        << csv_number(c.bin_low) << ',' << csv_number(c.bin_high) << ',' << c.count << ','
+        << csv_number(c.mean_probability) << ',' << csv_number(c.collision_frequency) << '\n';
   if (!out) throw std::runtime_error(file.string() + ": write error");
 }
 
@@ -246,6 +247,8 @@ json results_document(const RunOutput& run) {
                   {"truth_computed", s.truth_computed},
                   {"truth_cache_hits", s.truth_cache_hits},
                   {"truth_cache_rejected", s.truth_cache_rejected},
+                  {"calibration_fitted", s.calibration_fitted},
+                  {"calibration_cache_hits", s.calibration_cache_hits},
                   {"cgal_checked", s.cgal_checked},
                   {"cgal_mismatches", s.cgal_mismatches},
                   {"queries", s.queries},
@@ -289,6 +292,7 @@ json results_document(const RunOutput& run) {
                    {"strategy", c.strategy},
                    {"p_min", c.p_min < 0 ? json(nullptr) : json(c.p_min)},
                    {"budget", c.budget},
+                   {"calibrated", c.calibrated},
                    {"bin_low", c.bin_low},
                    {"bin_high", c.bin_high},
                    {"count", c.count},

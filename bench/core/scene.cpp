@@ -17,7 +17,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <numbers>
 #include <optional>
+#include <random>
 #include <set>
 #include <sstream>
 
@@ -655,6 +657,69 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
   }
 }
 
+/// Fails unless no training pose equals (bit for bit) a pose of the workload.
+void check_disjoint(const Node& at, const WorkloadSpec& training, const WorkloadSpec& test) {
+  auto bits = [](const RigidTransform& p) {
+    std::string out(reinterpret_cast<const char*>(p.rotation.data()), 9 * sizeof(double));
+    return out.append(reinterpret_cast<const char*>(p.translation.data()), 3 * sizeof(double));
+  };
+  std::set<std::string> seen;
+  for (const PoseGroup& g : test.groups)
+    for (const RigidTransform& p : g.poses) seen.insert(bits(p));
+  for (const PoseGroup& g : training.groups)
+    for (const RigidTransform& p : g.poses)
+      if (seen.count(bits(p)))
+        at.fail("a training pose at distance " + std::to_string(g.distance) +
+                " equals a test pose; choose another training_seed");
+}
+
+/// "calibration": the training pose set, drawn like the workload's poses from another seed.
+void parse_calibration(const Node& root, Scene& scene) {
+  if (!root.has("calibration")) return;
+  const Node c = root.child("calibration");
+  c.expect_object({"training_seed", "training_steps"});
+  CalibrationSpec spec;
+  spec.training_seed = static_cast<std::uint64_t>(c.child("training_seed").integer(0, 1LL << 53));
+  spec.training_steps = static_cast<int>(
+      c.child("training_steps")
+          .integer(static_cast<long long>(limits::kSteps.min), static_cast<long long>(limits::kSteps.max)));
+  const WorkloadSpec& test = scene.workload;
+  WorkloadSpec& training = spec.training;
+  training.steps = training.count = spec.training_steps;
+  training.seed = spec.training_seed;
+  std::mt19937_64 rng(spec.training_seed);
+  auto unit = [&rng] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  if (test.kind == WorkloadSpec::Kind::Protocol) {
+    training.distances = test.distances;
+    for (double d : test.distances) {
+      PoseGroup group{d, {}};
+      for (int k = 0; k < spec.training_steps; ++k) {
+        const double theta = 2.0 * std::numbers::pi * unit();
+        RigidTransform pose;
+        pose.rotation =
+            (Eigen::AngleAxisd(theta, Vec3::UnitZ()) * Eigen::AngleAxisd(theta, Vec3::UnitX())).matrix();
+        pose.translation = Vec3(d, 0, 0);
+        group.poses.push_back(pose);
+      }
+      training.groups.push_back(std::move(group));
+    }
+  } else if (test.kind == WorkloadSpec::Kind::Random) {
+    if (spec.training_seed == test.seed)
+      c.child("training_seed").fail("must differ from the workload's seed (the training poses are held out)");
+    training.kind = WorkloadSpec::Kind::Random;
+    training.box_min = test.box_min;
+    training.box_max = test.box_max;
+    training.groups.push_back(
+        {0, random_poses(spec.training_seed, spec.training_steps, test.box_min, test.box_max)});
+  } else {
+    c.fail("needs a protocol or random workload to draw training poses from (a pose file has no seed)");
+  }
+  check_disjoint(c, training, test);
+  training.identity = "calibration-training:seed=" + std::to_string(spec.training_seed) +
+                      ":steps=" + std::to_string(spec.training_steps) + ":" + test.identity;
+  scene.calibration = std::move(spec);
+}
+
 }  // namespace
 
 Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_dir,
@@ -663,7 +728,7 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   const json document = parse_json(json_text, source);
   const Node root(document, "", source);
   root.expect_object({"name", "description", "objects", "pairs", "hierarchies", "annotation", "strategies",
-                      "workload", "report", "world", "deform"});
+                      "workload", "report", "calibration", "world", "deform"});
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : "scene";
   parse_objects(root, base_dir, scene);
@@ -675,7 +740,8 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
     parse_hierarchies(root, scene);
     parse_density(root, scene);
     parse_strategies(root, scene);
-    if (root.has("report")) root.child("report").fail(std::string("does not apply to a ") + kind + " scene");
+    for (const char* field : {"report", "calibration"})
+      if (root.has(field)) root.child(field).fail(std::string("does not apply to a ") + kind + " scene");
     if (root.has("world"))
       parse_world(root, base_dir, scene);
     else
@@ -689,6 +755,7 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   parse_strategies(root, scene);
   check_densities_needed(root, scene);
   parse_workload(root, base_dir, scene.workload);
+  parse_calibration(root, scene);
   parse_report(root, scene, [&](const std::string& name) { return hierarchy_skipped(scene, name); });
   return scene;
 }

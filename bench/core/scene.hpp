@@ -17,6 +17,7 @@
 //                     20}]} ],
 //     "workload": {"type": "protocol", "distances": [0.4, 0.6], "steps": 500}
 //              or {"type": "poses", "file": "poses.json"},
+//     "calibration": {"training_seed": 2, "training_steps": 500},   // optional: calibrated series too
 //     "report": {"quality_distances": [1.2, 2.0], "cgal_sample": 64,
 //                "operating_point": {"hierarchy": "aabb", "p_min": 0.9},
 //                "baseline": {"hierarchy": "dop24", "strategy": "exact"}}
@@ -146,6 +147,17 @@ struct ReportSpec {
   std::string baseline_strategy = "exact";  ///< an exact strategy
 };
 
+/// "calibration": every inexact series is first run on a training pose set drawn from `training_seed`,
+/// disjoint from the workload's poses, and a monotone map (adb/calibration.hpp) fitted from its answers
+/// against the exact truth; the report then shows each series' test probabilities raw and through its map.
+struct CalibrationSpec {
+  std::uint64_t training_seed = 0;
+  int training_steps = 0;  ///< per protocol distance, or in all for a random workload
+  /// The training poses, drawn while parsing: a protocol workload's distances with the turn angle drawn
+  /// uniformly (R_z(t) R_x(t) as the protocol's steps), or a random workload's box from the training seed.
+  WorkloadSpec training;
+};
+
 /// One placed copy of a scene object in a world scene. Copies of one object share its trees.
 struct WorldInstance {
   std::string name;    ///< "jeep#3" (the object's name and its copy number), or as given
@@ -214,6 +226,7 @@ struct Scene {
   std::vector<StrategySpec> strategies;
   WorkloadSpec workload;
   ReportSpec report;
+  std::optional<CalibrationSpec> calibration;
   /// Set for a world scene: many instances over frames, in place of "pairs" and "workload".
   std::optional<WorldSpec> world;
   /// Set for a deform scene: one deforming object against a rigid one, in place of "pairs" and "workload".

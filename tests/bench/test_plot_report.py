@@ -125,6 +125,19 @@ class CalibrationFigure(unittest.TestCase):
         self.assertIn("no inexact strategy", [t.get_text() for t in fig.axes[0].texts])
 
 
+class CalibratedSeries(unittest.TestCase):
+    def test_a_calibrated_series_gets_its_own_panel_in_its_raw_series_colour(self):
+        rows = [result_row("0.9")]
+        raw = [calibration_bin(b / 10) for b in range(10)]
+        calibrated = [dict(calibration_bin(b / 10), calibrated="1") for b in range(10)]
+        fig, axes = plot_report.draw_calibration(raw + calibrated, rows)
+        self.assertEqual(list(axes), [("m", ("aabb", "adb p_min=0.9")), ("m", ("aabb", "adb p_min=0.9 calibrated"))])
+        colours = [to_rgba(series_line(ax).get_color()) for ax in axes.values()]
+        self.assertEqual(colours[0], colours[1])
+        self.assertIn("calibrated", axes[("m", ("aabb", "adb p_min=0.9 calibrated"))].get_title())
+        plt.close(fig)
+
+
 class Dodge(unittest.TestCase):
     def test_offsets_are_distinct_and_stay_between_neighbouring_distances(self):
         offsets = plot_report.dodge(5, [1.2, 1.4, 1.6])

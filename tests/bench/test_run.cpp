@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 
@@ -302,13 +303,94 @@ TEST_F(RunTest, CsvSchemaAndRates) {
   ASSERT_EQ(cal.size(), 1u + 3 * 10);
   std::map<std::string, long> answers_per_series;
   for (std::size_t i = 1; i < cal.size(); ++i)
-    answers_per_series[cal[i][2] + cal[i][3] + cal[i][4]] += std::stol(cal[i][7]);
+    answers_per_series[cal[i][2] + cal[i][3] + cal[i][4]] += std::stol(cal[i][8]);
   for (const auto& [series, n] : answers_per_series) EXPECT_EQ(n, 3 * 24) << series;
 
   const auto json = nlohmann::json::parse(testing::read_text(dir / "out" / "results.json"));
   EXPECT_EQ(json["rows"].size(), 12u);
   EXPECT_EQ(json["stats"]["trees_annotated"], 1);
   EXPECT_EQ(json["environment"]["build_type"], run.environment.build_type);
+}
+
+// Whether two runs binned their answers alike (an empty bin's mean is NaN in both).
+bool same_bins(const std::vector<CalibrationBin>& a, const std::vector<CalibrationBin>& b) {
+  auto same = [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].count != b[i].count || a[i].calibrated != b[i].calibrated ||
+        !same(a[i].mean_probability, b[i].mean_probability) ||
+        !same(a[i].collision_frequency, b[i].collision_frequency))
+      return false;
+  return true;
+}
+
+TEST_F(RunTest, CalibratedSeriesSitBesideTheRawOnesAndTheirMapsAreCached) {
+  const std::string calibration = R"("calibration": {"training_seed": 9, "training_steps": 30})";
+  const Scene raw_scene = adb_scene();
+  const Scene calibrated_scene =
+      scene(R"([{"bv": "aabb"}])",
+            R"([{"type": "exact"}, {"type": "adb", "p_min": [0.5, 0.9]},
+                     {"type": "time_critical", "p_min": 0.9, "budgets": [{"bv_tests": 8}]}])",
+            R"("annotation": {"type": "adb", "grid": 2, "tau": 0.5}, )" + calibration);
+  const RunOutput raw = run_scene(raw_scene, options);
+  const RunOutput first = run_scene(calibrated_scene, options);
+  // The answers are the raw strategy's: the same rows, no extra ones.
+  EXPECT_EQ(answers(first), answers(raw));
+  EXPECT_EQ(first.stats.calibration_fitted, 3u);  // the three inexact series
+  EXPECT_EQ(first.stats.calibration_cache_hits, 0u);
+  EXPECT_EQ(cache_files("calibration", ".calib").size(), 3u);
+  // Each raw series' ten bins, then its calibrated series' ten bins over the same answers.
+  ASSERT_EQ(raw.calibration.size(), 30u);
+  ASSERT_EQ(first.calibration.size(), 60u);
+  for (std::size_t s = 0; s < 3; ++s) {
+    std::size_t raw_count = 0, calibrated_count = 0;
+    for (std::size_t b = 0; b < 10; ++b) {
+      const CalibrationBin& r = first.calibration[20 * s + b];
+      const CalibrationBin& c = first.calibration[20 * s + 10 + b];
+      EXPECT_FALSE(r.calibrated);
+      EXPECT_TRUE(c.calibrated);
+      EXPECT_EQ(r.count, raw.calibration[10 * s + b].count);
+      EXPECT_EQ(std::tie(c.mesh, c.hierarchy, c.strategy, c.p_min, c.budget),
+                std::tie(r.mesh, r.hierarchy, r.strategy, r.p_min, r.budget));
+      raw_count += r.count;
+      calibrated_count += c.count;
+    }
+    EXPECT_EQ(raw_count, calibrated_count);
+  }
+  const auto summaries = calibration_summary(first.calibration, first.rows);
+  ASSERT_EQ(summaries.size(), 6u);
+  EXPECT_EQ(summaries[1].label, summaries[0].label + " calibrated");
+
+  // A second run reads the maps back and bins exactly as the first did.
+  const RunOutput second = run_scene(calibrated_scene, options);
+  EXPECT_EQ(second.stats.calibration_fitted, 0u);
+  EXPECT_EQ(second.stats.calibration_cache_hits, 3u);
+  EXPECT_TRUE(same_bins(second.calibration, first.calibration));
+
+  // A damaged map is refused by name and fitted again, never applied.
+  const auto file = cache_files("calibration", ".calib").front();
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(20);
+    f.put('\x7f');
+  }
+  messages.clear();
+  const RunOutput third = run_scene(calibrated_scene, options);
+  EXPECT_EQ(third.stats.calibration_fitted, 1u);
+  EXPECT_EQ(third.stats.calibration_cache_hits, 2u);
+  bool named = false;
+  for (const auto& m : messages)
+    named |= m.find("calibration cache: rejected " + file.filename().string()) == 0;
+  EXPECT_TRUE(named);
+  EXPECT_TRUE(same_bins(third.calibration, first.calibration));
+
+  // calibration.csv marks the calibrated series.
+  write_calibration_csv(first, dir / "out" / "calibration.csv");
+  const auto csv = testing::read_csv(dir / "out" / "calibration.csv");
+  ASSERT_EQ(csv.size(), 61u);
+  EXPECT_EQ(csv[0][5], "calibrated");
+  EXPECT_EQ(csv[1][5], "0");
+  EXPECT_EQ(csv[11][5], "1");
 }
 
 TEST_F(RunTest, PoseFileWorkloadAndPairsOfDifferentObjects) {

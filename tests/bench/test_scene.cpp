@@ -281,6 +281,59 @@ TEST_F(SceneTest, RandomPosesAreSeededAndInsideTheirBox) {
             std::string::npos);
 }
 
+TEST_F(SceneTest, CalibrationDrawsHeldOutTrainingPoses) {
+  const std::string workload = R"("workload": {"distances": [0.8, 1.6], "steps": 40})";
+  auto with = [&](const std::string& calibration, const std::string& w) {
+    return scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                      R"([{"type": "exact"}, {"type": "adb", "p_min": 0.9}])",
+                      R"("annotation": {"type": "adb", "grid": 2, "tau": 0.5}, )" + w + ", " + calibration);
+  };
+  const Scene scene = parse(with(R"("calibration": {"training_seed": 3, "training_steps": 25})", workload));
+  ASSERT_TRUE(scene.calibration);
+  const WorkloadSpec& training = scene.calibration->training;
+  ASSERT_EQ(training.groups.size(), 2u);
+  for (std::size_t g = 0; g < 2; ++g) {
+    EXPECT_EQ(training.groups[g].distance, scene.workload.groups[g].distance);
+    ASSERT_EQ(training.groups[g].poses.size(), 25u);
+    for (const RigidTransform& p : training.groups[g].poses) {
+      EXPECT_EQ(p.translation, Vec3(training.groups[g].distance, 0, 0));
+      EXPECT_NO_THROW(p.validate());
+      for (const RigidTransform& q : scene.workload.groups[g].poses)  // held out: no test pose repeated
+        EXPECT_FALSE(p.rotation == q.rotation) << "a training pose is a test pose";
+    }
+  }
+  EXPECT_NE(training.identity, scene.workload.identity);
+  const Scene other = parse(with(R"("calibration": {"training_seed": 4, "training_steps": 25})", workload));
+  EXPECT_NE(other.calibration->training.groups[0].poses[0].rotation, training.groups[0].poses[0].rotation);
+  EXPECT_NE(other.calibration->training.identity, training.identity);
+  EXPECT_FALSE(parse(with(R"("name": "x")", workload)).calibration);
+
+  const std::string random =
+      R"("workload": {"type": "random", "count": 30, "seed": 5, "box": [[1, 0, 0], [2, 1, 1]]})";
+  const Scene drawn = parse(with(R"("calibration": {"training_seed": 6, "training_steps": 40})", random));
+  ASSERT_EQ(drawn.calibration->training.groups.size(), 1u);
+  EXPECT_EQ(drawn.calibration->training.groups[0].poses.size(), 40u);
+  EXPECT_NE(drawn.calibration->training.groups[0].poses[0].translation,
+            drawn.workload.groups[0].poses[0].translation);
+
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {with(R"("calibration": {"training_seed": 5, "training_steps": 40})", random),
+       "/calibration/training_seed: must differ from the workload's seed"},
+      {with(R"("calibration": {"training_seed": 1})", workload), "/calibration/training_steps: missing"},
+      {with(R"("calibration": {"training_seed": 1, "training_steps": 0})", workload),
+       "/calibration/training_steps: expected an integer in [1, "},
+      {with(R"("calibration": {"training_seed": 1, "training_steps": 5, "seed": 2})", workload),
+       "/calibration/seed: unknown field"},
+  };
+  for (const auto& [text, expected] : bad)
+    EXPECT_NE(error_of(text).find(expected), std::string::npos) << error_of(text);
+  testing::write_text(dir / "poses.json", R"({"poses": [{"translation": [1, 0, 0]}]})");
+  EXPECT_NE(error_of(with(R"("calibration": {"training_seed": 1, "training_steps": 5})",
+                          R"("workload": {"type": "poses", "file": "poses.json"})"))
+                .find("/calibration: needs a protocol or random workload"),
+            std::string::npos);
+}
+
 TEST_F(SceneTest, AdbRunsOnEveryRegisteredVolume) {
   for (const std::string& bv : volume_names()) {
     const std::string text = scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": ")" + bv + R"("}])",

@@ -80,6 +80,19 @@ def test_the_rest_of_results_json(run):
     assert np.isfinite([c["bin_low"] for c in run["calibration"]]).all()
 
 
+def test_calibrated_series_come_back_beside_the_raw_ones(gear_file, run):
+    calibrated = bvhlab.run_scene(dict(scene(gear_file), calibration={"training_seed": 3, "training_steps": 40}))
+    # The answers are the raw strategy's: the same rows; the calibration bins come twice, raw then calibrated.
+    assert [r["answer_colliding_rate"] for r in calibrated["rows"]] == [r["answer_colliding_rate"]
+                                                                        for r in run["rows"]]
+    bins = calibrated["calibration"]
+    assert len(bins) == 2 * len(run["calibration"])
+    assert [b["calibrated"] for b in bins[:20]] == [False] * 10 + [True] * 10
+    assert calibrated["stats"]["calibration_fitted"] + calibrated["stats"]["calibration_cache_hits"] == 4
+    for raw, through_map in zip(bins[0::20], bins[10::20]):
+        assert (raw["hierarchy"], raw["p_min"]) == (through_map["hierarchy"], through_map["p_min"])
+
+
 def test_per_pose_records(gear, gear_file):
     with pytest.raises(ValueError, match='per_pose: expected one of none, all, wrong; got "some"'):
         bvhlab.run_scene(scene(gear_file), per_pose="some")
