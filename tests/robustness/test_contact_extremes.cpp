@@ -146,7 +146,9 @@ TEST(ContactExtremes, NeedlesCrossTouchAndMiss) {
   };
   for (const Case c : {Case{0.25e-6, true}, Case{1e-6, true}, Case{0.0, true}, Case{1.1e-6, false},
                        Case{1e-6 + 1e-13, false}, Case{-1e-13, false}}) {
-    const auto [a, b] = needle_pair(c.y);
+    const auto needles = needle_pair(c.y);  // not a structured binding: clang 14 cannot capture one
+    const Mesh& a = needles.first;
+    const Mesh& b = needles.second;
     ASSERT_EQ(CgalGroundTruth(a, b).collides({}), c.collides) << "y " << c.y;
     with_each_volume([&](auto id) {
       using BV = typename decltype(id)::type;
