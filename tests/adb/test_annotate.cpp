@@ -17,6 +17,8 @@
 namespace bvhlab {
 namespace {
 
+using testing::draw_vec3;
+
 using Range = std::pair<std::uint32_t, std::uint32_t>;
 
 Box box_of(const Vec3& lo, const Vec3& hi) {
@@ -94,9 +96,9 @@ TEST(TriangleAreaInBox, RandomTrianglesMatchAnIndependentClipper) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(-1, 1);
   for (int i = 0; i < 500; ++i) {
-    const TrianglePoints t{Vec3(unit(rng), unit(rng), unit(rng)), Vec3(unit(rng), unit(rng), unit(rng)),
-                           Vec3(unit(rng), unit(rng), unit(rng))};
-    Vec3 a(unit(rng), unit(rng), unit(rng)), b(unit(rng), unit(rng), unit(rng));
+    const TrianglePoints t{draw_vec3(unit, rng), draw_vec3(unit, rng), draw_vec3(unit, rng)};
+    Vec3 a = draw_vec3(unit, rng);
+    Vec3 b = draw_vec3(unit, rng);
     const Box box = box_of(a.cwiseMin(b), a.cwiseMax(b));
     const double expected = reference_area_in_box(t, box);
     EXPECT_NEAR(triangle_area_in_box(t, box), expected, 1e-12 * (1 + triangle_area(t))) << "case " << i;
@@ -108,9 +110,7 @@ TEST(TriangleAreaInBox, CellAreasOfAGridSumToTheTriangleArea) {
   std::uniform_real_distribution<double> inner(-0.9, 0.9);
   for (int g = 1; g <= 4; ++g)
     for (int i = 0; i < 40; ++i) {
-      const TrianglePoints t{Vec3(inner(rng), inner(rng), inner(rng)),
-                             Vec3(inner(rng), inner(rng), inner(rng)),
-                             Vec3(inner(rng), inner(rng), inner(rng))};
+      const TrianglePoints t{draw_vec3(inner, rng), draw_vec3(inner, rng), draw_vec3(inner, rng)};
       double sum = 0;
       for (int x = 0; x < g; ++x)
         for (int y = 0; y < g; ++y)
@@ -382,6 +382,7 @@ TEST(Annotate, RejectsBadInputWithAClearMessage) {
 }  // namespace bvhlab
 
 // A tree without density pays nothing: the compiler checks it for every registered kind of volume.
+#include "support/random_draws.hpp"
 #include "volumes/dop24.hpp"
 #include "volumes/obb.hpp"
 #include "volumes/restricted_box.hpp"

@@ -2,6 +2,7 @@
 // leaf test on crossing and parallel planes.
 #include "bvh/point_surface.hpp"
 
+#include "support/random_draws.hpp"
 #include "volumes/aabb.hpp"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,8 @@
 
 namespace bvhlab {
 namespace {
+
+using testing::draw_vec3;
 
 /// A UV sphere of radius 1 about the origin, triangles turned outward.
 Mesh uv_sphere(int rings, int segments) {
@@ -54,7 +57,7 @@ std::vector<Vec3> directions(int n, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> g;  // a test's own inputs: need not match across platforms
   std::vector<Vec3> out;
-  for (int i = 0; i < n; ++i) out.push_back(Vec3(g(rng), g(rng), g(rng)).normalized());
+  for (int i = 0; i < n; ++i) out.push_back(draw_vec3(g, rng).normalized());
   return out;
 }
 

@@ -3,6 +3,7 @@
 
 #include "bench/core/generators.hpp"
 #include "bvh/mesh.hpp"
+#include "random_draws.hpp"
 
 #include <random>
 
@@ -17,8 +18,8 @@ inline Mesh make_random_soup(int count, double size, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(-1, 1);
   for (int t = 0; t < count; ++t) {
-    const Vec3 c(unit(rng), unit(rng), unit(rng));
-    for (int k = 0; k < 3; ++k) m.vertices.push_back(c + size * Vec3(unit(rng), unit(rng), unit(rng)));
+    const Vec3 c = draw_vec3(unit, rng);
+    for (int k = 0; k < 3; ++k) m.vertices.push_back(c + size * draw_vec3(unit, rng));
     const auto b = static_cast<std::uint32_t>(3 * t);
     m.triangles.push_back({b, b + 1, b + 2});
   }
@@ -29,11 +30,11 @@ inline Mesh make_random_soup(int count, double size, std::uint64_t seed) {
 inline RigidTransform random_pose(std::mt19937_64& rng, double r) {
   std::normal_distribution<double> normal;
   std::uniform_real_distribution<double> unit(-r, r);
-  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  Eigen::Quaterniond q = draw_quaternion(normal, rng);
   q.normalize();
   RigidTransform pose;
   pose.rotation = q.toRotationMatrix();
-  pose.translation = Vec3(unit(rng), unit(rng), unit(rng));
+  pose.translation = draw_vec3(unit, rng);
   return pose;
 }
 

@@ -1,6 +1,7 @@
 // The broad phases against brute force (and brute force against Box::overlaps), their input rules, the
 // dynamic tree's fattened boxes, and world boxes against every transformed vertex.
 #include "bench/core/generators.hpp"
+#include "support/random_draws.hpp"
 #include "support/volume_lists.hpp"
 #include "traversal/broad_phase/registry.hpp"
 #include "traversal/broad_phase/world_box.hpp"
@@ -16,6 +17,9 @@
 
 namespace bvhlab {
 namespace {
+
+using testing::draw_quaternion;
+using testing::draw_vec3;
 
 std::vector<ObjectPair> overlapping_pairs(const std::vector<Box>& boxes) {
   std::vector<ObjectPair> out;
@@ -36,9 +40,8 @@ std::vector<Box> random_boxes(std::size_t n, bool clustered, std::mt19937_64& rn
   std::normal_distribution<double> spread(0, 6);
   std::vector<Box> boxes;
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 centre =
-        clustered ? Vec3(clusters[i % clusters.size()] + Vec3(spread(rng), spread(rng), spread(rng)))
-                  : generators::uniform_point(rng, -100, 100);
+    const Vec3 centre = clustered ? Vec3(clusters[i % clusters.size()] + draw_vec3(spread, rng))
+                                  : generators::uniform_point(rng, -100, 100);
     boxes.push_back(box_at(centre, generators::uniform_point(rng, 0.2, 4)));
   }
   return boxes;
@@ -49,7 +52,7 @@ std::vector<Box> random_boxes(std::size_t n, bool clustered, std::mt19937_64& rn
 void random_walk(std::vector<Box>& boxes, std::mt19937_64& rng) {
   std::normal_distribution<double> step(0, 0.4);
   for (Box& b : boxes) {
-    Vec3 centre = b.center() + Vec3(step(rng), step(rng), step(rng));
+    Vec3 centre = b.center() + draw_vec3(step, rng);
     Vec3 half = b.extent() * 0.5;
     if (generators::uniform(rng, 0, 1) < 0.02) centre = generators::uniform_point(rng, -150, 150);
     if (generators::uniform(rng, 0, 1) < 0.05) half = generators::uniform_point(rng, 0.2, 6);
@@ -349,7 +352,7 @@ Box rotated_corners(const Box& local, const RigidTransform& pose) {
 
 RigidTransform random_rigid(std::mt19937_64& rng, double reach) {
   std::normal_distribution<double> normal;
-  const Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  const Eigen::Quaterniond q = draw_quaternion(normal, rng);
   RigidTransform pose;
   pose.rotation = q.normalized().toRotationMatrix();
   pose.translation = generators::uniform_point(rng, -reach, reach);

@@ -5,6 +5,7 @@
 #include "bvh/mesh_io.hpp"
 #include "support/generated_meshes.hpp"
 #include "support/meshes.hpp"
+#include "support/random_draws.hpp"
 #include "traversal/exact.hpp"
 #include "traversal/frame_budget.hpp"
 #include "volumes/aabb.hpp"
@@ -20,6 +21,8 @@
 
 namespace bvhlab {
 namespace {
+
+using testing::draw_vec3;
 
 /// The bundled meshes, normalised (longest side 2), as ADB-annotated trees of one volume.
 template <class BV>
@@ -49,7 +52,7 @@ using Frame = std::vector<FramePair<BV, AdbDensity>>;
 RigidTransform pose_at(std::mt19937_64& rng, double distance) {
   RigidTransform pose = testing::random_pose(rng, 1.0);
   std::normal_distribution<double> normal;
-  const Vec3 direction = Vec3(normal(rng), normal(rng), normal(rng)).normalized();
+  const Vec3 direction = draw_vec3(normal, rng).normalized();
   pose.translation = distance * direction;
   return pose;
 }

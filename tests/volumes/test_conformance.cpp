@@ -3,6 +3,7 @@
 // exact triangle tests (with many just-touching pairs and the special poses), and is not vacuous; bounding
 // boxes and volumes agree with Monte Carlo sampling of contains().
 #include "bvh/triangle_intersection.hpp"
+#include "support/random_draws.hpp"
 #include "volume_models.hpp"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,8 @@
 
 namespace bvhlab::volume_tests {
 namespace {
+
+using testing::draw_vec3;
 
 template <class BV>
 class VolumeConformance : public ::testing::Test {};
@@ -76,7 +79,7 @@ TYPED_TEST(VolumeConformance, MergeContainsBoth) {
     const Box box = a.bounding_box();
     std::uniform_real_distribution<double> unit(0, 1);
     for (int s = 0; s < 200; ++s) {
-      const Vec3 p = box.min + box.extent().cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng)));
+      const Vec3 p = box.min + box.extent().cwiseProduct(draw_vec3(unit, rng));
       if (a.contains(p)) {
         ASSERT_TRUE(merged.contains(p)) << set.label << ": " << p.transpose();
       }
@@ -296,7 +299,7 @@ TYPED_TEST(VolumeConformance, BoundingBoxAndVolumeAgreeWithSampling) {
     const int n = 4000;
     int inside = 0;
     for (int s = 0; s < n; ++s) {
-      const Vec3 p = corner + extent.cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng)));
+      const Vec3 p = corner + extent.cwiseProduct(draw_vec3(unit, rng));
       if (!v.contains(p)) continue;
       ++inside;
       ASSERT_TRUE(box.contains(p)) << set.label << ": contained point outside bounding_box " << p.transpose();

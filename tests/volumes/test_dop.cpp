@@ -1,6 +1,7 @@
 // k-DOP specifics: Zachmann's re-alignment bound against the exact support of the transformed DOP, the
 // prototype's non-simple vertices, the volume against an independent vertex enumeration, split directions.
 // Also OBB and sphere properties that hold by construction of their fits.
+#include "support/random_draws.hpp"
 #include "volume_models.hpp"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,8 @@
 
 namespace bvhlab::volume_tests {
 namespace {
+
+using testing::draw_vec3;
 
 /// Every vertex of {x : n_m . x <= d_m}, by brute force over plane triples (reference, O(k^4)).
 template <std::size_t Planes>
@@ -219,8 +222,7 @@ TEST(ObbFit, NeverLargerThanTheAabbAndRecoversARotatedBox) {
     const Mat3 r = random_rotation(rng);
     const Vec3 half(2, 0.5, 0.1), center = gaussian_vec(rng);
     std::vector<Vec3> points;
-    for (int i = 0; i < 2000; ++i)
-      points.push_back(center + r * half.cwiseProduct(Vec3(unit(rng), unit(rng), unit(rng))));
+    for (int i = 0; i < 2000; ++i) points.push_back(center + r * half.cwiseProduct(draw_vec3(unit, rng)));
     for (int c = 0; c < 8; ++c)  // the corners, so the true box is the tightest
       points.push_back(center + r * half.cwiseProduct(Vec3(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1)));
     const double true_volume = 8 * half.prod();

@@ -1,4 +1,5 @@
 // Outward rounding to float, the basis of every float-stored volume's conservativeness.
+#include "support/random_draws.hpp"
 #include "volumes/aabb.hpp"
 #include "volumes/storage.hpp"
 
@@ -9,6 +10,8 @@
 
 namespace bvhlab {
 namespace {
+
+using testing::draw_vec3;
 
 // The shape GCC 12's SLP vectoriser miscompiles (double(float(x)) folded back to x): several coordinates
 // rounded and compared in one function, vectorisable, not inlined into the test loop.
@@ -26,7 +29,11 @@ TEST(FloatStorage, OutwardRoundingBracketsEveryValueTightly) {
   std::uniform_int_distribution<int> exponent(-100, 100);
   int exact = 0;
   for (int i = 0; i < 200000; ++i) {
-    const double p[2] = {std::ldexp(mantissa(rng), exponent(rng)), std::ldexp(mantissa(rng), exponent(rng))};
+    const auto draw = [&] {
+      const int e = exponent(rng);
+      return std::ldexp(mantissa(rng), e);
+    };
+    const double p[2] = {draw(), draw()};
     float lo[2], hi[2];
     round_pair(p, lo, hi);
     for (int k = 0; k < 2; ++k) {
@@ -45,7 +52,7 @@ TEST(FloatStorage, AabbFitContainsItsPointsAfterRounding) {
   std::mt19937_64 rng(43);
   std::uniform_real_distribution<double> u(-10, 10);
   for (int i = 0; i < 100000; ++i) {
-    const Vec3 points[2] = {Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)) * 1e-3};
+    const Vec3 points[2] = {draw_vec3(u, rng), draw_vec3(u, rng) * 1e-3};
     const Aabb box = Aabb::fit(points);
     ASSERT_TRUE(box.contains(points[0]) && box.contains(points[1])) << i;
   }

@@ -1,6 +1,7 @@
 // The bounding-volume models every typed volume test runs over, and point sets to fit them to.
 #pragma once
 
+#include "support/random_draws.hpp"
 #include "support/test_volumes.hpp"
 #include "support/volume_lists.hpp"
 
@@ -11,6 +12,9 @@
 #include <vector>
 
 namespace bvhlab::volume_tests {
+
+using testing::draw_quaternion;
+using testing::draw_vec3;
 
 /// Every shipped self-contained model, and the capsule that exists only under tests/.
 using AllModels =
@@ -25,7 +29,7 @@ struct ModelName {
 
 inline Mat3 random_rotation(std::mt19937_64& rng) {
   std::normal_distribution<double> normal;
-  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  Eigen::Quaterniond q = draw_quaternion(normal, rng);
   return q.normalized().toRotationMatrix();
 }
 
@@ -61,7 +65,7 @@ inline std::vector<PointSet> sample_point_sets(std::uint64_t seed) {
   // Uniform cube and sphere-surface clouds: extreme points everywhere.
   std::vector<Vec3> cube, shell;
   for (int i = 0; i < 200; ++i) {
-    cube.emplace_back(unit(rng), unit(rng), unit(rng));
+    cube.push_back(draw_vec3(unit, rng));
     shell.push_back(gaussian_vec(rng).normalized());
   }
   sets.push_back({"cube", cube});
@@ -70,7 +74,8 @@ inline std::vector<PointSet> sample_point_sets(std::uint64_t seed) {
   sets.push_back({"flat random plane", cloud(40, Vec3(1, 0.7, 0), 1)});
   std::vector<Vec3> flat_axis, collinear_axis;
   for (int i = 0; i < 20; ++i) {
-    flat_axis.emplace_back(unit(rng), unit(rng), 0.25);
+    const double y = unit(rng);
+    flat_axis.emplace_back(unit(rng), y, 0.25);
     collinear_axis.emplace_back(unit(rng), -0.5, 0.125);
   }
   sets.push_back({"flat z = const", flat_axis});
