@@ -163,7 +163,7 @@ class Builder {
         }
       }
       if (sah_bin >= 0) {
-        // Plain copies, not a structured binding: clang 14 (the fuzz preset) cannot capture those.
+        // Plain copies, not a structured binding: clang 14 (the sanitizer presets) cannot capture those.
         const Scalar lo = ranges[sah_dir].first;
         const Scalar scale = kBins / (ranges[sah_dir].second - lo);
         const Vec3 dir = directions_[sah_dir];
