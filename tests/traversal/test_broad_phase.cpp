@@ -391,6 +391,25 @@ TYPED_TEST(WorldBox, ContainsEveryTransformedVertexAndIsNoLargerThanTheRotatedRo
   }
 }
 
+// A DOP of the prototype's own shape: the support bound is exact there, so both sides of every world axis
+// must meet the rotated prototype's extreme vertices (the lower side comes from the upper side's search).
+TEST(WorldBox, DopOfThePrototypeShapeGivesTheExactRotatedBox) {
+  using Dop = KDop<dop_sets::Zachmann24>;
+  std::vector<Vec3> corners;
+  for (const auto& vertex : Dop::tables().vertices) corners.push_back(vertex.position);
+  const Dop prototype = Dop::fit(corners);
+  std::mt19937_64 rng(5);
+  for (int k = 0; k < 50; ++k) {
+    const RigidTransform pose = random_rigid(rng, 10.0);
+    Box exact;
+    for (const Vec3& c : corners) exact.extend(pose.apply(c));
+    const Box world = world_box(prototype, pose);
+    // Offsets are floats rounded upwards: a few 1e-7 of the prototype's size of about 1.
+    EXPECT_LT((world.max - exact.max).cwiseAbs().maxCoeff(), 1e-5) << "pose " << k;
+    EXPECT_LT((world.min - exact.min).cwiseAbs().maxCoeff(), 1e-5) << "pose " << k;
+  }
+}
+
 TEST(WorldBox, AabbRootUnder45DegreesIsTighterThanTheCubeAroundItsSphere) {
   const auto tree = Bvh<Aabb>::build(generators::make_box(5, 10, 20));
   RigidTransform pose;

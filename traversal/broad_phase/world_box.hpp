@@ -13,7 +13,8 @@
 //                          (kdop.hpp: the direction R^T e written as a non-negative combination of three
 //                          plane normals at the prototype's extremal vertex; support <= the same combination
 //                          of the offsets). The second is exact for the prototype's shape and usually
-//                          tighter for a rotated DOP; it costs one vertex search per direction (six).
+//                          tighter for a rotated DOP; it costs one vertex search per world axis (three:
+//                          the prototype's symmetry gives the opposite direction's bound with it).
 //   Sphere                 centre R c + t, radius r.
 //
 // With the object's BoundingBall (the farthest vertex from the root box's centre, computed once per tree),
@@ -94,24 +95,34 @@ Box world_box(const KDop<Set>& dop, const RigidTransform& pose) {
   for (std::size_t a = 0; a < 3; ++a)
     scale = std::max({scale, std::abs(double(dop.offsets[a])), std::abs(double(dop.offsets[a + D::kAxes]))});
   // support(v) = max over the DOP of v . x, bounded by sum lambda_m d_m (kdop.hpp); v in the object frame.
-  auto support = [&](const Vec3& v) {
+  // The prototype is symmetric: v = sum lambda_k n_(m_k) gives -v = sum lambda_k n_(opposite m_k) with the
+  // same lambda, so one vertex search bounds the support in both directions.
+  struct SupportPair {
+    double plus, minus;  // bounds of support(v) and support(-v)
+  };
+  auto supports = [&](const Vec3& v) {
     std::array<std::uint8_t, 3> planes{};
     std::array<double, 3> lambda{};
     tables.realign(v, planes, lambda);
-    double bound = 0, weight = 0;
+    SupportPair bound{0, 0};
+    double weight = 0;
     for (int k = 0; k < 3; ++k) {
-      bound += lambda[k] * double(dop.offsets[planes[k]]);
+      const std::size_t opposite = planes[k] < D::kAxes ? planes[k] + D::kAxes : planes[k] - D::kAxes;
+      bound.plus += lambda[k] * double(dop.offsets[planes[k]]);
+      bound.minus += lambda[k] * double(dop.offsets[opposite]);
       weight += std::abs(lambda[k]);
     }
     // Rounding of lambda (and a lambda a hair below zero) moves the bound by ulps of weight * |x|.
-    return bound + 1024 * std::numeric_limits<double>::epsilon() * (weight + 1) * 2 * scale;
+    const double slack = 1024 * std::numeric_limits<double>::epsilon() * (weight + 1) * 2 * scale;
+    return SupportPair{bound.plus + slack, bound.minus + slack};
   };
   Box own;
   for (int k = 0; k < 3; ++k) {
     const Vec3 v = pose.rotation.row(k).transpose();  // world axis k in the object frame
     const double t = pose.translation[k];
-    own.max[k] = support(v) + t + world_box_detail::kUlps * std::abs(t);
-    own.min[k] = -support(-v) + t - world_box_detail::kUlps * std::abs(t);
+    const SupportPair s = supports(v);
+    own.max[k] = s.plus + t + world_box_detail::kUlps * std::abs(t);
+    own.min[k] = -s.minus + t - world_box_detail::kUlps * std::abs(t);
   }
   return world_box_detail::intersection(own, world_box_detail::rotated_box(dop.bounding_box(), pose));
 }
