@@ -214,27 +214,32 @@ std::vector<SphereCovering> sphere_coverings(std::span<const TreeNode> nodes, st
   return out;
 }
 
+SurfaceSigns surface_signs(const PointSurface& surface, std::span<const Vec3> points,
+                           const RigidTransform& into, bool stop_at_both) {
+  SurfaceSigns out;
+  bool positive = false, negative = false;
+  for (const Vec3& p : points) {
+    const std::optional<double> f = surface.value(into.apply(p));
+    if (!f) continue;
+    ++out.defined_values;
+    positive = positive || *f >= 0;  // a point on the surface (f = 0) touches it: closed, like triangles
+    negative = negative || *f <= 0;
+    out.smallest = std::min(out.smallest, std::abs(*f));
+    if (stop_at_both && positive && negative) break;
+  }
+  out.both = positive && negative;
+  return out;
+}
+
 LeafSurfaceTest test_leaf_surfaces(const PointSurface& a, std::span<const Vec3> a_points,
                                    const PointSurface& b, std::span<const Vec3> b_points,
                                    const RigidTransform& b_to_a) {
+  const SurfaceSigns a_side = surface_signs(b, a_points, b_to_a.inverse());
+  const SurfaceSigns b_side = surface_signs(a, b_points, b_to_a);
   LeafSurfaceTest out;
-  double smallest = std::numeric_limits<double>::infinity();
-  auto side = [&](const PointSurface& surface, std::span<const Vec3> points, const RigidTransform& into) {
-    bool positive = false, negative = false;
-    for (const Vec3& p : points) {
-      const std::optional<double> f = surface.value(into.apply(p));
-      if (!f) continue;
-      ++out.defined_values;
-      positive = positive || *f >= 0;  // a point on the surface (f = 0) touches it: closed, like triangles
-      negative = negative || *f <= 0;
-      smallest = std::min(smallest, std::abs(*f));
-    }
-    return positive && negative;
-  };
-  const bool a_crosses = side(b, a_points, b_to_a.inverse());
-  const bool b_crosses = side(a, b_points, b_to_a);
-  out.crossing = a_crosses || b_crosses;
-  if (!out.crossing && out.defined_values > 0) out.distance = smallest;
+  out.crossing = a_side.both || b_side.both;
+  out.defined_values = a_side.defined_values + b_side.defined_values;
+  if (!out.crossing && out.defined_values > 0) out.distance = std::min(a_side.smallest, b_side.smallest);
   return out;
 }
 

@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -86,6 +87,19 @@ std::span<const Vec3> node_points(const Bvh<BV>& tree, std::uint32_t i) {
   return std::span<const Vec3>(tree.points()).subspan(n.first, n.count);
 }
 
+/// f of one surface over a set of points: the half of a leaf test that depends on one leaf only (the other
+/// side's f is the whole other cloud's), so a traversal may reuse it for every leaf pair of that leaf.
+struct SurfaceSigns {
+  bool both = false;  ///< f took both signs (or was 0 at a point: touching)
+  double smallest = std::numeric_limits<double>::infinity();  ///< the smallest |f| seen (when not stopped)
+  std::size_t defined_values = 0;                             ///< evaluations where f was defined
+};
+
+/// Evaluates `surface`'s f at `points` mapped by `into` (into the surface's frame). With stop_at_both the
+/// evaluation ends once both signs are seen (then `smallest` covers only the points seen).
+SurfaceSigns surface_signs(const PointSurface& surface, std::span<const Vec3> points,
+                           const RigidTransform& into, bool stop_at_both = false);
+
 /// What the test of two point leaves found.
 struct LeafSurfaceTest {
   bool crossing = false;  ///< f_B changes sign over A's points, or f_A over B's, or is 0 at one (touching)
@@ -94,9 +108,10 @@ struct LeafSurfaceTest {
 };
 
 /// Evaluates f_B at A's leaf points (mapped into B's frame) and f_A at B's leaf points (mapped into A's
-/// frame by b_to_a). Values of both signs from one side mean the surfaces cross between those points;
-/// otherwise the smallest |f| estimates their distance (to within the kernel's smoothing). A leaf wholly
-/// inside the other object sees one sign only, like a separated one: a crossing is a surface crossing.
+/// frame by b_to_a): surface_signs of each side. Values of both signs from one side mean the surfaces cross
+/// between those points; otherwise the smallest |f| estimates their distance (to within the kernel's
+/// smoothing). A leaf wholly inside the other object sees one sign only, like a separated one: a crossing is
+/// a surface crossing.
 LeafSurfaceTest test_leaf_surfaces(const PointSurface& a, std::span<const Vec3> a_points,
                                    const PointSurface& b, std::span<const Vec3> b_points,
                                    const RigidTransform& b_to_a);

@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 namespace bvhlab {
@@ -127,14 +128,17 @@ inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b
 }  // namespace detail
 
 /// The ADB strategies' hooks (queued by the estimate, in either order). `Estimator` is the probability
-/// model: estimate(box_a, box_b, overlap volume, node of A, node of B) -> probability.
-template <TreeVolume BV, class Estimator>
+/// model: estimate(box_a, box_b, overlap volume, node of A, node of B) -> probability. `Leaves` is the
+/// trees' leaf test (driver.hpp): triangles run only under exact_leaves (guided exact); a leaf test with
+/// kTestedByEstimates (point surfaces) runs on every leaf pair reached, the points' only evidence there.
+template <TreeVolume BV, class Estimator, class Leaves = TriangleLeaves>
 class AdbHooks {
  public:
   /// key: the pair's estimate; tag: the estimate exceeded p_min, awaiting confirmation by its children.
   using Pair = QueuedPair<BV, double, bool>;
 
-  AdbHooks(const TreePair<BV>& trees, Result& result, const AdbOptions& options, const Estimator& estimate)
+  AdbHooks(const TreePair<BV, Leaves>& trees, Result& result, const AdbOptions& options,
+           const Estimator& estimate)
       : trees_(trees),
         result_(result),
         options_(options),
@@ -168,8 +172,8 @@ class AdbHooks {
   }
 
   [[gnu::always_inline]] Step leaf_pair(const Pair& p) {
-    if (options_.exact_leaves) {
-      const bool hit = trees_.intersecting_triangles(p.a, p.b, [&](const TrianglePair& pair) {
+    if (Leaves::kTestedByEstimates || options_.exact_leaves) {
+      const bool hit = trees_.leaf_contact(p.a, p.b, [&](const std::optional<TrianglePair>& pair) {
         result_.witness = pair;
         return true;
       });
@@ -228,7 +232,7 @@ class AdbHooks {
     return Admission::Decide;
   }
 
-  const TreePair<BV>& trees_;
+  const TreePair<BV, Leaves>& trees_;
   Result& result_;
   const AdbOptions& options_;
   const Estimator& estimate_;
@@ -239,12 +243,13 @@ class AdbHooks {
 };
 
 /// ADB query on two trees annotated with a ProbabilityDensity (adb/concept.hpp). `b_to_a` maps B's frame
-/// into A's. The probability model comes from the trees' own annotation.
+/// into A's. The probability model comes from the trees' own annotation. `leaves` is the leaf test (the
+/// default: triangles; traversal/point_leaves.hpp passes point surfaces: query_adb_points).
 /// `Order` is AdbBestFirst (the paper's) or AdbDepthFirst. Const and thread-safe: the model is read-only and
 /// all traversal state is local.
-template <class Order = AdbBestFirst, TreeVolume BV, ProbabilityDensity D>
+template <class Order = AdbBestFirst, TreeVolume BV, ProbabilityDensity D, class Leaves = TriangleLeaves>
 Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
-                 const AdbOptions& options) {
+                 const AdbOptions& options, const Leaves& leaves = kTriangleLeaves) {
   BudgetLimit limit(options.budget);  // a deadline counts from here, set-up included
   options.validate();
   b_to_a.validate();
@@ -256,17 +261,17 @@ Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransfor
     else
       return D::estimator(a.density, b.density);
   }();
-  if (options.exact_leaves && (!a.bvh.has_polygons() || !b.bvh.has_polygons()))
-    throw std::invalid_argument("adb: guided exact needs trees with polygons");
+  if constexpr (Leaves::kTriangles)
+    if (options.exact_leaves) TriangleLeaves::require(a.bvh, b.bvh, "adb: guided exact");
 
   Result result;
   if (!a.bvh.empty() && !b.bvh.empty()) {
     const auto context = VolumeWalker<BV>::make_context(b_to_a);
-    const TreePair<BV> trees(a.bvh, b.bvh, b_to_a, context, result.counters);
+    const TreePair<BV, Leaves> trees(a.bvh, b.bvh, b_to_a, context, result.counters, leaves);
     // The probability model: the only place the traversal reads it.
     const auto node_estimate = [&](const Box& box_a, const Box& box_b, double overlap, std::uint32_t i,
                                    std::uint32_t j) { return estimate(i, box_a, j, box_b, overlap); };
-    AdbHooks<BV, decltype(node_estimate)> hooks(trees, result, options, node_estimate);
+    AdbHooks<BV, decltype(node_estimate), Leaves> hooks(trees, result, options, node_estimate);
     traverse<typename Order::Queue, typename Order::Descent>(trees, hooks,
                                                              limit);  // frees its queue before it returns
   }

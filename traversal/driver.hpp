@@ -3,7 +3,7 @@
 // policy, a limit and a hooks object, all resolved at compile time. No virtual calls, no copies of trees:
 // the hooks and policies inline into one loop, which costs what a hand-written loop would.
 //
-//   traverse<QueuePolicy, Descent>(trees, hooks, limit);   // trees: TreePair<BV>
+//   traverse<QueuePolicy, Descent>(trees, hooks, limit);   // trees: TreePair<BV, Leaves>
 //
 // The loop, in order:
 //   1. If the limit forbids a first BV test: finish(queue, Ended::BudgetExhausted).
@@ -62,7 +62,8 @@
 //   Admission admit(Pair&, Score)          files an evaluated pair: Queue (after setting pair.key and
 //                                          pair.tag as needed), Drop, or Decide.
 //   Step leaf_pair(const Pair&)            a pair of two leaves taken off the queue. Exact strategies run
-//                                          trees.intersecting_triangles, the one triangle-pair loop.
+//                                          trees.leaf_contact: the one triangle-pair loop, or the trees'
+//                                          other leaf test (TreePair's Leaves: point surfaces).
 //   Step children_evaluated(const Pair& parent, const Score* scores, int count)   optional: after all of a
 //                                          parent's children were evaluated, before any is admitted (ADB's
 //                                          "confirm with children").
@@ -91,7 +92,10 @@
 #include <concepts>
 #include <cstdint>
 #include <new>
+#include <optional>
 #include <queue>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -149,34 +153,71 @@ enum class Ended { QueueEmpty, BudgetExhausted };
 /// or stopped by its limit before a BV test (not finished: Traversal::stop gives the best-effort answer).
 enum class TraversalState { Running, Done, Stopped };
 
-/// The two trees of one query, the pose, the volumes' pair context (Walker::make_context(b_to_a)), and the
-/// query's counters. Only references: the context is a separate local of the query, so passing it to an
-/// out-of-line overlap test does not make the compiler reload these after every test.
-template <TreeVolume BV>
+/// The leaf test of two trees of triangles: the one triangle-pair loop (TreePair::intersecting_triangles).
+/// Another leaf test is a class of the same shape whose object the query passes to TreePair; the
+/// traversal/point_leaves.hpp one tests the implicit surfaces of point clouds. It has
+///   static constexpr bool kTriangles = false;
+///   static constexpr bool kTestedByEstimates;  // ADB's leaf pairs run it too (triangles: only guided exact)
+///   bool may_touch(std::uint32_t i, std::uint32_t j) const;  // after the volumes overlap: may A's node i
+///                                                            // and B's node j still touch? (pruning)
+///   bool crossing(std::uint32_t i, std::uint32_t j) const;   // a leaf pair: do the objects touch there?
+/// The choice is made at compile time: a tree pair of triangles compiles to what it did before.
+struct TriangleLeaves {
+  static constexpr bool kTriangles = true;
+  static constexpr bool kTestedByEstimates = false;
+
+  /// Throws std::invalid_argument when a tree cannot serve triangle tests, naming the tree and why: it
+  /// holds a point cloud (a point query passes the clouds' surfaces: traversal/point_leaves.hpp), or it was
+  /// loaded without polygons. `who` starts the message.
+  template <TreeVolume BV>
+  static void require(const Bvh<BV>& a, const Bvh<BV>& b, const char* who) {
+    for (const Bvh<BV>* tree : {&a, &b}) {
+      const std::string side = tree == &a ? "tree A" : "tree B";
+      if (tree->has_points())
+        throw std::invalid_argument(std::string(who) + ": " + side +
+                                    " holds a point cloud, not triangles; query point trees with their "
+                                    "surfaces (query_exact_points, query_adb_points)");
+      if (!tree->empty() && !tree->has_polygons())
+        throw std::invalid_argument(std::string(who) + ": " + side +
+                                    " was loaded without polygons; exact tests need them");
+    }
+  }
+};
+inline constexpr TriangleLeaves kTriangleLeaves{};
+
+/// The two trees of one query, the pose, the volumes' pair context (Walker::make_context(b_to_a)), the
+/// query's counters and its leaf test. Only references: the context is a separate local of the query, so
+/// passing it to an out-of-line overlap test does not make the compiler reload these after every test.
+template <TreeVolume BV, class Leaves = TriangleLeaves>
 class TreePair {
  public:
   using Walker = VolumeWalker<BV>;
   using Context = typename Walker::Context;
+  using LeafTest = Leaves;
 
   TreePair(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, const Context& context,
-           Counters& counters)
-      : a(a), b(b), b_to_a(b_to_a), context(context), counters(counters) {}
+           Counters& counters, const Leaves& leaves = kTriangleLeaves)
+      : a(a), b(b), b_to_a(b_to_a), context(context), counters(counters), leaves(leaves) {}
 
   const Bvh<BV>& a;
   const Bvh<BV>& b;
   const RigidTransform& b_to_a;
   const Context& context;
   Counters& counters;
+  const Leaves& leaves;
 
   template <class Pair>
   [[gnu::always_inline]] [[nodiscard]] Pair root() const {
     return Pair{{}, 0, 0, Walker::root_a(a, context), Walker::root_b(b, context), {}};
   }
-  /// The BV-pair overlap test; counts one BV test.
+  /// The BV-pair overlap test, and the leaf test's pruning where it has one; counts one BV test.
   template <class Pair>
   [[gnu::always_inline]] bool overlap(const Pair& p) const {
     ++counters.bv_tests;
-    return Walker::overlap(a, p.a, p.wa, b, p.b, p.wb, context);
+    if constexpr (Leaves::kTriangles)
+      return Walker::overlap(a, p.a, p.wa, b, p.b, p.wb, context);
+    else
+      return Walker::overlap(a, p.a, p.wa, b, p.b, p.wb, context) && leaves.may_touch(p.a, p.b);
   }
   template <class Pair>
   [[gnu::always_inline]] [[nodiscard]] Box box_a(const Pair& p) const {
@@ -189,6 +230,21 @@ class TreePair {
   template <class Pair>
   [[gnu::always_inline]] [[nodiscard]] bool is_leaf_pair(const Pair& p) const {
     return a.node(p.a).is_leaf() && b.node(p.b).is_leaf();
+  }
+
+  /// The test of leaf pair (i, j), whatever the trees hold: on_hit(std::optional<TrianglePair>) is called
+  /// per intersecting triangle pair (source-mesh indices), or once with nullopt when another leaf test finds
+  /// the objects touching (no triangle pair to name). on_hit returns true to stop; so does this, then.
+  /// Triangles count one triangle test per triangle pair; another leaf test one per leaf pair.
+  template <class OnHit>
+  [[gnu::always_inline]] bool leaf_contact(std::uint32_t i, std::uint32_t j, OnHit&& on_hit) const {
+    if constexpr (Leaves::kTriangles) {
+      return intersecting_triangles(
+          i, j, [&](const TrianglePair& hit) { return on_hit(std::optional<TrianglePair>(hit)); });
+    } else {
+      ++counters.triangle_tests;
+      return leaves.crossing(i, j) && on_hit(std::optional<TrianglePair>());
+    }
   }
 
   /// The one triangle-pair loop: B's triangles of leaf j moved into A's frame, each tested against A's of
@@ -303,8 +359,8 @@ struct OrderedDepthFirst {
 struct SplitLarger {
   /// Calls sink.child(Pair&&) on each child pair of `p` (not two leaves), in order; stops, returning false,
   /// as soon as that returns false.
-  template <TreeVolume BV, class Pair, class Sink>
-  [[gnu::always_inline]] static bool expand(const TreePair<BV>& t, const Pair& p, Sink& sink) {
+  template <TreeVolume BV, class Leaves, class Pair, class Sink>
+  [[gnu::always_inline]] static bool expand(const TreePair<BV, Leaves>& t, const Pair& p, Sink& sink) {
     const TreeNode& na = t.a.node(p.a);
     const TreeNode& nb = t.b.node(p.b);
     // The two children written out rather than a loop over {right, left}: GCC leaves such a loop rolled,
@@ -315,21 +371,21 @@ struct SplitLarger {
   }
 
  private:
-  template <TreeVolume BV, class Pair, class Sink>
-  [[gnu::always_inline]] static bool split_a(const TreePair<BV>& t, const Pair& p, std::uint32_t child,
-                                             Sink& sink) {
+  template <TreeVolume BV, class Leaves, class Pair, class Sink>
+  [[gnu::always_inline]] static bool split_a(const TreePair<BV, Leaves>& t, const Pair& p,
+                                             std::uint32_t child, Sink& sink) {
     return sink.child(Pair{{}, child, p.b, VolumeWalker<BV>::child_a(t.a, p.wa, child, t.context), p.wb, {}});
   }
-  template <TreeVolume BV, class Pair, class Sink>
-  [[gnu::always_inline]] static bool split_b(const TreePair<BV>& t, const Pair& p, std::uint32_t child,
-                                             Sink& sink) {
+  template <TreeVolume BV, class Leaves, class Pair, class Sink>
+  [[gnu::always_inline]] static bool split_b(const TreePair<BV, Leaves>& t, const Pair& p,
+                                             std::uint32_t child, Sink& sink) {
     return sink.child(Pair{{}, p.a, child, p.wa, VolumeWalker<BV>::child_b(t.b, p.wb, child, t.context), {}});
   }
 };
 
 struct SplitBoth {
-  template <TreeVolume BV, class Pair, class Sink>
-  [[gnu::always_inline]] static bool expand(const TreePair<BV>& t, const Pair& p, Sink& sink) {
+  template <TreeVolume BV, class Leaves, class Pair, class Sink>
+  [[gnu::always_inline]] static bool expand(const TreePair<BV, Leaves>& t, const Pair& p, Sink& sink) {
     using Walker = VolumeWalker<BV>;
     using Working = typename Walker::Working;
     const TreeNode& na = t.a.node(p.a);
@@ -443,7 +499,8 @@ struct StagedChildren {
 /// It holds only references: the queue, the staged children, the trees and the hooks live on the caller's
 /// stack as separate objects, so the queue's out-of-line growth does not force the compiler to reload the
 /// trees' and hooks' references after every BV test.
-template <class QueuePolicy, class Descent, TreeVolume BV, class Hooks, class Limit>
+template <class QueuePolicy, class Descent, TreeVolume BV, class Hooks, class Limit,
+          class Leaves = TriangleLeaves>
 class Traversal {
  public:
   using Pair = typename Hooks::Pair;
@@ -451,7 +508,7 @@ class Traversal {
   using Queue = typename QueuePolicy::template Queue<Pair>;
   using Staged = StagedChildren<Pair, Score>;
 
-  Traversal(const TreePair<BV>& trees, Hooks& hooks, Limit& limit, Queue& queue, Staged& staged)
+  Traversal(const TreePair<BV, Leaves>& trees, Hooks& hooks, Limit& limit, Queue& queue, Staged& staged)
       : trees_(trees), hooks_(hooks), limit_(limit), queue_(queue), staged_(staged) {}
 
   [[gnu::always_inline]] void run() {
@@ -549,7 +606,7 @@ class Traversal {
     return admission == Admission::Decide;
   }
 
-  const TreePair<BV>& trees_;
+  const TreePair<BV, Leaves>& trees_;
   Hooks& hooks_;
   Limit& limit_;
   Queue& queue_;
@@ -557,9 +614,9 @@ class Traversal {
 };
 
 /// Runs one traversal; see the header comment for the order of the calls.
-template <class QueuePolicy, class Descent, TreeVolume BV, class Hooks, class Limit>
-[[gnu::always_inline]] inline void traverse(const TreePair<BV>& trees, Hooks& hooks, Limit& limit) {
-  using Run = Traversal<QueuePolicy, Descent, BV, Hooks, Limit>;
+template <class QueuePolicy, class Descent, TreeVolume BV, class Leaves, class Hooks, class Limit>
+[[gnu::always_inline]] inline void traverse(const TreePair<BV, Leaves>& trees, Hooks& hooks, Limit& limit) {
+  using Run = Traversal<QueuePolicy, Descent, BV, Hooks, Limit, Leaves>;
   typename Run::Queue queue;
   typename Run::Staged staged;
   Run(trees, hooks, limit, queue, staged).run();

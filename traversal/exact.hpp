@@ -4,31 +4,33 @@
 
 #include "driver.hpp"
 
+#include <optional>
 #include <stdexcept>
 
 namespace bvhlab {
 
 enum class ContactMode { First, All };
 
-/// The exact strategy's hooks: a pair is queued iff its volumes overlap; leaf pairs run the triangle tests.
-/// `Pair` may carry a key for other queue policies (set by a derived admit); exact depth-first needs none.
-template <TreeVolume BV, class Pair_ = QueuedPair<BV>>
+/// The exact strategy's hooks: a pair is queued iff its volumes overlap; leaf pairs run the leaf test (the
+/// triangle tests, or Leaves' own). `Pair` may carry a key for other queue policies (set by a derived
+/// admit); exact depth-first needs none.
+template <TreeVolume BV, class Pair_ = QueuedPair<BV>, class Leaves = TriangleLeaves>
 class ExactHooks {
  public:
   using Pair = Pair_;
 
-  ExactHooks(const TreePair<BV>& trees, Result& result, ContactMode mode)
+  ExactHooks(const TreePair<BV, Leaves>& trees, Result& result, ContactMode mode)
       : trees_(trees), result_(result), mode_(mode) {}
 
   [[gnu::always_inline]] bool evaluate(const Pair& p) { return trees_.overlap(p); }
   static Admission admit(Pair&, bool overlap) { return overlap ? Admission::Queue : Admission::Drop; }
   [[gnu::always_inline]] Step leaf_pair(const Pair& p) {
-    const bool first_found = trees_.intersecting_triangles(p.a, p.b, [&](const TrianglePair& hit) {
+    const bool first_found = trees_.leaf_contact(p.a, p.b, [&](const std::optional<TrianglePair>& hit) {
       result_.collides = true;
       result_.probability = 1;
       if (!result_.witness) result_.witness = hit;
       if (mode_ == ContactMode::First) return true;
-      result_.contacts.push_back(hit);
+      if (hit) result_.contacts.push_back(*hit);  // a leaf test without triangles is refused in All mode
       return false;
     });
     return first_found ? Step::Decided : Step::Continue;
@@ -37,25 +39,29 @@ class ExactHooks {
   static void finish(const Queue&, Ended) {}  // nothing left to shape: no contact, or all of them listed
 
  private:
-  const TreePair<BV>& trees_;
+  const TreePair<BV, Leaves>& trees_;
   Result& result_;
   ContactMode mode_;
 };
 
-/// Exact first-contact (or all-contacts) query. `b_to_a` maps B's local frame into A's.
-/// Const and thread-safe on shared trees: all traversal state lives on this call's stack.
-template <TreeVolume BV>
+/// Exact first-contact (or all-contacts) query. `b_to_a` maps B's local frame into A's. `leaves` is the
+/// leaf test (TreePair's Leaves); the default tests triangles, and traversal/point_leaves.hpp passes the
+/// surfaces of point clouds (query_exact_points). Const and thread-safe on shared trees: all traversal
+/// state lives on this call's stack.
+template <TreeVolume BV, class Leaves = TriangleLeaves>
 Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
-                   ContactMode mode = ContactMode::First) {
+                   ContactMode mode = ContactMode::First, const Leaves& leaves = kTriangleLeaves) {
   b_to_a.validate();
+  if constexpr (!Leaves::kTriangles)
+    if (mode == ContactMode::All)
+      throw std::invalid_argument("all contacts: point surfaces have no triangle pairs to list");
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;
-  if (!a.has_polygons() || !b.has_polygons())
-    throw std::invalid_argument("exact query: a tree was loaded without polygons; exact mode needs them");
+  if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "exact query");
   const auto context = VolumeWalker<BV>::make_context(b_to_a);
-  const TreePair<BV> trees(a, b, b_to_a, context, result.counters);
-  ExactHooks<BV> hooks(trees, result, mode);
+  const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
+  ExactHooks<BV, QueuedPair<BV>, Leaves> hooks(trees, result, mode);
   Unlimited limit;
   traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
   return result;

@@ -10,7 +10,7 @@ namespace bvhlab {
 /// Work done by one query. All strategies fill what applies to them.
 struct Counters {
   std::uint64_t bv_tests = 0;        ///< BV-pair overlap tests
-  std::uint64_t triangle_tests = 0;  ///< exact triangle-pair tests
+  std::uint64_t triangle_tests = 0;  ///< exact triangle-pair tests (point queries: leaf-pair surface tests)
   std::uint64_t nodes_visited = 0;   ///< node pairs taken off the stack or queue
   std::uint64_t probability_evaluations = 0;
 
@@ -35,7 +35,8 @@ struct Result {
   bool collides = false;
   /// Estimated probability of collision; exactly 1 or 0 when `exact`.
   double probability = 0;
-  /// True when the answer is decided by exact triangle tests (or by exhausting all overlapping pairs).
+  /// True when the answer is decided by exact triangle tests (or by exhausting all overlapping pairs). Point
+  /// queries (traversal/point_leaves.hpp): by the surfaces' leaf tests, exact on the surfaces only.
   bool exact = true;
   /// True when the deadline or the BV-test cap was reached before the traversal finished. Stopped by it,
   /// the answer is a best effort (not exact). A traversal that finished (queue empty, or a pair decided) in
