@@ -6,16 +6,22 @@
 // positives and false negatives outside the band (of the clear poses), and the speed-up over exact_points.
 // Series: exact on the meshes, exact_points (cloud against cloud), exact_points of the cloud against the
 // mesh, ADB on the clouds at each p_min (traversal/point_leaves.hpp). All on AABB trees, one run, queries
-// timed one by one (warm: each series runs once over the poses before the timed pass).
+// timed one by one (warm: each series runs once over the poses before the timed pass). Built with FCL, also
+// FCL's octree collision on octrees of the same points (bench/core/fcl_octree.hpp) at each --octree-res (in
+// point spacings), and per octree the fastest ADB p_min with no more errors.
 //
 //   bench_points [--meshes=pinion.off] [--points=5000,20000] [--steps=200] [--band=1]
-//                [--p-min=0.5,0.7,0.9,0.95,0.99] [--distances=0.4,...,2.0] [--leaf=16]
+//                [--p-min=0.5,0.7,0.9,0.95,0.99] [--distances=0.4,...,2.0] [--leaf=16] [--octree-res=1,2]
 #include "adb/point_density.hpp"
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
 #include "traversal/point_leaves.hpp"
 #include "volumes/aabb.hpp"
+
+#ifdef BVHLAB_HAVE_FCL
+#include "bench/core/fcl_octree.hpp"
+#endif
 
 #include <benchmark/benchmark.h>
 
@@ -97,6 +103,10 @@ Row measure(const std::string& series, const std::vector<Pose>& poses, Query&& q
   return row;
 }
 
+double error_percent(const Row& r) {
+  return 100.0 * static_cast<double>(r.fp + r.fn) / static_cast<double>(r.clear);
+}
+
 void print_rows(const std::vector<Row>& rows, const Row& reference, double max_error) {
   std::printf("%-22s %10s %10s %7s %7s %7s %9s %9s\n", "series", "median_us", "mean_us", "FP%", "FN%", "err%",
               "x_median", "x_mean");
@@ -117,6 +127,25 @@ void print_rows(const std::vector<Row>& rows, const Row& reference, double max_e
     std::printf("no adb p_min at <= %.0f%% wrong\n", max_error);
 }
 
+/// Per FCL octree row, the fastest ADB row (by mean time) with no more errors than it on the clear poses.
+void print_adb_against_fcl(const std::vector<Row>& rows) {
+  for (const Row& f : rows) {
+    if (f.series.rfind("fcl_octree", 0) != 0) continue;
+    const Row* best = nullptr;
+    for (const Row& r : rows)
+      if (r.series.rfind("adb", 0) == 0 && error_percent(r) <= error_percent(f) &&
+          (!best || r.mean_us < best->mean_us))
+        best = &r;
+    if (best)
+      std::printf("%s (%.2f%% wrong): %s at %.2f%% wrong is %.2fx faster by mean time, %.2fx by median\n",
+                  f.series.c_str(), error_percent(f), best->series.c_str(), error_percent(*best),
+                  f.mean_us / best->mean_us, f.median_us / best->median_us);
+    else
+      std::printf("%s (%.2f%% wrong): no adb p_min at equal or fewer errors\n", f.series.c_str(),
+                  error_percent(f));
+  }
+}
+
 struct Setup {
   std::vector<double> points{5000, 20000};
   std::vector<double> p_mins{0.5, 0.7, 0.9, 0.95, 0.99};
@@ -124,7 +153,33 @@ struct Setup {
   int steps = 200;
   double band = 1;
   unsigned leaf = 16;
+  std::vector<double> octree_res{1, 2};  ///< FCL octree voxel sides, in point spacings
 };
+
+/// FCL's octree series, one per resolution (none without FCL).
+void add_fcl_octree_rows([[maybe_unused]] const PointCloud& cloud, [[maybe_unused]] double spacing,
+                         [[maybe_unused]] const Setup& setup, [[maybe_unused]] const std::vector<Pose>& poses,
+                         [[maybe_unused]] std::vector<Row>& rows) {
+#ifdef BVHLAB_HAVE_FCL
+  for (double factor : setup.octree_res) {
+    const double res = factor * spacing;
+    const auto start = std::chrono::steady_clock::now();
+    const auto octree = make_fcl_octree(cloud, res);
+    const double build_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    std::printf("octree res %.4f (%.3g spacings): %zu occupied leaves, built in %.1f ms\n", res, factor,
+                octree->toBoxes().size(), build_ms);
+    FclOctreePair pair(octree, octree);
+    char name[32];
+    std::snprintf(name, sizeof name, "fcl_octree res=%.4f", res);
+    rows.push_back(measure(name, poses, [&](const RigidTransform& pose) {
+      Result r;
+      r.collides = pair.collides(pose);
+      return r;
+    }));
+  }
+#endif
+}
 
 void run_mesh(const std::string& file, const Setup& setup) {
   const Mesh mesh = load_protocol_mesh(file);
@@ -169,7 +224,9 @@ void run_mesh(const std::string& file, const Setup& setup) {
         return query_adb_points(tree, side, tree, side, pose, adb);
       }));
     }
+    add_fcl_octree_rows(cloud, spacing, setup, poses, rows);
     print_rows(rows, rows[1], 4.0);
+    print_adb_against_fcl(rows);
   }
 }
 
@@ -180,19 +237,23 @@ int main(int argc, char** argv) {
   using namespace bvhlab;
   std::vector<std::string> meshes{"pinion.off"};
   Setup setup;
-  if (auto exit = initialize_benchmark("bench_points",
-                                       {{"meshes", &meshes, "meshes to sample"},
-                                        {"points", &setup.points, "points per cloud, one cloud per value"},
-                                        {"p-min", &setup.p_mins, "ADB's p_min values"},
-                                        {"distances", &setup.distances, "protocol distances"},
-                                        {"steps", &setup.steps, "poses per distance"},
-                                        {"band", &setup.band, "ambiguous band, in point spacings"},
-                                        {"leaf", &setup.leaf, "points per leaf"}},
-                                       argc, argv))
+  if (auto exit = initialize_benchmark(
+          "bench_points",
+          {{"meshes", &meshes, "meshes to sample"},
+           {"points", &setup.points, "points per cloud, one cloud per value"},
+           {"p-min", &setup.p_mins, "ADB's p_min values"},
+           {"distances", &setup.distances, "protocol distances"},
+           {"steps", &setup.steps, "poses per distance"},
+           {"band", &setup.band, "ambiguous band, in point spacings"},
+           {"leaf", &setup.leaf, "points per leaf"},
+           {"octree-res", &setup.octree_res, "FCL octree voxel sides in point spacings (built with FCL)"}},
+          argc, argv))
     return *exit;
   try {
     if (setup.steps < 1) throw std::invalid_argument("--steps must be at least 1");
     if (!(setup.band >= 0)) throw std::invalid_argument("--band must be at least 0 spacings");
+    for (double r : setup.octree_res)
+      if (!(r > 0 && r <= 1e3)) throw std::invalid_argument("--octree-res must be in (0, 1000] spacings");
     for (double n : setup.points)
       if (!(n >= 11 && n <= 1e7 && n == std::floor(n)))
         throw std::invalid_argument("--points must be whole numbers from 11 to 10^7");

@@ -1,7 +1,9 @@
 // FCL's side of a world run: on a crowded world of bundled meshes, FCL's managers and narrow phase find
 // exactly the colliding pairs bvhlab's exact traversal finds, and CGAL finds, pair by pair in every frame;
-// the runner's FCL rows count them so.
+// the runner's FCL rows count them so. And FCL's octrees of point clouds (bench/core/fcl_octree.hpp, what
+// bench_points times): occupied voxels that overlap collide, clouds apart do not.
 #include "bench/core/fcl_model.hpp"
+#include "bench/core/fcl_octree.hpp"
 #include "bench/core/ground_truth.hpp"
 #include "bench/world.hpp"
 #include "scene_fixtures.hpp"
@@ -10,7 +12,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+#include <numbers>
 #include <set>
 
 namespace bvhlab {
@@ -106,6 +110,53 @@ TEST(FclWorld, PosesOfAnotherCountAndMissingModelsAreRefused) {
   FclWorld empty({});
   const std::vector<RigidTransform> one(1);
   EXPECT_THROW(empty.place(one), std::invalid_argument);
+}
+
+// A square plate of (n + 1)^2 points in the plane z = 0, side 1, corner at the origin.
+PointCloud plate(int n) {
+  PointCloud cloud;
+  cloud.name = "plate";
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) cloud.positions.emplace_back(double(i) / n, double(j) / n, 0.0);
+  return cloud;
+}
+
+RigidTransform moved(const Vec3& translation, const Mat3& rotation = Mat3::Identity()) {
+  RigidTransform t;
+  t.rotation = rotation;
+  t.translation = translation;
+  return t;
+}
+
+TEST(FclOctree, OverlappingOccupiedVoxelsCollideAndCloudsApartDoNot) {
+  const double res = 0.05;  // the plate's point spacing
+  const auto octree = make_fcl_octree(plate(20), res);
+  FclOctreePair pair(octree, octree);
+  const Mat3 upright =
+      Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitX()).toRotationMatrix();  // the plate in y = 0
+  EXPECT_TRUE(pair.collides(moved({0, 0, 0})));
+  EXPECT_TRUE(pair.collides(moved({0.3, 0.5, 0}, upright)));  // crossing A along y = 0.5
+  EXPECT_FALSE(pair.collides(moved({5, 0, 0})));
+  EXPECT_FALSE(pair.collides(moved({0, 0, 2.5 * res})));  // parallel, one empty voxel between: unknown space
+  EXPECT_FALSE(pair.collides(moved({1.5, 0.5, 0}, upright)));
+}
+
+TEST(FclOctree, OnlyNodesAtTheOccupancyThresholdCount) {
+  const auto octree = make_fcl_octree(plate(20), 0.05);
+  EXPECT_LT(octree->getOccupancyThres(), 0.97);  // the voxels' value, octomap's clamping maximum
+  EXPECT_LT(octree->getFreeThres(), octree->getOccupancyThres());
+  FclOctreePair pair(octree, octree);
+  octree->setOccupancyThres(0.99);  // above every voxel: nothing is occupied, nothing collides
+  EXPECT_FALSE(pair.collides(moved({0, 0, 0})));
+}
+
+TEST(FclOctree, BadResolutionsPointsOutOfRangeAndNullTreesAreRefused) {
+  EXPECT_THROW(make_fcl_octree(plate(2), 0), std::invalid_argument);
+  EXPECT_THROW(make_fcl_octree(plate(2), std::nan("")), std::invalid_argument);
+  PointCloud far = plate(2);
+  far.positions.emplace_back(1e9, 0, 0);
+  EXPECT_THROW(make_fcl_octree(far, 0.01), std::invalid_argument);
+  EXPECT_THROW(FclOctreePair(nullptr, make_fcl_octree(plate(2), 0.5)), std::invalid_argument);
 }
 
 }  // namespace
