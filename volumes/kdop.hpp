@@ -64,6 +64,10 @@ struct Tables {
   std::vector<Vertex> vertices;       // prototype: n_m . x <= 1 for every m
   double max_lambda_sum = 0;          // largest sum of lambda over the chosen triples (= prototype radius)
 
+  /// Plane m's opposite: the same axis, the other side. The prototype is symmetric, so the triple realign
+  /// finds for -v is the opposite planes of the one for v, with the same coefficients.
+  static constexpr std::size_t opposite(std::size_t m) { return m < Axes ? m + Axes : m - Axes; }
+
   explicit Tables(const DirectionSet<Axes>& set) {
     for (std::size_t a = 0; a < Axes; ++a) {
       axes[a] = Vec3(set.raw[a][0], set.raw[a][1], set.raw[a][2]).normalized();
@@ -327,9 +331,14 @@ struct KDop {
     const auto& t = tables();
     PairContext c{};
     double max_coefficient_sum = 0;
-    for (std::size_t m = 0; m < kPlanes; ++m) {
+    // Plane m + k/2 is plane m's opposite: its triple and coefficients follow from m's (Tables::opposite),
+    // one vertex search per axis instead of per plane.
+    for (std::size_t m = 0; m < kAxes; ++m) {
       const Vec3 v = pose.rotation.transpose() * t.normals[m];
       t.realign(v, c.planes[m], c.coefficients[m]);
+      for (int k = 0; k < 3; ++k)
+        c.planes[m + kAxes][k] = static_cast<std::uint8_t>(t.opposite(c.planes[m][k]));
+      c.coefficients[m + kAxes] = c.coefficients[m];
       max_coefficient_sum =
           std::max(max_coefficient_sum, std::abs(c.coefficients[m][0]) + std::abs(c.coefficients[m][1]) +
                                             std::abs(c.coefficients[m][2]));

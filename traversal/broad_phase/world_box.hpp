@@ -107,9 +107,8 @@ Box world_box(const KDop<Set>& dop, const RigidTransform& pose) {
     SupportPair bound{0, 0};
     double weight = 0;
     for (int k = 0; k < 3; ++k) {
-      const std::size_t opposite = planes[k] < D::kAxes ? planes[k] + D::kAxes : planes[k] - D::kAxes;
       bound.plus += lambda[k] * double(dop.offsets[planes[k]]);
-      bound.minus += lambda[k] * double(dop.offsets[opposite]);
+      bound.minus += lambda[k] * double(dop.offsets[tables.opposite(planes[k])]);
       weight += std::abs(lambda[k]);
     }
     // Rounding of lambda (and a lambda a hair below zero) moves the bound by ulps of weight * |x|.
