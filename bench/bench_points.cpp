@@ -5,10 +5,11 @@
 // errors are counted outside it. Per density and series: the median and mean time per query, false
 // positives and false negatives outside the band (of the clear poses), and the speed-up over exact_points.
 // Series: exact on the meshes, exact_points (cloud against cloud), exact_points of the cloud against the
-// mesh, ADB on the clouds at each p_min (traversal/point_leaves.hpp). All on AABB trees, one run, queries
+// mesh, ADB on the clouds at each p_min and time-critical (ADB at p_min 0.9 under each --bv-tests budget;
+// traversal/point_leaves.hpp). All on AABB trees, one run, queries
 // timed one by one (warm: each series runs once over the poses before the timed pass). Built with FCL, also
 // FCL's octree collision on octrees of the same points (bench/core/fcl_octree.hpp) at each --octree-res (in
-// point spacings), and per octree the fastest ADB p_min with no more errors.
+// point spacings), and per octree the fastest inexact series (ADB or time-critical) with no more errors.
 //
 //   bench_points [--meshes=pinion.off] [--points=5000,20000] [--steps=200] [--band=1]
 //                [--p-min=0.5,0.7,0.9,0.95,0.99] [--distances=0.4,...,2.0] [--leaf=16] [--octree-res=1,2]
@@ -103,6 +104,11 @@ Row measure(const std::string& series, const std::vector<Pose>& poses, Query&& q
   return row;
 }
 
+/// The series that may trade errors for time: ADB at a p_min, and time-critical.
+bool is_inexact(const std::string& series) {
+  return series.rfind("adb", 0) == 0 || series.rfind("time_critical", 0) == 0;
+}
+
 double error_percent(const Row& r) {
   return 100.0 * static_cast<double>(r.fp + r.fn) / static_cast<double>(r.clear);
 }
@@ -116,24 +122,23 @@ void print_rows(const std::vector<Row>& rows, const Row& reference, double max_e
     const double fp = 100.0 * static_cast<double>(r.fp) / n, fn = 100.0 * static_cast<double>(r.fn) / n;
     std::printf("%-22s %10.2f %10.2f %7.2f %7.2f %7.2f %9.2f %9.2f\n", r.series.c_str(), r.median_us,
                 r.mean_us, fp, fn, fp + fn, reference.median_us / r.median_us, reference.mean_us / r.mean_us);
-    if (r.series.rfind("adb", 0) == 0 && fp + fn <= max_error && (!best || r.mean_us < best->mean_us))
-      best = &r;
+    if (is_inexact(r.series) && fp + fn <= max_error && (!best || r.mean_us < best->mean_us)) best = &r;
   }
   if (best)
-    std::printf("best adb at <= %.0f%% wrong: %s, %.2fx faster than %s by mean time, %.2fx by median\n",
+    std::printf("best inexact at <= %.0f%% wrong: %s, %.2fx faster than %s by mean time, %.2fx by median\n",
                 max_error, best->series.c_str(), reference.mean_us / best->mean_us, reference.series.c_str(),
                 reference.median_us / best->median_us);
   else
-    std::printf("no adb p_min at <= %.0f%% wrong\n", max_error);
+    std::printf("no inexact series at <= %.0f%% wrong\n", max_error);
 }
 
-/// Per FCL octree row, the fastest ADB row (by mean time) with no more errors than it on the clear poses.
+/// Per FCL octree row, the fastest inexact row (by mean time) with no more errors than it on the clear poses.
 void print_adb_against_fcl(const std::vector<Row>& rows) {
   for (const Row& f : rows) {
     if (f.series.rfind("fcl_octree", 0) != 0) continue;
     const Row* best = nullptr;
     for (const Row& r : rows)
-      if (r.series.rfind("adb", 0) == 0 && error_percent(r) <= error_percent(f) &&
+      if (is_inexact(r.series) && error_percent(r) <= error_percent(f) &&
           (!best || r.mean_us < best->mean_us))
         best = &r;
     if (best)
@@ -141,7 +146,7 @@ void print_adb_against_fcl(const std::vector<Row>& rows) {
                   f.series.c_str(), error_percent(f), best->series.c_str(), error_percent(*best),
                   f.mean_us / best->mean_us, f.median_us / best->median_us);
     else
-      std::printf("%s (%.2f%% wrong): no adb p_min at equal or fewer errors\n", f.series.c_str(),
+      std::printf("%s (%.2f%% wrong): no inexact series at equal or fewer errors\n", f.series.c_str(),
                   error_percent(f));
   }
 }
@@ -153,7 +158,8 @@ struct Setup {
   int steps = 200;
   double band = 1;
   unsigned leaf = 16;
-  std::vector<double> octree_res{1, 2};  ///< FCL octree voxel sides, in point spacings
+  std::vector<double> octree_res{1, 2};   ///< FCL octree voxel sides, in point spacings
+  std::vector<double> bv_tests{50, 200};  ///< time-critical budgets (ADB at p_min 0.9 with a BV-test cap)
 };
 
 /// FCL's octree series, one per resolution (none without FCL).
@@ -224,6 +230,15 @@ void run_mesh(const std::string& file, const Setup& setup) {
         return query_adb_points(tree, side, tree, side, pose, adb);
       }));
     }
+    for (double bv_tests : setup.bv_tests) {
+      AdbOptions time_critical;  // p_min 0.9; on exhaustion, "collision" iff the best queued estimate >= 0.5
+      time_critical.budget.max_bv_tests = static_cast<std::uint64_t>(bv_tests);
+      char name[48];
+      std::snprintf(name, sizeof name, "time_critical bv_tests=%.0f", bv_tests);
+      rows.push_back(measure(name, poses, [&](const RigidTransform& pose) {
+        return query_adb_points(tree, side, tree, side, pose, time_critical);
+      }));
+    }
     add_fcl_octree_rows(cloud, spacing, setup, poses, rows);
     print_rows(rows, rows[1], 4.0);
     print_adb_against_fcl(rows);
@@ -246,12 +261,16 @@ int main(int argc, char** argv) {
            {"steps", &setup.steps, "poses per distance"},
            {"band", &setup.band, "ambiguous band, in point spacings"},
            {"leaf", &setup.leaf, "points per leaf"},
+           {"bv-tests", &setup.bv_tests, "time-critical series: BV-test budgets at p_min 0.9"},
            {"octree-res", &setup.octree_res, "FCL octree voxel sides in point spacings (built with FCL)"}},
           argc, argv))
     return *exit;
   try {
     if (setup.steps < 1) throw std::invalid_argument("--steps must be at least 1");
     if (!(setup.band >= 0)) throw std::invalid_argument("--band must be at least 0 spacings");
+    for (double n : setup.bv_tests)
+      if (!(n >= 1 && n <= 1e9 && n == std::floor(n)))
+        throw std::invalid_argument("--bv-tests must be whole numbers from 1 to 10^9");
     for (double r : setup.octree_res)
       if (!(r > 0 && r <= 1e3)) throw std::invalid_argument("--octree-res must be in (0, 1000] spacings");
     for (double n : setup.points)
