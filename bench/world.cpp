@@ -33,6 +33,27 @@ std::vector<std::string> instance_objects(const Scene& scene) {
   return objects;
 }
 
+/// `count` copies of the scene's objects (cyclically) at the scene's density: the region grows with the
+/// count, the walk keeps its steps; kScalingFrames frames of it. What every broad phase's scaling row runs
+/// on.
+struct ScalingWorld {
+  std::vector<std::string> objects;
+  std::vector<std::vector<RigidTransform>> frames;
+};
+
+ScalingWorld scaling_world(const Scene& scene, int count) {
+  const WorldSpec& w = *scene.world;
+  const std::vector<std::string> names = instance_objects(scene);
+  ScalingWorld out;
+  for (int i = 0; i < count; ++i) out.objects.push_back(names[static_cast<std::size_t>(i) % names.size()]);
+  const double grow = std::cbrt(double(count) / double(names.size()));
+  const Box region{w.region.center() - 0.5 * grow * w.region.extent(),
+                   w.region.center() + 0.5 * grow * w.region.extent()};
+  const std::vector<std::optional<RigidTransform>> random(out.objects.size());
+  out.frames = random_walk(random, region, w.seed + 1, kScalingFrames, w.step, w.turn_deg);
+  return out;
+}
+
 /// A candidate pair of one frame: the instances, the prepared trees of their objects and B's pose in A's.
 struct Candidate {
   ObjectPair instances;
@@ -101,24 +122,15 @@ class WorldHierarchy {
     return first;
   }
 
-  /// Each broad phase alone on `count` copies of the scene's objects (cyclically) at the scene's density:
-  /// the region grows with the count, the walk keeps its steps; medians over kScalingFrames frames.
+  /// Each broad phase alone on scaling_world(count); medians over its frames.
   std::vector<ScalingRow> scaling(int count) {
-    const WorldSpec& w = *scene_.world;
-    const std::vector<std::string> names = instance_objects(scene_);
-    std::vector<std::string> objects;
-    for (int i = 0; i < count; ++i) objects.push_back(names[static_cast<std::size_t>(i) % names.size()]);
-    const std::vector<const PreparedHierarchy*> own = own_trees(objects);
-    const double grow = std::cbrt(double(count) / double(names.size()));
-    const Box region{w.region.center() - 0.5 * grow * w.region.extent(),
-                     w.region.center() + 0.5 * grow * w.region.extent()};
-    const std::vector<std::optional<RigidTransform>> random(objects.size());
-    const auto frames = random_walk(random, region, w.seed + 1, kScalingFrames, w.step, w.turn_deg);
+    const ScalingWorld world = scaling_world(scene_, count);
+    const std::vector<const PreparedHierarchy*> own = own_trees(world.objects);
     std::vector<ScalingRow> rows;
-    for (const std::string& name : w.broad_phases) {
+    for (const std::string& name : scene_.world->broad_phases) {
       std::unique_ptr<AnyBroadPhase> broad_phase = make_broad_phase(name);
       std::vector<double> boxes_micros, update_micros, candidates;
-      for (const auto& poses : frames) {
+      for (const auto& poses : world.frames) {
         const auto start = Clock::now();
         const std::vector<Box> boxes = world_boxes(own, poses);
         boxes_micros.push_back(micros_since(start));
@@ -127,7 +139,7 @@ class WorldHierarchy {
         candidates.push_back(double(broad_phase->pairs().size()));
         update_micros.push_back(micros_since(begin));
       }
-      rows.push_back({planned_.hierarchy->name, name, objects.size(),
+      rows.push_back({planned_.hierarchy->name, name, world.objects.size(),
                       static_cast<std::size_t>(report_tables::median(candidates)),
                       report_tables::median(boxes_micros), report_tables::median(update_micros)});
     }
@@ -254,7 +266,31 @@ std::vector<Candidate> with_truth(WorldHierarchy& h, const Scene& scene, std::sp
 /// under the hierarchy kFclWorldHierarchy.
 class FclSide {
  public:
-  FclSide(const Scene& scene, Preparation& preparation) : scene_(scene), world_(models(scene, preparation)) {}
+  FclSide(const Scene& scene, Preparation& preparation)
+      : scene_(scene), preparation_(preparation), world_(models(instance_objects(scene))) {}
+
+  /// FCL's managers alone on scaling_world(count), timed as the hierarchies' scaling rows are (its boxes:
+  /// setTransform and computeAABB; then registration in the first frame, update after, and the pairs).
+  std::vector<ScalingRow> scaling(int count) {
+    const ScalingWorld scaled = scaling_world(scene_, count);
+    std::vector<ScalingRow> rows;
+    for (std::size_t k = 0; k < FclWorld::kManagers.size(); ++k) {
+      FclWorld world(models(scaled.objects));
+      std::vector<double> boxes_micros, update_micros, candidates;
+      for (const auto& poses : scaled.frames) {
+        const auto start = Clock::now();
+        world.place(poses);
+        boxes_micros.push_back(micros_since(start));
+        const auto begin = Clock::now();
+        candidates.push_back(double(world.pairs(k).size()));
+        update_micros.push_back(micros_since(begin));
+      }
+      rows.push_back({std::string(kFclWorldHierarchy), FclWorld::kManagers[k], world.size(),
+                      static_cast<std::size_t>(report_tables::median(candidates)),
+                      report_tables::median(boxes_micros), report_tables::median(update_micros)});
+    }
+    return rows;
+  }
 
   void frame(int frame, std::span<const RigidTransform> poses,
              const std::map<std::pair<std::uint32_t, std::uint32_t>, bool>& truth, int warmup,
@@ -278,14 +314,11 @@ class FclSide {
 
  private:
   /// One model per object (FCL's OBBRSS, as the pair runner's fcl_obbrss), shared by its instances.
-  static std::vector<std::shared_ptr<fcl::CollisionGeometryd>> models(const Scene& scene,
-                                                                      Preparation& preparation) {
-    std::map<std::string, std::shared_ptr<fcl::CollisionGeometryd>> by_object;
+  std::vector<std::shared_ptr<fcl::CollisionGeometryd>> models(const std::vector<std::string>& objects) {
     std::vector<std::shared_ptr<fcl::CollisionGeometryd>> out;
-    for (const WorldInstance& instance : scene.world->instances) {
-      auto& model = by_object[instance.object];
-      if (!model)
-        model = make_fcl_model<fcl::OBBRSSd>(preparation.object(*scene.object(instance.object)).mesh);
+    for (const std::string& object : objects) {
+      auto& model = models_[object];
+      if (!model) model = make_fcl_model<fcl::OBBRSSd>(preparation_.object(*scene_.object(object)).mesh);
       out.push_back(model);
     }
     return out;
@@ -350,6 +383,8 @@ class FclSide {
   }
 
   const Scene& scene_;
+  Preparation& preparation_;
+  std::map<std::string, std::shared_ptr<fcl::CollisionGeometryd>> models_;  // by object; before world_
   FclWorld world_;
   std::vector<ObjectPair> colliding_;  ///< FCL's colliding pairs of the frame, sorted
 };
@@ -396,6 +431,9 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
   for (int count : scene.world->scaling) {
     log("broad phases alone at " + std::to_string(count) + " objects");
     for (auto& row : hierarchies.front()->scaling(count)) output.scaling.push_back(row);
+#ifdef BVHLAB_HAVE_FCL
+    for (auto& row : fcl.scaling(count)) output.scaling.push_back(row);
+#endif
   }
   output.models = preparation.models();
   output.stats.wall_seconds = std::chrono::duration<double>(Clock::now() - wall).count();

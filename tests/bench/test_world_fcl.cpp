@@ -33,7 +33,8 @@ const std::string kCrowd = R"({"objects": [{"mesh": "jeep1.ms3d", "name": "jeep"
   "world": {"instances": [{"object": "jeep", "count": 4}, {"object": "gear", "count": 4},
                           {"object": "teapot", "count": 4}],
             "region": {"min": [-2.5, -2.5, -2.5], "max": [2.5, 2.5, 2.5]},
-            "motion": {"type": "random_walk", "frames": 4, "seed": 5, "step": 0.3, "turn_deg": 20}}})";
+            "motion": {"type": "random_walk", "frames": 4, "seed": 5, "step": 0.3, "turn_deg": 20},
+            "scaling": [36]}})";
 
 using PairSet = std::set<ObjectPair>;
 
@@ -102,6 +103,22 @@ TEST_F(WorldFclTest, FclsCollidingPairsAreBvhlabsAndCgalsInEveryFrame) {
     }
   }
   EXPECT_GT(colliding_seen, 2 * std::size_t(w.frames));  // crowded enough to compare something
+
+  // The scaling rows: FCL's two managers beside bvhlab's broad phases on the same 36 copies and walk; both
+  // managers see FCL's boxes, so they find the same number of candidates, never fewer than bvhlab's.
+  std::map<std::string, std::size_t> fcl_candidates;
+  std::size_t bvhlab_scaled = 0;
+  for (const ScalingRow& r : out.scaling) {
+    EXPECT_EQ(r.objects, 36u) << r.hierarchy << " " << r.broad_phase;
+    if (r.hierarchy == kFclWorldHierarchy)
+      fcl_candidates[r.broad_phase] = r.candidates;
+    else
+      bvhlab_scaled = r.candidates;
+  }
+  ASSERT_EQ(fcl_candidates.size(), FclWorld::kManagers.size());
+  EXPECT_EQ(fcl_candidates.begin()->second, fcl_candidates.rbegin()->second);
+  EXPECT_GE(fcl_candidates.begin()->second, bvhlab_scaled);
+  EXPECT_GT(bvhlab_scaled, 0u);
   EXPECT_LT(colliding_seen, std::size_t(w.frames) * n * (n - 1) / 2);
 }
 
