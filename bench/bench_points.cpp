@@ -50,15 +50,6 @@ struct Row {
   std::size_t fp = 0, fn = 0, clear = 0;
 };
 
-double mesh_area(const Mesh& mesh) {
-  double area = 0;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const TrianglePoints p = mesh.triangle(t);
-    area += 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-  }
-  return area;
-}
-
 /// The protocol poses with the mesh answer; ambiguous where B moved by `shift` along an axis changes it.
 std::vector<Pose> protocol_workload(const Bvh<Aabb>& mesh_tree, const std::vector<double>& distances,
                                     int steps, double shift) {
@@ -190,7 +181,7 @@ void add_fcl_octree_rows([[maybe_unused]] const PointCloud& cloud, [[maybe_unuse
 void run_mesh(const std::string& file, const Setup& setup) {
   const Mesh mesh = load_protocol_mesh(file);
   const auto mesh_tree = Bvh<Aabb>::build(mesh);
-  const double area = mesh_area(mesh);
+  const double area = surface_area(mesh);
   std::printf("\n=== %s: %zu triangles, area %.3f (longest side 2), %d steps x %zu distances ===\n",
               file.c_str(), mesh.triangles.size(), area, setup.steps, setup.distances.size());
   for (double count : setup.points) {

@@ -303,14 +303,17 @@ double length(const Vec3& v) {
   return std::sqrt(v.x() * v.x() + v.y() * v.y() + v.z() * v.z());
 }
 
+double triangle_area(const TrianglePoints& p) {
+  return 0.5 * length(cross(p[1] - p[0], p[2] - p[0]));
+}
+
 /// Area-weighted triangle choice and uniform points in triangles.
 class MeshSampler {
  public:
   explicit MeshSampler(const Mesh& mesh) : mesh_(mesh) {
     cumulative_.reserve(mesh.triangle_count());
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-      const TrianglePoints p = mesh.triangle(t);
-      total_ += 0.5 * length(cross(p[1] - p[0], p[2] - p[0]));
+      total_ += triangle_area(mesh.triangle(t));
       cumulative_.push_back(total_);
     }
     if (!(total_ > 0) || !std::isfinite(total_))
@@ -411,6 +414,12 @@ void save_point_cloud_ply(const PointCloud& cloud, const std::filesystem::path& 
     out << '\n';
   }
   if (!out) fail(path.string(), "write failed");
+}
+
+double surface_area(const Mesh& mesh) {
+  double total = 0;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) total += triangle_area(mesh.triangle(t));
+  return total;
 }
 
 PointCloud sample_uniform(const Mesh& mesh, std::size_t n, std::uint64_t seed) {

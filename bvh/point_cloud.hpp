@@ -61,6 +61,10 @@ PointCloud load_point_cloud_from_memory(std::span<const std::byte> bytes, std::s
 /// Writes an ascii PLY of the positions (and normals when present).
 void save_point_cloud_ply(const PointCloud& cloud, const std::filesystem::path& path);
 
+/// The total area of the mesh's triangles: what sample_uniform's points share (each the area / n), and
+/// the square of the point spacing times n.
+double surface_area(const Mesh& mesh);
+
 /// `n` points uniform by area on the mesh: a triangle chosen with probability proportional to its area, a
 /// uniform point in it, the triangle's normal (right-hand rule of its indices). Each point's area is the
 /// mesh's area / n. The same for a seed on every platform (own integer generator, no std distributions).

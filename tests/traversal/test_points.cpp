@@ -16,15 +16,6 @@
 namespace bvhlab {
 namespace {
 
-double mesh_area(const Mesh& mesh) {
-  double area = 0;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const TrianglePoints p = mesh.triangle(t);
-    area += 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-  }
-  return area;
-}
-
 /// A mesh, a cloud sampled from it, and what a point query needs of the cloud.
 struct Sampled {
   Sampled(Mesh source, std::size_t points, std::uint64_t seed)
@@ -34,7 +25,7 @@ struct Sampled {
         surface(cloud),
         tree(annotate_adb_points(Bvh<Aabb>::build(cloud), cloud, 2)),
         coverings(sphere_coverings(tree.bvh, surface)),
-        spacing(std::sqrt(mesh_area(mesh) / static_cast<double>(points))) {}
+        spacing(std::sqrt(surface_area(mesh) / static_cast<double>(points))) {}
   [[nodiscard]] SurfaceSide side() const { return cloud_side(surface, coverings); }
 
   Mesh mesh;
