@@ -31,6 +31,7 @@
 
 #include "../../volumes/geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <compare>
 #include <concepts>
@@ -99,6 +100,34 @@ inline bool boxes_touch(const Box& a, const Box& b) {
 inline ObjectPair ordered_pair(std::uint32_t i, std::uint32_t j) {
   return i < j ? ObjectPair{i, j} : ObjectPair{j, i};
 }
+
+/// Puts a frame's pairs in ascending order: bucketed by their first object (a counting sort, O(n + pairs)),
+/// then each bucket, a handful of pairs, by the second. A comparison sort of the pairs took about a sixth of
+/// the dynamic tree's frame in a dense world. Keeps its buffers between frames.
+class PairSorter {
+ public:
+  void sort(std::vector<ObjectPair>& pairs, std::size_t objects) {
+    bucket_end_.assign(objects + 1, 0);
+    for (const ObjectPair& p : pairs) ++bucket_end_[p.a + 1];
+    for (std::size_t i = 1; i <= objects; ++i) bucket_end_[i] += bucket_end_[i - 1];
+    sorted_.resize(pairs.size());
+    for (const ObjectPair& p : pairs) sorted_[bucket_end_[p.a]++] = p;
+    // bucket_end_[a] is now where bucket a ends; it starts where bucket a - 1 ends.
+    std::uint32_t begin = 0;
+    for (std::size_t a = 0; a < objects; ++a) {
+      const std::uint32_t end = bucket_end_[a];
+      if (end - begin > 1)
+        std::sort(sorted_.begin() + begin, sorted_.begin() + end,
+                  [](const ObjectPair& x, const ObjectPair& y) { return x.b < y.b; });
+      begin = end;
+    }
+    pairs.swap(sorted_);
+  }
+
+ private:
+  std::vector<std::uint32_t> bucket_end_;
+  std::vector<ObjectPair> sorted_;
+};
 
 }  // namespace broad_phase_detail
 

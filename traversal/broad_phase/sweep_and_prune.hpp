@@ -138,11 +138,11 @@ class SweepAndPrune {
       const Entry& a = entries_[i];
       for (std::size_t j = i + 1; j < n && entries_[j].lo <= a.hi; ++j) {
         const Entry& b = entries_[j];
-        if (b.lo1 <= a.hi1 && a.lo1 <= b.hi1 && b.lo2 <= a.hi2 && a.lo2 <= b.hi2)
+        if ((b.lo1 <= a.hi1) & (a.lo1 <= b.hi1) & (b.lo2 <= a.hi2) & (a.lo2 <= b.hi2))
           pairs_.push_back(broad_phase_detail::ordered_pair(a.id, b.id));
       }
     }
-    std::sort(pairs_.begin(), pairs_.end());
+    sorter_.sort(pairs_, n);
   }
 
   std::int64_t registered_ = -1;
@@ -152,6 +152,7 @@ class SweepAndPrune {
   std::uint64_t full_sorts_ = 0;
   std::vector<Entry> entries_;  // sorted by lo
   std::vector<ObjectPair> pairs_;
+  broad_phase_detail::PairSorter sorter_;
 };
 
 static_assert(BroadPhase<SweepAndPrune>);
