@@ -1,6 +1,7 @@
 // The points scene: its section is parsed with every refusal named, and a report run on the small shipped
 // scene writes rows that agree with the scene (every density, distance and series) and with each other.
 #include "bench/points.hpp"
+#include "bench/run.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 
@@ -70,6 +71,11 @@ TEST_F(PointsSceneTest, TheRunnerRefusesASceneWithoutPoints) {
   const Scene scene = parse(R"({"objects": [{"mesh": "torus.obj"}], "hierarchies": [{"bv": "aabb"}],
                                 "strategies": [{"type": "exact"}], "workload": {"steps": 2}})");
   EXPECT_THROW(run_points(scene, true), std::invalid_argument);
+}
+
+TEST_F(PointsSceneTest, TheMeshRunnerRefusesAPointsScene) {
+  EXPECT_THROW(run_scene(parse(points_scene(R"({"densities": [100]})")), RunOptions{}),
+               std::invalid_argument);
 }
 
 /// A CSV file as rows of named cells (the report's quoting: strings in double quotes, no commas inside).
