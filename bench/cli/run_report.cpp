@@ -1,6 +1,7 @@
 // bvhlab run, report and demo: run a scene and write its results, or its report folder.
 #include "bench/cli/cli.hpp"
 #include "bench/deform.hpp"
+#include "bench/points.hpp"
 #include "bench/report.hpp"
 #include "bench/world.hpp"
 #include "bench/write.hpp"
@@ -107,12 +108,33 @@ int run_deform_scene(const Scene& scene, const RunOptions& options, const fs::pa
   return figures && !plot_error.empty() ? 4 : 0;
 }
 
+/// A points scene's run: its CSV files, figures (when asked) and README in `dir`; prints the README's path
+/// and, on stderr, the figures'. 3 if the mesh truth disagrees with CGAL, 4 if figures could not be drawn.
+int run_points_scene(const Scene& scene, const fs::path& dir, bool figures, bool quiet) {
+  const PointsOutput output = run_points(scene, quiet);
+  const std::string plot_error = write_points_report(output, dir, figures);
+  if (!quiet) std::fputs(points_text(output).c_str(), stderr);
+  if (figures && !plot_error.empty()) std::fprintf(stderr, "bvhlab: %s\n", plot_error.c_str());
+  for (const char* figure : {"points_error_vs_time.png", "points_fp_fn.png"})
+    if (fs::is_regular_file(dir / figure))
+      std::fprintf(stderr, "bvhlab: figure %s\n", fs::absolute(dir / figure).c_str());
+  std::printf("%s\n", fs::absolute(dir / "README.md").c_str());
+  if (output.cgal_mismatches) {
+    std::fprintf(stderr,
+                 "bvhlab: the mesh truth disagrees with CGAL on %zu poses; the error rates are suspect\n",
+                 output.cgal_mismatches);
+    return 3;
+  }
+  return figures && !plot_error.empty() ? 4 : 0;
+}
+
 int run_command(const SceneArgs& args) {
   const RunOptions options = scene_run_options(args);
   const Scene scene = load_scene(args.scene_file);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / scene.name : fs::path(args.out_dir);
   if (scene.world) return run_world_scene(scene, options, dir, false, args.quiet);
   if (scene.deform) return run_deform_scene(scene, options, dir, false, args.quiet);
+  if (scene.points) return run_points_scene(scene, dir, false, args.quiet);
   const RunOutput output = run_scene(scene, options);
   write_results_csv(output, dir / "results.csv");
   write_results_json(output, dir / "results.json");
@@ -138,6 +160,7 @@ struct ReportJob {
 int run_report(const ReportJob& job) {
   if (job.scene.world) return run_world_scene(job.scene, job.options, job.dir, job.figures, job.quiet);
   if (job.scene.deform) return run_deform_scene(job.scene, job.options, job.dir, job.figures, job.quiet);
+  if (job.scene.points) return run_points_scene(job.scene, job.dir, job.figures, job.quiet);
   const RunOutput output = run_scene(job.scene, job.options);
   ReportOptions report_options;
   report_options.figures = job.figures;

@@ -728,10 +728,20 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   const json document = parse_json(json_text, source);
   const Node root(document, "", source);
   root.expect_object({"name", "description", "objects", "pairs", "hierarchies", "annotation", "strategies",
-                      "workload", "report", "calibration", "world", "deform"});
+                      "workload", "report", "calibration", "world", "deform", "points"});
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : "scene";
   parse_objects(root, base_dir, scene);
+  // A points scene runs its own series on its clouds' trees: pairs and "points" only.
+  if (root.has("points")) {
+    for (const char* field :
+         {"world", "deform", "hierarchies", "annotation", "strategies", "workload", "report", "calibration"})
+      if (root.has(field))
+        root.child(field).fail("does not apply to a points scene (its series and poses are in \"points\")");
+    parse_pairs(root, scene);
+    parse_points(root, scene, fcl_available());
+    return scene;
+  }
   if (root.has("world") && root.has("deform"))
     root.child("deform").fail("a scene is a world or a deform scene");
   // A world or deform scene names its own motion: no pairs, workload or report.

@@ -216,6 +216,24 @@ struct DeformSpec {
   std::vector<DensityUpdateSpec> density_updates;  ///< for the hierarchies with an ADB density
 };
 
+/// Point clouds sampled from each pair's meshes, B tumbling about A on the protocol ("points" in the file;
+/// format: bench/scenes/README.md; the series and the measuring: bench/points.hpp).
+struct PointsSpec {
+  std::vector<double> densities{5000, 20000};  ///< points per cloud (whole numbers), one cloud per value
+  std::uint64_t seed = 1;                      ///< sampling seed (B's cloud of another object: seed + 1)
+  bool varying = false;                        ///< sample_varying with k-NN areas, else sample_uniform
+  double ratio = 4;                            ///< varying: the density ratio along the longest axis
+  std::vector<double> distances{0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0};
+  int steps = 200;          ///< protocol poses per distance
+  double band = 1;          ///< the ambiguous band, in point spacings
+  std::uint32_t leaf = 16;  ///< points per leaf
+  int grid = 2;             ///< the ADB grid of the clouds' trees
+  std::vector<double> p_mins{0.5, 0.7, 0.9, 0.95, 0.99};
+  std::vector<double> bv_tests{50, 200};  ///< time-critical series: BV-test caps at p_min 0.9
+  std::vector<double> octree_res;         ///< FCL octree voxel sides in spacings (FCL builds only)
+  int cgal_sample = 16;                   ///< poses per pair whose mesh truth is checked against CGAL
+};
+
 struct Scene {
   std::string name;
   std::filesystem::path file;  ///< where it was read from (empty for a string)
@@ -231,6 +249,8 @@ struct Scene {
   std::optional<WorldSpec> world;
   /// Set for a deform scene: one deforming object against a rigid one, in place of "pairs" and "workload".
   std::optional<DeformSpec> deform;
+  /// Set for a points scene: clouds sampled from each pair's meshes, in place of the strategies and workload.
+  std::optional<PointsSpec> points;
   /// What the parser left out on purpose (an optional hierarchy this build cannot provide), for the report.
   std::vector<std::string> notes;
 

@@ -134,4 +134,8 @@ void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene&
 /// the density updates.
 void parse_deform(const Node& root, const std::filesystem::path& base_dir, Scene& scene);
 
+/// The "points" section (bench/core/points_scene.cpp): densities, sampling, the protocol, the series'
+/// parameters. `fcl`: whether this build has FCL (its octree series).
+void parse_points(const Node& root, Scene& scene, bool fcl);
+
 }  // namespace bvhlab::scene_json

@@ -1,0 +1,126 @@
+#!/usr/bin/env python3
+"""Figures of a points report (bvhlab report on a scene with "points"), from the CSV files in REPORT_DIR:
+
+  points_error_vs_time.png  wrong answers outside the ambiguous band (FP + FN, percent of the clear poses)
+                            against the mean time per query, one panel per pair and density, one colour per
+                            series; ADB's p_min values joined by a line, the goal's 4 % dashed
+  points_fp_fn.png          FP and FN (percent of each distance's clear poses) against the protocol distance,
+                            one row of two panels per pair and density, one colour per series
+"""
+import argparse
+import csv
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+GOAL_PERCENT = 4.0
+
+
+def read_csv(path):
+    if not os.path.exists(path):
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def percent(part, whole):
+    return 100.0 * part / whole if whole else 0.0
+
+
+def error_percent(r):
+    """Wrong answers outside the band, percent of the clear poses."""
+    return percent(int(r["fp"]) + int(r["fn"]), int(r["clear"]))
+
+
+def groups(rows):
+    """(pair, points) -> rows, in the order the run wrote them."""
+    out = {}
+    for r in rows:
+        out.setdefault((r["pair"], int(r["points"])), []).append(r)
+    return out
+
+
+def series_colours(rows):
+    """One colour per series, the same in every panel and figure."""
+    names = list(dict.fromkeys(r["series"] for r in rows))
+    first, more = plt.get_cmap("tab10"), plt.get_cmap("Dark2")
+    return {name: first(k) if k < 10 else more((k - 10) % 8) for k, name in enumerate(names)}
+
+
+def panel_grid(count, columns):
+    rows = max(1, (count + columns - 1) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(5.2 * columns, 3.8 * rows), squeeze=False)
+    return fig, axes
+
+
+def figure_error_vs_time(summary, out):
+    colours = series_colours(summary)
+    by_group = groups(summary)
+    fig, axes = panel_grid(len(by_group), min(2, len(by_group)))
+    flat = [ax for row in axes for ax in row]
+    for ax, ((pair, points), rows) in zip(flat, by_group.items()):
+        adb = sorted((r for r in rows if r["series"].startswith("adb")), key=lambda r: float(r["mean_us"]))
+        if len(adb) > 1:
+            ax.plot([float(r["mean_us"]) for r in adb], [error_percent(r) for r in adb], "-", color="0.6",
+                    linewidth=1, zorder=1)
+        for r in rows:
+            ax.scatter([max(float(r["mean_us"]), 1e-3)], [error_percent(r)], color=colours[r["series"]],
+                       label=r["series"], zorder=2)
+        ax.axhline(GOAL_PERCENT, color="0.3", linestyle="--", linewidth=0.8)
+        ax.set_xscale("log")
+        ax.set_ylim(bottom=0)
+        ax.set_xlabel("mean µs per query")
+        ax.set_ylabel("FP + FN, % of clear poses")
+        ax.set_title(f"{pair}, {points} points", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in flat[len(by_group):]:
+        ax.set_visible(False)
+    flat[0].legend(fontsize=6, loc="upper right")
+    fig.suptitle("Point clouds: error outside the ambiguous band against time")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def figure_fp_fn(rows, out):
+    colours = series_colours(rows)
+    by_group = groups(rows)
+    fig, axes = plt.subplots(len(by_group), 2, figsize=(10.4, 3.4 * len(by_group)), squeeze=False)
+    for ((pair, points), group_rows), panels in zip(by_group.items(), axes):
+        for series in dict.fromkeys(r["series"] for r in group_rows):
+            curve = sorted((r for r in group_rows if r["series"] == series), key=lambda r: float(r["distance"]))
+            d = [float(r["distance"]) for r in curve]
+            panels[0].plot(d, [percent(int(r["fp"]), int(r["clear"])) for r in curve], marker=".",
+                           color=colours[series], label=series)
+            panels[1].plot(d, [percent(int(r["fn"]), int(r["clear"])) for r in curve], marker=".",
+                           color=colours[series], label=series)
+        for ax, what in zip(panels, ("false positives", "false negatives")):
+            ax.set_xlabel("distance")
+            ax.set_ylabel(f"{what}, % of clear poses")
+            ax.set_ylim(bottom=0)
+            ax.set_title(f"{pair}, {points} points: {what}", fontsize=9)
+            ax.grid(True, alpha=0.3)
+    axes[0][0].legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("report_dir")
+    args = parser.parse_args()
+    summary = read_csv(os.path.join(args.report_dir, "points_summary.csv"))
+    rows = read_csv(os.path.join(args.report_dir, "points_rows.csv"))
+    if not summary or not rows:
+        sys.exit("plot_points.py: points_summary.csv or points_rows.csv is missing or empty")
+    figure_error_vs_time(summary, os.path.join(args.report_dir, "points_error_vs_time.png"))
+    figure_fp_fn(rows, os.path.join(args.report_dir, "points_fp_fn.png"))
+
+
+if __name__ == "__main__":
+    main()
