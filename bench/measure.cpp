@@ -65,45 +65,41 @@ double clock_overhead_us() {
 // ---------------------------------------------------------------------------------------------------------
 // Ground truth on disk.
 
-std::optional<Truth> TruthCache::load(const std::string& key, const WorkloadSpec& workload,
-                                      std::string* why) const {
-  if (dir_.empty()) return std::nullopt;
-  const auto file = file_of(key);
-  if (!std::filesystem::exists(file)) return std::nullopt;
+std::vector<std::byte> KeyedFileCache::read(const std::filesystem::path& file, const std::string& key) {
+  std::vector<std::byte> bytes = tree_cache_detail::read_file_bytes(file);
+  Reader in{bytes};
+  if (in.u64() != ContentHash().update(key).digest()) throw std::runtime_error("stale: made for another key");
+  return bytes;
+}
+
+void KeyedFileCache::store(const std::string& key, std::span<const std::byte> payload,
+                           const LogFn& log) const {
+  if (dir_.empty()) return;
+  std::vector<std::byte> out;
+  const std::uint64_t digest = ContentHash().update(key).digest();
+  for (std::size_t i = 0; i < kKeyBytes; ++i)
+    out.push_back(static_cast<std::byte>((digest >> (8 * i)) & 0xff));
+  out.insert(out.end(), payload.begin(), payload.end());
   try {
-    const std::vector<std::byte> bytes = tree_cache_detail::read_file_bytes(file);
-    Reader in{bytes};
-    if (in.take(8) != std::string_view("BVHLGT01")) throw std::runtime_error("not a ground-truth file");
-    if (in.u64() != ContentHash().update(key).digest())
-      throw std::runtime_error("stale: made for another key");
-    const std::uint64_t groups = in.u64();
-    if (groups != workload.groups.size()) throw std::runtime_error("stale: wrong number of pose groups");
-    Truth truth(groups);
-    for (std::size_t g = 0; g < groups; ++g) {
-      const std::uint64_t n = in.u64();
-      if (n != workload.groups[g].poses.size()) throw std::runtime_error("stale: wrong number of poses");
-      const std::string_view bits = in.take((n + 7) / 8);
-      truth[g].resize(n);
-      for (std::size_t i = 0; i < n; ++i)
-        truth[g][i] = (static_cast<unsigned char>(bits[i / 8]) >> (i % 8)) & 1;
-    }
-    const std::size_t body = in.position;
-    if (in.u64() != hash_bytes(std::span(bytes).first(body))) throw std::runtime_error("checksum mismatch");
-    if (in.position != bytes.size()) throw std::runtime_error("trailing bytes");
-    return truth;
+    tree_cache_detail::write_file_bytes(file_of(key), out);
   } catch (const std::exception& e) {
-    *why = file.filename().string() + ": " + e.what();
-    return std::nullopt;
+    log(what_ + " cache: could not store (" + e.what() + ")");
   }
 }
 
-void TruthCache::store(const std::string& key, const Truth& truth, const LogFn& log) const {
-  if (dir_.empty()) return;
-  std::string out = "BVHLGT01";
+std::filesystem::path KeyedFileCache::file_of(const std::string& key) const {
+  return dir_ / (ContentHash().update(key).hex() + extension_);
+}
+
+namespace {
+
+// Ground truth payload: "BVHLGT02", the group count, per group its pose count and one bit per pose, then a
+// checksum of all before it.
+std::vector<std::byte> encode_truth(const Truth& truth) {
+  std::string out = "BVHLGT02";
   auto put = [&](std::uint64_t v) {
     for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
   };
-  put(ContentHash().update(key).digest());
   put(truth.size());
   for (const auto& group : truth) {
     put(group.size());
@@ -113,53 +109,32 @@ void TruthCache::store(const std::string& key, const Truth& truth, const LogFn& 
     out += bits;
   }
   put(hash_bytes(std::as_bytes(std::span(out.data(), out.size()))));
-  try {
-    tree_cache_detail::write_file_bytes(file_of(key), std::as_bytes(std::span(out.data(), out.size())));
-  } catch (const std::exception& e) {
-    log(std::string("truth cache: could not store (") + e.what() + ")");
+  const auto bytes = std::as_bytes(std::span(out.data(), out.size()));
+  return {bytes.begin(), bytes.end()};
+}
+
+// Throws naming what is wrong: not a truth payload, made for another workload, corrupt.
+Truth decode_truth(std::span<const std::byte> bytes, const WorkloadSpec& workload) {
+  Reader in{bytes};
+  if (in.take(8) != std::string_view("BVHLGT02")) throw std::runtime_error("not a ground-truth file");
+  const std::uint64_t groups = in.u64();
+  if (groups != workload.groups.size()) throw std::runtime_error("stale: wrong number of pose groups");
+  Truth truth(groups);
+  for (std::size_t g = 0; g < groups; ++g) {
+    const std::uint64_t n = in.u64();
+    if (n != workload.groups[g].poses.size()) throw std::runtime_error("stale: wrong number of poses");
+    const std::string_view bits = in.take((n + 7) / 8);
+    truth[g].resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      truth[g][i] = (static_cast<unsigned char>(bits[i / 8]) >> (i % 8)) & 1;
   }
+  const std::size_t body = in.position;
+  if (in.u64() != hash_bytes(bytes.first(body))) throw std::runtime_error("checksum mismatch");
+  if (in.position != bytes.size()) throw std::runtime_error("trailing bytes");
+  return truth;
 }
 
-std::filesystem::path TruthCache::file_of(const std::string& key) const {
-  return dir_ / (ContentHash().update(key).hex() + ".truth");
-}
-
-// ---------------------------------------------------------------------------------------------------------
-// Calibration maps on disk.
-
-std::optional<CalibrationMap> CalibrationCache::load(const std::string& key, std::string* why) const {
-  if (dir_.empty()) return std::nullopt;
-  const auto file = file_of(key);
-  if (!std::filesystem::exists(file)) return std::nullopt;
-  try {
-    const std::vector<std::byte> bytes = tree_cache_detail::read_file_bytes(file);
-    Reader in{bytes};
-    if (in.u64() != ContentHash().update(key).digest())
-      throw std::runtime_error("stale: made for another key");
-    return CalibrationMap::decode(std::span(bytes).subspan(in.position), "map");
-  } catch (const std::exception& e) {
-    *why = file.filename().string() + ": " + e.what();
-    return std::nullopt;
-  }
-}
-
-void CalibrationCache::store(const std::string& key, const CalibrationMap& map, const LogFn& log) const {
-  if (dir_.empty()) return;
-  std::vector<std::byte> out;
-  const std::uint64_t digest = ContentHash().update(key).digest();
-  for (int i = 0; i < 8; ++i) out.push_back(static_cast<std::byte>((digest >> (8 * i)) & 0xff));
-  const std::vector<std::byte> body = map.encode();
-  out.insert(out.end(), body.begin(), body.end());
-  try {
-    tree_cache_detail::write_file_bytes(file_of(key), out);
-  } catch (const std::exception& e) {
-    log(std::string("calibration cache: could not store (") + e.what() + ")");
-  }
-}
-
-std::filesystem::path CalibrationCache::file_of(const std::string& key) const {
-  return dir_ / (ContentHash().update(key).hex() + ".calib");
-}
+}  // namespace
 
 // ---------------------------------------------------------------------------------------------------------
 // Progress.
@@ -200,8 +175,10 @@ Measurement::Measurement(const Scene& scene, const RunPlan& plan, const RunOptio
       log_(std::move(log)),
       threads_(threads),
       warmup_(options.warmup_queries),
-      truth_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "truth"),
-      calibration_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "calibration"),
+      truth_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "truth", ".truth",
+                   "truth"),
+      calibration_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "calibration",
+                         ".calib", "calibration"),
       progress_(options.progress, plan.total_queries) {}
 
 Truth Measurement::ground_truth(const PreparedPair& pair, Preparation& preparation) {
@@ -216,7 +193,8 @@ Truth Measurement::cached_truth(const PreparedPair& pair, Preparation& preparati
                                 const WorkloadSpec& workload) {
   const std::string truth_key = "truth v1|A=" + pair.a->key + "|B=" + pair.b->key + "|" + workload.identity;
   std::string why;
-  std::optional<Truth> truth = truth_cache_.load(truth_key, workload, &why);
+  std::optional<Truth> truth = truth_cache_.load(
+      truth_key, &why, [&](std::span<const std::byte> payload) { return decode_truth(payload, workload); });
   if (truth) {
     ++stats_.truth_cache_hits;
     return std::move(*truth);
@@ -227,7 +205,7 @@ Truth Measurement::cached_truth(const PreparedPair& pair, Preparation& preparati
   }
   truth = compute_truth(pair, preparation, workload);
   ++stats_.truth_computed;
-  truth_cache_.store(truth_key, *truth, log_);
+  truth_cache_.store(truth_key, encode_truth(*truth), log_);
   return std::move(*truth);
 }
 
@@ -315,7 +293,9 @@ SeriesMaps Measurement::calibration_maps(const PreparedPair& pair, Preparation& 
                               "|annotation=" + pair.hierarchies[i]->model.annotation +
                               "|series=" + variant.label() + "|" + training.identity;
       std::string why;
-      if ((maps[i][v] = calibration_cache_.load(key, &why))) {
+      if ((maps[i][v] = calibration_cache_.load(key, &why, [](std::span<const std::byte> payload) {
+            return CalibrationMap::decode(payload, "map");
+          }))) {
         ++stats_.calibration_cache_hits;
         continue;
       }
@@ -329,7 +309,7 @@ SeriesMaps Measurement::calibration_maps(const PreparedPair& pair, Preparation& 
       }
       maps[i][v] = CalibrationMap::fit(samples);
       ++stats_.calibration_fitted;
-      calibration_cache_.store(key, *maps[i][v], log_);
+      calibration_cache_.store(key, maps[i][v]->encode(), log_);
     }
   }
   return maps;

@@ -65,17 +65,41 @@ PoseAnswer answer_pose(const RigidTransform& pose, int repeat, double clock_over
 
 using Truth = std::vector<std::vector<std::uint8_t>>;  // [group][pose] -> 0/1
 
-/// Exact answers per pose group on disk, one file per key. An empty directory: nothing is read or written.
-class TruthCache {
+/// Files in one directory, one per key, named by the key's hash: the key's hash again, then the payload.
+/// Reading checks that hash, so a file made for another key is stale, not misread. The ground truth and the
+/// calibration maps are kept this way, each payload with its own checked encoding. An empty directory:
+/// nothing is read or written.
+class KeyedFileCache {
  public:
-  explicit TruthCache(std::filesystem::path dir) : dir_(std::move(dir)) {}
-  /// The cached truth, or nothing; `why` names a file that was there but stale or corrupt.
-  std::optional<Truth> load(const std::string& key, const WorkloadSpec& workload, std::string* why) const;
-  void store(const std::string& key, const Truth& truth, const LogFn& log) const;
+  KeyedFileCache(std::filesystem::path dir, std::string extension, std::string what)
+      : dir_(std::move(dir)), extension_(std::move(extension)), what_(std::move(what)) {}
+
+  /// decode(payload) for the file under `key`, or nothing: no file, or one that is stale or does not decode
+  /// (decode throws), which `why` then names.
+  template <class Decode>
+  auto load(const std::string& key, std::string* why, Decode decode) const
+      -> std::optional<decltype(decode(std::span<const std::byte>{}))> {
+    const std::filesystem::path file = file_of(key);
+    if (dir_.empty() || !std::filesystem::exists(file)) return std::nullopt;
+    try {
+      const std::vector<std::byte> bytes = read(file, key);
+      return decode(std::span(bytes).subspan(kKeyBytes));
+    } catch (const std::exception& e) {
+      *why = file.filename().string() + ": " + e.what();
+      return std::nullopt;
+    }
+  }
+  /// Writes `payload` under `key`; a failure is logged ("<what> cache: could not store (...)"), not thrown.
+  void store(const std::string& key, std::span<const std::byte> payload, const LogFn& log) const;
   [[nodiscard]] std::filesystem::path file_of(const std::string& key) const;
 
  private:
+  static constexpr std::size_t kKeyBytes = 8;
+  /// The file's bytes, key hash included; throws when it was made for another key.
+  static std::vector<std::byte> read(const std::filesystem::path& file, const std::string& key);
+
   std::filesystem::path dir_;
+  std::string extension_, what_;
 };
 
 /// Progress bar on stderr: redrawn in place on a terminal, a line per tenth otherwise.
@@ -98,20 +122,6 @@ using GroupRecords = std::vector<std::vector<std::vector<QueryRecord>>>;
 /// Per planned series, [hierarchy][variant]: its calibration map, or none (exact series, or no
 /// "calibration").
 using SeriesMaps = std::vector<std::vector<std::optional<CalibrationMap>>>;
-
-/// Calibration maps on disk, one file per key (the pair's trees, the series and the training poses): the
-/// key's hash, then the map's own checked encoding. An empty directory: nothing is read or written.
-class CalibrationCache {
- public:
-  explicit CalibrationCache(std::filesystem::path dir) : dir_(std::move(dir)) {}
-  /// The cached map, or nothing; `why` names a file that was there but stale or corrupt.
-  std::optional<CalibrationMap> load(const std::string& key, std::string* why) const;
-  void store(const std::string& key, const CalibrationMap& map, const LogFn& log) const;
-  [[nodiscard]] std::filesystem::path file_of(const std::string& key) const;
-
- private:
-  std::filesystem::path dir_;
-};
 
 /// The measure stage of one run.
 class Measurement {
@@ -138,8 +148,8 @@ class Measurement {
   LogFn log_;
   unsigned threads_;
   int warmup_;
-  TruthCache truth_cache_;
-  CalibrationCache calibration_cache_;
+  KeyedFileCache truth_cache_;        ///< payload: encode_truth
+  KeyedFileCache calibration_cache_;  ///< payload: CalibrationMap::encode
   Progress progress_;
   std::vector<QueryRecord> block_records_;
 };
