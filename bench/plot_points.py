@@ -3,7 +3,8 @@
 
   points_error_vs_time.png  wrong answers outside the ambiguous band (FP + FN, percent of the clear poses)
                             against the mean time per query, one panel per pair and density, one colour per
-                            series; ADB's p_min values joined by a line, the goal's 4 % dashed
+                            series; ADB's p_min values joined by a line (dotted: one per confirm_levels),
+                            the goal's 4 % dashed
   points_fp_fn.png          FP and FN (percent of each distance's clear poses) against the protocol distance,
                             one row of two panels per pair and density, one colour per series
 """
@@ -47,8 +48,9 @@ def groups(rows):
 def series_colours(rows):
     """One colour per series, the same in every panel and figure."""
     names = list(dict.fromkeys(r["series"] for r in rows))
-    first, more = plt.get_cmap("tab10"), plt.get_cmap("Dark2")
-    return {name: first(k) if k < 10 else more((k - 10) % 8) for k, name in enumerate(names)}
+    # tab10's colours while they last; past 10 series tab20's 20 (its pairs of shades stay distinct).
+    palette, size = (plt.get_cmap("tab10"), 10) if len(names) <= 10 else (plt.get_cmap("tab20"), 20)
+    return {name: palette(k % size) for k, name in enumerate(names)}
 
 
 def panel_grid(count, columns):
@@ -57,16 +59,27 @@ def panel_grid(count, columns):
     return fig, axes
 
 
+def adb_families(rows):
+    """ADB's series by what follows "adb p_min=P" (the paper's rule, or a confirm_levels value), each sorted
+    by mean time: each family is one line over its p_min values, the paper's rule solid."""
+    families = {}
+    for r in rows:
+        if r["series"].startswith("adb p_min="):
+            families.setdefault(" ".join(r["series"].split()[2:]), []).append(r)
+    return [(sorted(f, key=lambda r: float(r["mean_us"])), "-" if rule == "" else ":")
+            for rule, f in families.items()]
+
+
 def figure_error_vs_time(summary, out):
     colours = series_colours(summary)
     by_group = groups(summary)
     fig, axes = panel_grid(len(by_group), min(2, len(by_group)))
     flat = [ax for row in axes for ax in row]
     for ax, ((pair, points), rows) in zip(flat, by_group.items()):
-        adb = sorted((r for r in rows if r["series"].startswith("adb")), key=lambda r: float(r["mean_us"]))
-        if len(adb) > 1:
-            ax.plot([float(r["mean_us"]) for r in adb], [error_percent(r) for r in adb], "-", color="0.6",
-                    linewidth=1, zorder=1)
+        for family, style in adb_families(rows):
+            if len(family) > 1:
+                ax.plot([float(r["mean_us"]) for r in family], [error_percent(r) for r in family], style,
+                        color="0.6", linewidth=1, zorder=1)
         for r in rows:
             ax.scatter([max(float(r["mean_us"]), 1e-3)], [error_percent(r)], color=colours[r["series"]],
                        label=r["series"], zorder=2)

@@ -222,6 +222,18 @@ void run_density(const Mesh& mesh_a, const Mesh& mesh_b, const Bvh<Aabb>& tree_a
                    }),
              out);
   }
+  for (double levels : spec.confirm_levels)
+    for (double p_min : spec.confirm_p_mins) {
+      AdbOptions confirmed;
+      confirmed.p_min = p_min;
+      confirmed.confirm_levels = static_cast<std::uint8_t>(levels);
+      rows.add(fmt::format("adb p_min={:g} confirm_levels={:g}", p_min, levels),
+               timed(poses,
+                     [&](const RigidTransform& p) {
+                       return query_adb_points(a->tree, a->side(), cb.tree, cb.side(), p, confirmed);
+                     }),
+               out);
+    }
   for (double bv_tests : spec.bv_tests) {
     AdbOptions capped;  // p_min 0.9; on exhaustion, "collision" iff the best queued estimate >= 0.5
     capped.budget.max_bv_tests = static_cast<std::uint64_t>(bv_tests);

@@ -7,9 +7,10 @@
 //
 // Series, all on AABB trees, timed one query at a time after a warm pass over the poses, net of the clock's
 // own overhead: exact_mesh (exact on the meshes), exact_points (cloud against cloud), exact_points_vs_mesh
-// (A's cloud against B's mesh), adb p_min=P on the clouds, time_critical p_min=0.9 bv_tests=N (ADB under a
-// BV-test cap), and with FCL fcl_octree res=R (FCL's octrees of the same points, voxel side R spacings;
-// bench/core/fcl_octree.hpp). bench_points and `bvhlab report` both run this.
+// (A's cloud against B's mesh), adb p_min=P on the clouds, adb p_min=P confirm_levels=L (ADB deciding only
+// after L generations of candidates: AdbOptions::confirm_levels), time_critical p_min=0.9 bv_tests=N (ADB
+// under a BV-test cap), and with FCL fcl_octree res=R (FCL's octrees of the same points, voxel side R
+// spacings; bench/core/fcl_octree.hpp). bench_points and `bvhlab report` both run this.
 #pragma once
 
 #include "bench/core/scene.hpp"

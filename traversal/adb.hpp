@@ -56,10 +56,20 @@ struct AdbOptions {
   /// widely. Costs at most four BV tests per decision. Leaf pairs have no children and decide directly.
   /// When not set: the paper's literal rule.
   bool confirm_with_children = false;
+  /// A pair whose estimate exceeds p_min decides "collision" only once this many generations below it
+  /// exceed p_min too, one pair per generation (a child of a candidate that exceeds p_min carries the
+  /// count down; a leaf pair ends the chain and decides). Coarse pairs of closed surfaces fill every cell, so
+  /// the estimate passes any p_min wherever their boxes overlap widely, touching or not; a chain of
+  /// candidates must find pairs small enough to see the gap. Costs about four BV tests per level per
+  /// decision. 0: the paper's rule. Not with confirm_with_children.
+  std::uint8_t confirm_levels = 0;
 
-  /// Throws std::invalid_argument for nonsense values (NaN, outside [0, 1], negative deadline).
+  /// Throws std::invalid_argument for nonsense values (NaN, outside [0, 1], negative deadline) and for both
+  /// confirmations at once.
   void validate() const {
     if (!(p_min >= 0 && p_min <= 1)) throw std::invalid_argument("adb: p_min must lie in [0, 1]");
+    if (confirm_with_children && confirm_levels > 0)
+      throw std::invalid_argument("adb: confirm_with_children and confirm_levels exclude each other");
     if (!(best_effort_threshold >= 0 && best_effort_threshold <= 1))
       throw std::invalid_argument("adb: best_effort_threshold must lie in [0, 1]");
     if (!(budget.deadline_us >= 0)) throw std::invalid_argument("adb: deadline must be >= 0 microseconds");
@@ -134,8 +144,9 @@ inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b
 template <TreeVolume BV, class Estimator, class Leaves = TriangleLeaves>
 class AdbHooks {
  public:
-  /// key: the pair's estimate; tag: the estimate exceeded p_min, awaiting confirmation by its children.
-  using Pair = QueuedPair<BV, double, bool>;
+  /// key: the pair's estimate; tag: the estimate exceeded p_min and awaits confirmation, by its children's
+  /// combined estimate (confirm_with_children: 1) or by this many more generations (confirm_levels).
+  using Pair = QueuedPair<BV, double, std::uint8_t>;
 
   AdbHooks(const TreePair<BV, Leaves>& trees, Result& result, const AdbOptions& options,
            const Estimator& estimate)
@@ -160,8 +171,15 @@ class AdbHooks {
     if (probability < 0) return Admission::Drop;  // volumes apart: provably no contact below
     if (!options_.exact_leaves) {
       if (probability > options_.p_min) {
-        if (!options_.confirm_with_children || trees_.is_leaf_pair(p)) return decide(probability);
-        p.tag = true;
+        if (trees_.is_leaf_pair(p)) return decide(probability);
+        if (options_.confirm_levels > 0) {
+          // A candidate's child carries its count down; any other pair starts a chain.
+          p.tag = parent_levels_ > 0 ? parent_levels_ - 1 : options_.confirm_levels;
+          if (p.tag == 0) return decide(probability);
+        } else {
+          if (!options_.confirm_with_children) return decide(probability);
+          p.tag = 1;
+        }
       } else if (probability <= 0) {
         dropped_possible_contact_ = true;
         return Admission::Drop;
@@ -198,8 +216,10 @@ class AdbHooks {
   }
 
   /// A candidate is confirmed by its children's combined estimate, or demoted to a plain descent.
+  /// Under confirm_levels, it only notes the parent's count for the children's admission, which follows.
   [[gnu::always_inline]] Step children_evaluated(const Pair& parent, const double* estimates, int count) {
-    if (!parent.tag) return Step::Continue;
+    parent_levels_ = parent.tag;
+    if (!parent.tag || options_.confirm_levels > 0) return Step::Continue;
     double no_contact_in_children = 1;
     for (int c = 0; c < count; ++c) no_contact_in_children *= 1 - std::max(0.0, estimates[c]);
     if (!(1 - no_contact_in_children > options_.p_min)) return Step::Continue;
@@ -240,6 +260,7 @@ class AdbHooks {
   bool dropped_possible_contact_ = false;  // a pair whose volumes overlap was left unexamined
   double best_dropped_ = 0;
   double no_contact_in_leaves_ = 1;  // prod(1 - p) over leaf pairs left below p_min
+  std::uint8_t parent_levels_ = 0;   // the tag of the pair whose children are being admitted
 };
 
 /// ADB query on two trees annotated with a ProbabilityDensity (adb/concept.hpp). `b_to_a` maps B's frame

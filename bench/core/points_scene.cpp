@@ -65,7 +65,7 @@ void parse_sampling(const Node& p, PointsSpec& points) {
 void parse_points(const Node& root, Scene& scene, bool fcl) {
   const Node p = root.child("points");
   p.expect_object({"densities", "seed", "sampling", "ratio", "distances", "steps", "band", "leaf", "grid",
-                   "p_min", "bv_tests", "octree_res", "cgal_sample"});
+                   "p_min", "confirm_levels", "confirm_p_min", "bv_tests", "octree_res", "cgal_sample"});
   PointsSpec points;
   if (p.has("densities")) points.densities = densities(p.child("densities"));
   if (p.has("seed")) points.seed = static_cast<std::uint64_t>(p.child("seed").integer(0, 1LL << 53));
@@ -82,6 +82,11 @@ void parse_points(const Node& root, Scene& scene, bool fcl) {
   if (p.has("leaf")) points.leaf = static_cast<std::uint32_t>(p.child("leaf").integer(1, 255));
   if (p.has("grid")) points.grid = static_cast<int>(p.child("grid").integer(2, 4));
   if (p.has("p_min")) points.p_mins = p_mins(p.child("p_min"));
+  if (p.has("confirm_levels")) points.confirm_levels = whole_numbers(p.child("confirm_levels"), 1, 255);
+  if (p.has("confirm_p_min")) {
+    if (!p.has("confirm_levels")) p.child("confirm_p_min").fail("applies with \"confirm_levels\" only");
+    points.confirm_p_mins = p_mins(p.child("confirm_p_min"));
+  }
   if (p.has("bv_tests")) points.bv_tests = whole_numbers(p.child("bv_tests"), 1, 1'000'000'000);
   if (p.has("octree_res"))
     points.octree_res = octree_resolutions(p.child("octree_res"), fcl);

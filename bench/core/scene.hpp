@@ -229,9 +229,11 @@ struct PointsSpec {
   std::uint32_t leaf = 16;  ///< points per leaf
   int grid = 2;             ///< the ADB grid of the clouds' trees
   std::vector<double> p_mins{0.5, 0.7, 0.9, 0.95, 0.99};
-  std::vector<double> bv_tests{50, 200};  ///< time-critical series: BV-test caps at p_min 0.9
-  std::vector<double> octree_res;         ///< FCL octree voxel sides in spacings (FCL builds only)
-  int cgal_sample = 16;                   ///< poses per pair whose mesh truth is checked against CGAL
+  std::vector<double> confirm_levels;             ///< ADB with AdbOptions::confirm_levels: one series per
+  std::vector<double> confirm_p_mins{0.9, 0.99};  ///< level and p_min here (none without levels)
+  std::vector<double> bv_tests{50, 200};          ///< time-critical series: BV-test caps at p_min 0.9
+  std::vector<double> octree_res;                 ///< FCL octree voxel sides in spacings (FCL builds only)
+  int cgal_sample = 16;                           ///< poses per pair whose mesh truth is checked against CGAL
 };
 
 struct Scene {

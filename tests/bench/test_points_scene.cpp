@@ -36,6 +36,10 @@ TEST_F(PointsSceneTest, TheSectionIsReadWithItsDefaults) {
   EXPECT_EQ(scene.points->steps, 3);
   EXPECT_EQ(scene.points->p_mins, (std::vector<double>{0.9}));
   EXPECT_EQ(scene.points->bv_tests, (std::vector<double>{50, 200}));
+  EXPECT_TRUE(scene.points->confirm_levels.empty());  // no confirmed series unless asked for
+  const Scene confirmed = parse(points_scene(R"({"confirm_levels": [2, 4], "confirm_p_min": [0.95]})"));
+  EXPECT_EQ(confirmed.points->confirm_levels, (std::vector<double>{2, 4}));
+  EXPECT_EQ(confirmed.points->confirm_p_mins, (std::vector<double>{0.95}));
   ASSERT_EQ(scene.pairs.size(), 1u);
   EXPECT_EQ(scene.pairs[0].label(), "torus");
 }
@@ -53,6 +57,11 @@ TEST_F(PointsSceneTest, RefusalsNameTheField) {
       {points_scene(R"({"distances": []})"), "/points/distances"},
       {points_scene(R"({"grid": 5})"), "/points/grid"},
       {points_scene(R"({"bv_tests": [0]})"), "/points/bv_tests/0"},
+      {points_scene(R"({"confirm_levels": [0]})"), "/points/confirm_levels/0"},
+      {points_scene(R"({"confirm_levels": [256]})"), "/points/confirm_levels/0"},
+      {points_scene(R"({"confirm_levels": [2], "confirm_p_min": [0]})"), "/points/confirm_p_min/0"},
+      {points_scene(R"({"confirm_p_min": [0.9]})"),
+       "/points/confirm_p_min: applies with \"confirm_levels\" only"},
       {points_scene(R"({"pmin": [0.9]})"), "/points/pmin: unknown field"},
       {points_scene("{}", R"(, "strategies": [{"type": "exact"}])"),
        "/strategies: does not apply to a points"},
@@ -106,7 +115,8 @@ std::size_t count(const std::map<std::string, std::string>& row, const std::stri
 
 /// The series a scene's "points" asks for, by the label prefixes the runner gives them.
 std::size_t expected_series(const PointsSpec& spec) {
-  return 3 + spec.p_mins.size() + spec.bv_tests.size() + spec.octree_res.size();
+  return 3 + spec.p_mins.size() + spec.confirm_levels.size() * spec.confirm_p_mins.size() +
+         spec.bv_tests.size() + spec.octree_res.size();
 }
 
 TEST(PointsReport, RowsCoverTheSceneAndAgreeWithEachOther) {
@@ -151,6 +161,11 @@ TEST(PointsReport, RowsCoverTheSceneAndAgreeWithEachOther) {
   EXPECT_EQ(series.size(), expected_series(spec));
   for (const char* name : {"exact_mesh", "exact_points", "exact_points_vs_mesh"})
     EXPECT_TRUE(series.count(name));
+  ASSERT_FALSE(spec.confirm_levels.empty()) << "points_small.json should run a confirmed series";
+  std::ostringstream confirmed;  // default stream formatting is %g, as the runner's labels
+  confirmed << "adb p_min=" << spec.confirm_p_mins.front()
+            << " confirm_levels=" << spec.confirm_levels.front();
+  EXPECT_TRUE(series.count(confirmed.str())) << confirmed.str();
   for (const auto& t : totals) {
     const auto& sum = sums.at({count(t, "points"), t.at("series")});
     for (std::size_t c = 0; const char* column : {"poses", "clear", "colliding", "fp", "fn"})

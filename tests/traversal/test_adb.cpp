@@ -143,6 +143,47 @@ TEST(AdbTraversal, ConfirmationNeverDecidesOnASingleCoarsePair) {
   EXPECT_EQ(query_adb(scene.tree_a, scene.tree_a, RigidTransform::identity(), literal).counters.bv_tests, 1u);
 }
 
+TEST(AdbTraversal, ConfirmLevelsDecideOnlyThatManyGenerationsDown) {
+  const Scene scene;
+  for (std::uint8_t levels : {1, 2, 3}) {
+    AdbOptions confirm;
+    confirm.p_min = 0.0;  // every overlapping pair is a candidate: each generation confirms the one above
+    confirm.confirm_levels = levels;
+    // Depth first dives: the root, then one pair expanded per generation (both sides split: four children).
+    const Result dive =
+        query_adb<AdbDepthFirst>(scene.tree_a, scene.tree_a, RigidTransform::identity(), confirm);
+    EXPECT_TRUE(dive.collides);
+    EXPECT_FALSE(dive.exact);
+    EXPECT_EQ(dive.counters.bv_tests, 1u + 4u * levels) << int(levels) << " levels";
+    // Best first may expand a more probable pair of an earlier generation in between: never fewer.
+    const Result best = query_adb(scene.tree_a, scene.tree_a, RigidTransform::identity(), confirm);
+    EXPECT_TRUE(best.collides);
+    EXPECT_GE(best.counters.bv_tests, 1u + 4u * levels) << int(levels) << " levels";
+  }
+}
+
+TEST(AdbTraversal, ConfirmLevelsOnlyTakeCollisionsAway) {
+  const Scene scene;
+  std::mt19937_64 rng(41);
+  int removed = 0;
+  for (double p_min : {0.5, 0.9})
+    for (int k = 0; k < 150; ++k) {
+      const RigidTransform pose = testing::random_pose(rng, 1.2);
+      AdbOptions literal;
+      literal.p_min = p_min;
+      AdbOptions confirm = literal;
+      confirm.confirm_levels = 3;
+      const Result a = query_adb(scene.tree_a, scene.tree_b, pose, literal);
+      const Result b = query_adb(scene.tree_a, scene.tree_b, pose, confirm);
+      // Where no pair exceeds p_min both traversals are the same, so a literal "no" stays "no".
+      if (b.collides) {
+        EXPECT_TRUE(a.collides) << "pose " << k;
+      }
+      removed += a.collides && !b.collides;
+    }
+  EXPECT_GT(removed, 0);  // the option must matter on this scene, or the test shows nothing
+}
+
 TEST(AdbTraversal, DisjointIsAnExactNo) {
   const Scene scene;
   const Result r = query_adb(scene.tree_a, scene.tree_b, RigidTransform::translate(Vec3(10, 0, 0)), {});
@@ -158,6 +199,10 @@ TEST(AdbTraversal, NonsenseOptionsAndMismatchedTauAreRejected) {
   EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, bad), std::invalid_argument);
   bad.p_min = 1.5;
   EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, bad), std::invalid_argument);
+  AdbOptions both;  // two confirmation rules at once: refused, not one silently ignored
+  both.confirm_with_children = true;
+  both.confirm_levels = 2;
+  EXPECT_THROW(query_adb(scene.tree_a, scene.tree_b, {}, both), std::invalid_argument);
   // Trees annotated with another tau (or grid) cannot share one model: refused, not mixed.
   const auto other_tau = crude_annotation<2>(Bvh<Aabb>::build(scene.b), 0.25);
   EXPECT_THROW(query_adb(scene.tree_a, other_tau, {}, AdbOptions{}), std::invalid_argument);

@@ -156,6 +156,34 @@ TEST(PointQueries, AdbOnPointsIsExactWhereItSaysSoAndGuidedExactIsExactPoints) {
   EXPECT_LE(inexact_no, 3);
 }
 
+TEST(PointQueries, ConfirmLevelsOnPointsOnlyTakeFalseCollisionsAway) {
+  const Sampled a(testing::make_torus(0.7, 0.25, 40, 20), 2000, 7);
+  const Sampled b(testing::make_torus(0.6, 0.2, 36, 18), 1500, 8);
+  std::mt19937_64 rng(12);
+  int removed = 0, false_literal = 0, false_confirmed = 0;
+  for (int k = 0; k < 60; ++k) {
+    const RigidTransform pose = testing::random_pose(rng, 1.2);
+    const bool points = query_exact_points(a.tree.bvh, a.side(), b.tree.bvh, b.side(), pose).collides;
+    AdbOptions literal;
+    literal.p_min = 0.9;
+    AdbOptions confirm = literal;
+    confirm.confirm_levels = 3;
+    const Result l = query_adb_points(a.tree, a.side(), b.tree, b.side(), pose, literal);
+    const Result c = query_adb_points(a.tree, a.side(), b.tree, b.side(), pose, confirm);
+    if (c.collides) {
+      EXPECT_TRUE(l.collides) << "pose " << k;  // a literal "no" stays "no"
+    }
+    if (points) {
+      EXPECT_EQ(c.collides, l.collides) << "a crossing is found either way, pose " << k;
+    }
+    removed += l.collides && !c.collides;
+    false_literal += l.collides && !points;
+    false_confirmed += c.collides && !points;
+  }
+  EXPECT_GT(removed, 0);  // the option must matter here, or the test shows nothing
+  EXPECT_LT(false_confirmed, false_literal);
+}
+
 TEST(PointQueries, TimeCriticalOnPointsKeepsItsBudget) {
   const Sampled a(testing::make_torus(0.7, 0.25, 40, 20), 2000, 10);
   std::mt19937_64 rng(11);
