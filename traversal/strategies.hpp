@@ -20,6 +20,18 @@ inline constexpr ParamSpec kPMinSweep{.name = "p_min",
                                       .default_value = 0.9,
                                       .sweep = true,
                                       .in_label = true};
+inline constexpr ParamSpec kAdb[] = {
+    kPMinSweep,
+    {.name = "confirm_levels",
+     .description =
+         "decide \"collision\" only once this many generations below also exceed p_min (0: the paper)",
+     .min = 0,
+     .max = 32,
+     .default_value = 0,
+     .integer = true,
+     .sweep = true,
+     .in_label = true},
+};
 inline constexpr ParamSpec kTimeCritical[] = {
     {.name = "p_min",
      .description = "answer \"collision\" once a pair's estimate exceeds it",
@@ -94,10 +106,11 @@ struct AdbStrategy : GuidedExactStrategy {
   }
   static constexpr bool exact = false;
   static constexpr bool needs_polygons = false;
-  static std::span<const ParamSpec> parameters() { return {&strategy_detail::kPMinSweep, 1}; }
+  static std::span<const ParamSpec> parameters() { return strategy_detail::kAdb; }
   static Options configure(const ParamValues& values, const Budget&) {
     Options options;
     options.p_min = parameter(values, "p_min");
+    options.confirm_levels = static_cast<std::uint8_t>(parameter(values, "confirm_levels"));
     options.validate();
     return options;
   }

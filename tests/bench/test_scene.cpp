@@ -3,6 +3,7 @@
 #include "bench/core/scene.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
+#include "traversal/strategies.hpp"
 
 #include <gtest/gtest.h>
 
@@ -39,7 +40,8 @@ TEST_F(SceneTest, ParsesWhatTheFileSays) {
     "strategies": [{"type": "exact"}, {"type": "guided_exact", "hierarchies": ["aabb"]},
                    {"type": "adb", "p_min": [0.5, 0.8, 0.95], "hierarchies": ["aabb"]},
                    {"type": "time_critical", "p_min": 0.7, "budgets": [{"bv_tests": 10}, {"deadline_us": 5.5}],
-                    "hierarchies": ["aabb"]}],
+                    "hierarchies": ["aabb"]},
+                   {"type": "adb_dfs", "p_min": 0.9, "confirm_levels": [1, 3], "hierarchies": ["aabb"]}],
     "workload": {"type": "protocol", "distances": [0.5, 1.5], "steps": 7},
     "report": {"quality_distances": [1.0, 1.5], "cgal_sample": 3, "operating_point": {"p_min": 0.8},
                "baseline": {"hierarchy": "dop", "strategy": "exact"}}})");
@@ -64,8 +66,14 @@ TEST_F(SceneTest, ParsesWhatTheFileSays) {
   // Only the hierarchy a strategy that needs the density runs on is annotated.
   EXPECT_TRUE(scene.needs_density(scene.hierarchies[0]));
   EXPECT_FALSE(scene.needs_density(scene.hierarchies[1]));
-  ASSERT_EQ(scene.strategies.size(), 4u);
+  ASSERT_EQ(scene.strategies.size(), 5u);
   EXPECT_EQ(expand(scene.strategies[2]).size(), 3u);
+  const auto confirmed = expand(scene.strategies[4]);  // one variant per level, in the label
+  ASSERT_EQ(confirmed.size(), 2u);
+  EXPECT_EQ(confirmed[1].label(), "adb_dfs p_min=0.9 confirm_levels=3");
+  EXPECT_EQ(strategy_options<AdbDfsStrategy>(confirmed[1].values).confirm_levels, 3);
+  EXPECT_EQ(strategy_options<AdbStrategy>(expand(scene.strategies[2])[0].values).confirm_levels,
+            0);  // the paper
   const auto budgets = expand(scene.strategies[3]);
   ASSERT_EQ(budgets.size(), 2u);
   EXPECT_EQ(budgets[0].budget.max_bv_tests, 10u);
@@ -165,7 +173,10 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
        "/strategies/0/p_min: unknown field; expected one of type, hierarchies"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
                   R"([{"type": "adb", "budgets": [{"bv_tests": 5}]}])"),
-       "/strategies/0/budgets: unknown field; expected one of type, hierarchies, p_min"},
+       "/strategies/0/budgets: unknown field; expected one of type, hierarchies, p_min, confirm_levels"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                  R"([{"type": "adb", "p_min": 0.9, "confirm_levels": [2, 1.5]}])"),
+       "/strategies/0/confirm_levels/1: confirm_levels must be an integer in [0, 32], got 1.5"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "time_critical"}])"),
        "/strategies/0/budgets: missing"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
