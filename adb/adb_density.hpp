@@ -6,6 +6,7 @@
 
 #include "annotate.hpp"
 #include "model.hpp"
+#include "pair_geometry.hpp"
 #include "tree.hpp"
 
 #include <cstdint>
@@ -43,15 +44,21 @@ void check_combinable(const AdbStorage& a, const AdbStorage& b, std::string_view
 }  // namespace adb_storage
 
 /// An ADB density: the cell counts, read through `Variant::rule`. `Variant` names it: a struct with
-/// `static constexpr std::string_view name` and `static constexpr AdbRule rule`.
+/// `static constexpr std::string_view name`, `static constexpr AdbRule rule` and
+/// `static constexpr bool cells_in_node_frames`.
 template <class Variant>
 struct BasicAdbDensity {
   using Params = AdbParams;
   using Storage = AdbStorage;
   static constexpr AdbRule rule = Variant::rule;
+  /// Cells in the node's own frame on volumes that have one (adb/pair_geometry.hpp), else on its bounding
+  /// box.
+  static constexpr bool cells_in_node_frames = Variant::cells_in_node_frames;
 
   static constexpr std::string_view name() { return Variant::name; }
-  static constexpr std::uint32_t version() { return 1; }
+  /// Version 2: the counts of a FramedVolume's nodes lie in the nodes' frames (version 1 had them on the
+  /// bounding boxes, so those files are refused, not misread).
+  static constexpr std::uint32_t version() { return cells_in_node_frames ? 2 : 1; }
   static std::span<const ParamSpec> parameters() { return adb_storage::parameters(); }
   /// Throws std::invalid_argument for a tau without an LB value.
   static Params make_params(const ParamValues& values) { return adb_storage::make_params(values, name()); }
@@ -66,10 +73,23 @@ struct BasicAdbDensity {
     options.tau = params.tau;
     options.threads = context.threads;
     options.progress = context.progress;
-    CellCounts result = annotate_counts(bvh.node_boxes(), node_triangle_ranges(bvh.nodes()), bvh.triangles(),
-                                        params.grid, options);
+    CellCounts result = count_cells(bvh, params.grid, options);
     if (stats) *stats = result.stats;
     return make_storage(params, std::move(result.counts));
+  }
+
+  /// The counts on the nodes' own frames where the density and the volume have them, else on the boxes.
+  template <TreeVolume BV>
+  static CellCounts count_cells(const Bvh<BV>& bvh, int grid, const AnnotateOptions& options) {
+    if constexpr (estimates_in_node_frames<BasicAdbDensity, BV>) {
+      std::vector<OrientedBox> frames(bvh.nodes().size());
+      for (std::size_t i = 0; i < frames.size(); ++i) frames[i] = bvh.volume(i).oriented_box();
+      return annotate_counts_in_frames(frames, node_triangle_ranges(bvh.nodes()), bvh.triangles(), grid,
+                                       options);
+    } else {
+      return annotate_counts(bvh.node_boxes(), node_triangle_ranges(bvh.nodes()), bvh.triangles(), grid,
+                             options);
+    }
   }
 
   /// A storage from counts computed elsewhere (tests, decoding). Throws std::invalid_argument for a count
@@ -103,10 +123,12 @@ struct BasicAdbDensity {
   }
 };
 
-/// The default ADB density: finer cells for differently sized nodes, and no count read as 0 (adb/model.hpp).
+/// The default ADB density: finer cells for differently sized nodes, no count read as 0 (adb/model.hpp), and
+/// cells in an OBB's own frame (adb/pair_geometry.hpp).
 struct SizedAdbVariant {
   static constexpr std::string_view name = "adb";
   static constexpr AdbRule rule = kAdbSizedRule;
+  static constexpr bool cells_in_node_frames = true;
 };
 using AdbDensity = BasicAdbDensity<SizedAdbVariant>;
 static_assert(ProbabilityDensity<AdbDensity>);

@@ -44,8 +44,12 @@ struct AdbNormalDensity {
   /// Below this, the orientation factor does not go: coplanar sheets may still touch.
   static constexpr double kMinParallelFactor = 0.05;
 
+  /// The counts are "adb"'s, in an OBB's own frame too (adb/pair_geometry.hpp).
+  static constexpr bool cells_in_node_frames = AdbDensity::cells_in_node_frames;
+
   static constexpr std::string_view name() { return "adb_normal"; }
-  static constexpr std::uint32_t version() { return 1; }
+  /// Version 2: the counts of "adb" version 2.
+  static constexpr std::uint32_t version() { return 2; }
   static std::span<const ParamSpec> parameters() { return adb_storage::parameters(); }
   static Params make_params(const ParamValues& values) { return adb_storage::make_params(values, name()); }
 

@@ -3,6 +3,7 @@
 // adb/annotate.hpp for the definitions and the exactness argument.
 #include "adb/annotate.hpp"
 #include "adb/annotate_internal.hpp"
+#include "adb/pair_geometry.hpp"
 
 #include <algorithm>
 #include <array>
@@ -45,6 +46,8 @@ struct ThreadStats {
 struct Worker {
   ThreadStats stats;
   std::vector<std::uint32_t> pending;  ///< scratch: the current node's triangles that need clipping
+  std::vector<TrianglePoints> local;   ///< scratch: the current node's triangles in its own frame
+  std::vector<TriangleInfo> infos;     ///< scratch: their infos
 };
 
 struct Job {
@@ -52,6 +55,14 @@ struct Job {
   std::span<const std::pair<std::uint32_t, std::uint32_t>> ranges;
   std::span<const TrianglePoints> triangles;
   std::span<const TriangleInfo> infos;
+  int g = 2;
+  double tau = kDefaultAdbTau;
+};
+
+struct FrameJob {
+  std::span<const OrientedBox> frames;
+  std::span<const std::pair<std::uint32_t, std::uint32_t>> ranges;
+  std::span<const TrianglePoints> triangles;
   int g = 2;
   double tau = kDefaultAdbTau;
 };
@@ -91,25 +102,27 @@ struct CellState {
   }
 };
 
-/// pc of one node. Fast-path triangles first; then a clipped triangle is clipped only against candidate
-/// cells the bounds have not decided yet (most cells of a large node are decided by their fast-path area).
-std::uint8_t count_node(const Job& job, std::uint32_t node, Worker& worker) {
-  ThreadStats& stats = worker.stats;
-  const auto [begin, end] = job.ranges[node];
-  if (begin == end) return 0;
-  const Box& box = job.boxes[node];
+void check_grid_box(const Box& box, std::uint32_t node) {
   if (box.empty() || !box.min.allFinite() || !box.max.allFinite() || !(box.max - box.min).allFinite())
     throw std::invalid_argument("annotate: node " + std::to_string(node) +
                                 " has an empty or non-finite bounding box but holds triangles");
-  const Grid grid(box, job.g);
-  const int g = job.g;
+}
+
+/// pc of one node: its grid box and its triangles with their infos. Fast-path triangles first; then a
+/// clipped triangle is clipped only against candidate cells the bounds have not decided yet (most cells of a
+/// large node are decided by their fast-path area).
+std::uint8_t count_cells(const Box& box, std::span<const TrianglePoints> triangles,
+                         std::span<const TriangleInfo> infos, int g, double tau, Worker& worker) {
+  ThreadStats& stats = worker.stats;
+  const Grid grid(box, g);
+  const std::uint32_t begin = 0, end = static_cast<std::uint32_t>(triangles.size());
 
   Bounds threshold;
   {
     CGAL::Protect_FPU_rounding<true> guard;
     Interval a[3];
     for (int k = 0; k < 3; ++k) a[k] = (Interval(box.max[k]) - Interval(box.min[k])) / Interval(g);
-    const Interval t = Interval(job.tau) * (a[0] * a[1] + a[1] * a[2] + a[2] * a[0]) / Interval(3);
+    const Interval t = Interval(tau) * (a[0] * a[1] + a[1] * a[2] + a[2] * a[0]) / Interval(3);
     threshold = to_bounds(t);
   }
 
@@ -119,7 +132,7 @@ std::uint8_t count_node(const Job& job, std::uint32_t node, Worker& worker) {
   pending.clear();
 
   for (std::uint32_t t = begin; t < end; ++t) {
-    const TriangleInfo& info = job.infos[t];
+    const TriangleInfo& info = infos[t];
     if (info.degenerate) {
       ++stats.degenerate;
       continue;
@@ -156,7 +169,7 @@ std::uint8_t count_node(const Job& job, std::uint32_t node, Worker& worker) {
   // area is the triangle's minus the others': one clip fewer per triangle.
   std::vector<std::array<int, 3>> candidates;
   for (const std::uint32_t t : pending) {
-    const TriangleInfo& info = job.infos[t];
+    const TriangleInfo& info = infos[t];
     const Placement p = place(grid, info);
     candidates.clear();
     bool all_open = true;
@@ -196,7 +209,7 @@ std::uint8_t count_node(const Job& job, std::uint32_t node, Worker& worker) {
       Bounds area;
       if (has_area[k]) {
         ++stats.clip_calls;
-        area = clipped_area_bounds(job.triangles[t], boxes[k]);
+        area = clipped_area_bounds(triangles[t], boxes[k]);
         if (derived < candidates.size()) {
           CGAL::Protect_FPU_rounding<true> guard;
           rest -= Interval(area.lo, area.hi);
@@ -225,28 +238,75 @@ std::uint8_t count_node(const Job& job, std::uint32_t node, Worker& worker) {
             break;
           case CellState::Decision::Open:  // a tie or a near-tie: decide exactly
             ++stats.exact_cells;
-            if (cell_counts_exactly(grid, c, box, job.tau, job.triangles.subspan(begin, end - begin),
-                                    job.infos.subspan(begin, end - begin)))
-              ++count;
+            if (cell_counts_exactly(grid, c, box, tau, triangles, infos)) ++count;
             break;
         }
       }
   return static_cast<std::uint8_t>(count);
 }
 
+/// pc of node `node` on its bounding box (the triangles and infos shared by all nodes).
+std::uint8_t count_node(const Job& job, std::uint32_t node, Worker& worker) {
+  const auto [begin, end] = job.ranges[node];
+  if (begin == end) return 0;
+  check_grid_box(job.boxes[node], node);
+  return count_cells(job.boxes[node], job.triangles.subspan(begin, end - begin),
+                     job.infos.subspan(begin, end - begin), job.g, job.tau, worker);
+}
+
+/// pc of node `node` in its own frame: its triangles mapped into the frame (rounded to doubles), counted on
+/// the frame's box grown to hold them; an axis thinner than kMinRelativeThickness of the longest is
+/// flattened to the plane 0, the flat box the query thickens (adb/pair_geometry.hpp).
+std::uint8_t count_node_in_frame(const FrameJob& job, std::uint32_t node, Worker& worker) {
+  const auto [begin, end] = job.ranges[node];
+  if (begin == end) return 0;
+  const OrientedBox& frame = job.frames[node];
+  Box box;
+  if (!frame.empty()) box = {-frame.half, frame.half};
+  worker.local.clear();
+  for (std::uint32_t t = begin; t < end; ++t) {
+    const TrianglePoints& world = job.triangles[t];
+    TrianglePoints local;
+    for (int k = 0; k < 3; ++k) {
+      local[k] = frame.local(world[k]);
+      if (!local[k].allFinite())  // a corrupt frame; Box::extend would skip a NaN silently
+        throw std::invalid_argument("annotate: node " + std::to_string(node) +
+                                    " has a non-finite frame but holds triangles");
+      box.extend(local[k]);
+    }
+    worker.local.push_back(local);
+  }
+  check_grid_box(box, node);
+  const Vec3 extent = box.extent();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(extent[axis] < kMinRelativeThickness * extent.maxCoeff())) continue;
+    box.min[axis] = box.max[axis] = 0;
+    for (TrianglePoints& t : worker.local)
+      for (Vec3& v : t) v[axis] = 0;
+  }
+  worker.infos.clear();
+  for (const TrianglePoints& t : worker.local) worker.infos.push_back(make_info(t));
+  return count_cells(box, worker.local, worker.infos, job.g, job.tau, worker);
+}
+
 }  // namespace
 
-CellCounts annotate_counts(std::span<const Box> node_boxes,
-                           std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
-                           std::span<const TrianglePoints> triangles, int grid,
-                           const AnnotateOptions& options) {
+namespace {
+
+/// Checks the shared arguments, then counts every node with count(worker, node) over the threads, with
+/// progress and statistics. `shared_infos`: the triangles' infos are computed first (for count_node).
+template <class CountNode>
+CellCounts count_all(std::size_t node_count,
+                     std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
+                     std::span<const TrianglePoints> triangles, int grid, const AnnotateOptions& options,
+                     std::vector<TriangleInfo>* shared_infos, CountNode&& count) {
   const auto start = std::chrono::steady_clock::now();
   if (grid < 1 || grid > kMaxGrid)
     throw std::invalid_argument("annotate: grid must be 1..6 cells per axis, got " + std::to_string(grid));
   if (!std::isfinite(options.tau) || !(options.tau >= 0))  // tau = 0: every cell with some area counts
     throw std::invalid_argument("annotate: tau must be finite and >= 0, got " + std::to_string(options.tau));
-  if (node_boxes.size() != node_ranges.size())
-    throw std::invalid_argument("annotate: " + std::to_string(node_boxes.size()) + " node boxes but " +
+  if (node_count != node_ranges.size())
+    throw std::invalid_argument("annotate: " + std::to_string(node_count) + " node boxes but " +
                                 std::to_string(node_ranges.size()) + " node ranges");
   std::size_t total_pairs = 0;
   for (std::size_t i = 0; i < node_ranges.size(); ++i) {
@@ -263,13 +323,10 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
         throw std::invalid_argument("annotate: triangle " + std::to_string(t) + " has a non-finite vertex");
 
   unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  threads =
-      static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, node_boxes.size() / 64)));
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, node_count / 64)));
 
-  std::vector<TriangleInfo> infos(triangles.size());
-  std::vector<std::uint8_t> counts(node_boxes.size(), 0);
+  std::vector<std::uint8_t> counts(node_count, 0);
   std::vector<Worker> workers(threads);
-  const Job job{node_boxes, node_ranges, triangles, infos, grid, options.tau};
 
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done_pairs{0};
@@ -302,17 +359,20 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
     if (error) std::rethrow_exception(error);
   };
 
-  run_parallel(
-      [&](unsigned, std::size_t first, std::size_t last) {
-        for (std::size_t t = first; t < last; ++t) infos[t] = make_info(triangles[t]);
-      },
-      triangles.size(), 4096);
+  if (shared_infos) {
+    shared_infos->resize(triangles.size());
+    run_parallel(
+        [&](unsigned, std::size_t first, std::size_t last) {
+          for (std::size_t t = first; t < last; ++t) (*shared_infos)[t] = make_info(triangles[t]);
+        },
+        triangles.size(), 4096);
+  }
 
   run_parallel(
       [&](unsigned id, std::size_t first, std::size_t last) {
         std::size_t pairs = 0;
         for (std::size_t n = first; n < last; ++n) {
-          counts[n] = count_node(job, static_cast<std::uint32_t>(n), workers[id]);
+          counts[n] = count(workers[id], static_cast<std::uint32_t>(n));
           pairs += node_ranges[n].second - node_ranges[n].first;
         }
         const std::size_t done = done_pairs.fetch_add(pairs) + pairs;
@@ -324,14 +384,14 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
           }
         }
       },
-      node_boxes.size(), 16);
+      node_count, 16);
   if (options.progress) options.progress(total_pairs, total_pairs);
 
   CellCounts out;
   out.counts = std::move(counts);
   AnnotateStats& s = out.stats;
   s.threads = threads;
-  s.nodes = node_boxes.size();
+  s.nodes = node_count;
   s.triangle_node_pairs = total_pairs;
   for (const Worker& w : workers) {
     const ThreadStats& t = w.stats;
@@ -345,6 +405,30 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
   }
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
+}
+
+}  // namespace
+
+CellCounts annotate_counts(std::span<const Box> node_boxes,
+                           std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
+                           std::span<const TrianglePoints> triangles, int grid,
+                           const AnnotateOptions& options) {
+  std::vector<TriangleInfo> infos;  // filled by count_all before any node is counted
+  return count_all(node_boxes.size(), node_ranges, triangles, grid, options, &infos,
+                   [&](Worker& worker, std::uint32_t node) {
+                     const Job job{node_boxes, node_ranges, triangles, infos, grid, options.tau};
+                     return count_node(job, node, worker);
+                   });
+}
+
+CellCounts annotate_counts_in_frames(std::span<const OrientedBox> node_frames,
+                                     std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
+                                     std::span<const TrianglePoints> triangles, int grid,
+                                     const AnnotateOptions& options) {
+  const FrameJob job{node_frames, node_ranges, triangles, grid, options.tau};
+  return count_all(
+      node_frames.size(), node_ranges, triangles, grid, options, nullptr,
+      [&](Worker& worker, std::uint32_t node) { return count_node_in_frame(job, node, worker); });
 }
 
 }  // namespace bvhlab

@@ -3,7 +3,9 @@
 //
 // Definitions (the open points of the method, decided here)
 // - Grid: V's bounding box (BV::bounding_box(), so a non-box BV uses its bounding box), cut into g cells per
-//   axis. Cell boundaries are the doubles lo + (hi - lo) * i / g (clamped to hi; the last one is hi itself).
+//   axis; or, for the default density on a volume with a frame of its own (an OBB), V's box in that frame
+//   (annotate_counts_in_frames). Cell boundaries are the doubles lo + (hi - lo) * i / g (clamped to hi; the
+//   last one is hi itself).
 // - Cells are CLOSED boxes. A polygon lying exactly in a face shared by two cells counts in full for both,
 //   one along an edge shared by four cells counts for all four: both neighbours' closures contain it, and an
 //   object touching it from either side collides with it, so counting it twice errs on the safe side
@@ -82,6 +84,18 @@ CellCounts annotate_counts(std::span<const Box> node_boxes,
                            std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
                            std::span<const TrianglePoints> triangles, int grid,
                            const AnnotateOptions& options);
+
+/// The same with each node's grid in the node's own frame (`node_frames[i]`, an OBB's box): the node's
+/// triangles are mapped into the frame (OrientedBox::local, rounded to doubles; the counts are exact for the
+/// mapped triangles) and counted on the box [-half, half], grown to hold the mapped vertices should rounding
+/// put one outside. An axis thinner than kMinRelativeThickness of the longest (a flat node: one triangle's
+/// OBB is as thin as its rounding margin) is flattened to the plane 0, so its polygons count in every layer,
+/// as in a flat axis-aligned box; the query thickens the same boxes (adb/pair_geometry.hpp).
+/// Throws as annotate_counts does (an empty or non-finite frame box for a node that holds triangles).
+CellCounts annotate_counts_in_frames(std::span<const OrientedBox> node_frames,
+                                     std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
+                                     std::span<const TrianglePoints> triangles, int grid,
+                                     const AnnotateOptions& options);
 
 /// Area of the part of `triangle` inside the closed box `cell` (CGAL clipping, Epeck), to double precision.
 /// 0 for degenerate triangles, boxes that miss the triangle, and empty boxes.

@@ -18,22 +18,28 @@ void check_tree(std::string_view policy, std::size_t state_nodes, std::size_t tr
 
 AnnotateStats recount(std::span<const Box> boxes, const NodeRanges& ranges,
                       std::span<const TrianglePoints> triangles, std::span<const std::uint32_t> selected,
-                      AdbStorage& storage, const AnnotationContext& context) {
+                      AdbStorage& storage, const AnnotationContext& context,
+                      std::span<const OrientedBox> frames) {
   if (selected.empty()) return {};
   // annotate_counts takes any list of (box, triangle range): the selected nodes, compacted.
   std::vector<Box> chosen_boxes;
+  std::vector<OrientedBox> chosen_frames;
   NodeRanges chosen_ranges;
   chosen_boxes.reserve(selected.size());
   chosen_ranges.reserve(selected.size());
   for (const std::uint32_t node : selected) {
     chosen_boxes.push_back(boxes[node]);
+    if (!frames.empty()) chosen_frames.push_back(frames[node]);
     chosen_ranges.push_back(ranges[node]);
   }
   AnnotateOptions options;
   options.tau = storage.params.tau;
   options.threads = context.threads;
   options.progress = context.progress;
-  CellCounts result = annotate_counts(chosen_boxes, chosen_ranges, triangles, storage.params.grid, options);
+  CellCounts result =
+      frames.empty()
+          ? annotate_counts(chosen_boxes, chosen_ranges, triangles, storage.params.grid, options)
+          : annotate_counts_in_frames(chosen_frames, chosen_ranges, triangles, storage.params.grid, options);
   for (std::size_t k = 0; k < selected.size(); ++k)
     storage.possible_collision_cells[selected[k]] = result.counts[k];
   return result.stats;

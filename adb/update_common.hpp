@@ -21,9 +21,21 @@ void check_tree(std::string_view policy, std::size_t state_nodes, std::size_t tr
 
 /// Counts the nodes `selected` anew, exactly as the annotation does (adb/annotate.hpp), into
 /// storage.possible_collision_cells; the other nodes keep their counts. Returns the recount's statistics.
+/// `frames`: when not empty, the nodes' own frames, where the default density counts an OBB's cells
+/// (annotate_counts_in_frames); `boxes` then only size the recount.
 AnnotateStats recount(std::span<const Box> boxes, const NodeRanges& ranges,
                       std::span<const TrianglePoints> triangles, std::span<const std::uint32_t> selected,
-                      AdbStorage& storage, const AnnotationContext& context);
+                      AdbStorage& storage, const AnnotationContext& context,
+                      std::span<const OrientedBox> frames = {});
+
+/// The nodes' own frames when "adb" counts BV's cells there (adb/pair_geometry.hpp), else none.
+template <TreeVolume BV>
+std::vector<OrientedBox> count_frames(const Bvh<BV>& bvh) {
+  std::vector<OrientedBox> frames;
+  if constexpr (estimates_in_node_frames<AdbDensity, BV>)
+    for (std::size_t i = 0; i < bvh.nodes().size(); ++i) frames.push_back(bvh.volume(i).oriented_box());
+  return frames;
+}
 
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -21,8 +21,7 @@ struct RecountAllUpdate : density_update::StatelessPolicy<RecountAllUpdate> {
     options.tau = storage.params.tau;
     options.threads = context.threads;
     options.progress = context.progress;
-    CellCounts result = annotate_counts(bvh.node_boxes(), node_triangle_ranges(bvh.nodes()), bvh.triangles(),
-                                        storage.params.grid, options);
+    CellCounts result = AdbDensity::count_cells(bvh, storage.params.grid, options);  // as annotating anew
     storage.possible_collision_cells = std::move(result.counts);
     if (stats)
       *stats = DensityUpdateStats{.seconds = density_update::seconds_since(start),

@@ -49,8 +49,8 @@ struct RecountMovedUpdate {
       throw std::invalid_argument("density update 'recount_moved': the tree holds no polygons");
     const std::vector<Box> boxes = bvh.node_boxes();
     const std::vector<std::uint32_t> selected = moved_nodes(state, boxes, storage.params.grid);
-    const AnnotateStats counted =
-        density_update::recount(boxes, state.ranges, bvh.triangles(), selected, storage, context);
+    const AnnotateStats counted = density_update::recount(
+        boxes, state.ranges, bvh.triangles(), selected, storage, context, density_update::count_frames(bvh));
     for (const std::uint32_t node : selected) state.counted[node] = boxes[node];
     if (stats)
       *stats = DensityUpdateStats{.seconds = density_update::seconds_since(start),

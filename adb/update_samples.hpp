@@ -50,6 +50,10 @@ struct SampledUpdate {
                                rest.possible_collision_cells.size());
     if (!bvh.has_polygons())
       throw std::invalid_argument("density update 'samples': the tree holds no polygons");
+    if constexpr (estimates_in_node_frames<AdbDensity, BV>)
+      throw std::invalid_argument("density update 'samples': on " + std::string(BV::name()) +
+                                  " trees the counts lie in each node's own frame, which the samples are not "
+                                  "binned in; use recount_all or recount_moved");
     State state = draw(bvh.triangles(), params);
     state.ranges = node_triangle_ranges(bvh.nodes());
     state.rest_exact = rest.possible_collision_cells;

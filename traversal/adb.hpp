@@ -23,10 +23,14 @@
 //     an overlap of 0 with anything: its estimate would be 0 while the volumes overlap. Each box is thickened
 //     to at least kMinRelativeThickness of its longest side before the overlap and the estimate see it; the
 //     overlap's share of the box, all the estimate uses of it, then stays that of the plane.
+//   * Which boxes: the nodes' bounding boxes in the trees' frames, or, for a density that counts its cells
+//     in the nodes' own frames on a volume that has one (the OBB under "adb"), the nodes' own boxes and
+//     their overlap in those frames (adb/pair_geometry.hpp). The density decides; the loop is the same.
 //   * The estimate itself comes from the trees' density (adb/concept.hpp, ProbabilityDensity): for ADB,
 //     adb/model.hpp.
 #pragma once
 
+#include "../adb/pair_geometry.hpp"
 #include "../adb/tree.hpp"
 #include "driver.hpp"
 
@@ -103,37 +107,11 @@ double highest_queued(const Queue& queue) {
   }
 }
 
-/// Thinnest side of a box the estimate sees, relative to its longest side (header comment, "Flat boxes").
-inline constexpr double kMinRelativeThickness = 1e-3;
-
-/// `box`, each side at least kMinRelativeThickness times its longest one (same centre).
-[[gnu::always_inline]] inline Box with_min_thickness(const Box& box) {
-  if (box.empty()) return box;
-  const Vec3 extent = box.extent();
-  const Vec3 grow = (Vec3::Constant(kMinRelativeThickness * extent.maxCoeff()) - extent).cwiseMax(0.0) * 0.5;
-  return {box.min - grow, box.max + grow};
-}
-
-/// Volume of `box` ∩ (`other` re-boxed through rotation/translation): an upper bound of the overlap.
-inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rotation,
-                              const Mat3& abs_rotation, const Vec3& translation) {
-  const Vec3 center = rotation * other.center() + translation;
-  const Vec3 half = abs_rotation * (other.extent() * 0.5);
-  const Vec3 lo = box.min.cwiseMax(center - half), hi = box.max.cwiseMin(center + half);
-  return (hi - lo).cwiseMax(0.0).prod();
-}
-
-/// An upper bound of Vol(A ∩ B) for a rotated pair: re-boxing either box in the other's frame bounds the
-/// overlap from above, so the smaller of the two bounds is the tighter one.
-inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b_to_a,
-                             const Mat3& abs_rotation) {
-  if (a.empty() || b.empty()) return 0;
-  const double in_a = reboxed_overlap(a, b, b_to_a.rotation, abs_rotation, b_to_a.translation);
-  if (!(in_a > 0)) return 0;
-  const Mat3 r_t = b_to_a.rotation.transpose();
-  const double in_b = reboxed_overlap(b, a, r_t, abs_rotation.transpose(), -(r_t * b_to_a.translation));
-  return std::min(in_a, in_b);
-}
+// The estimate's geometry lives with the density (adb/pair_geometry.hpp); the old names stay for callers.
+using bvhlab::kMinRelativeThickness;
+using bvhlab::overlap_volume;
+using bvhlab::reboxed_overlap;
+using bvhlab::with_min_thickness;
 
 }  // namespace detail
 
@@ -141,7 +119,9 @@ inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b
 /// model: estimate(box_a, box_b, overlap volume, node of A, node of B) -> probability. `Leaves` is the
 /// trees' leaf test (driver.hpp): triangles run only under exact_leaves (guided exact); a leaf test with
 /// kTestedByEstimates (point surfaces) runs on every leaf pair reached, the points' only evidence there.
-template <TreeVolume BV, class Estimator, class Leaves = TriangleLeaves>
+/// `kNodeFrames`: the boxes and the overlap are taken in the nodes' own frames, for a density that counts
+/// its cells there (estimates_in_node_frames, adb/pair_geometry.hpp); otherwise in the trees' frames.
+template <TreeVolume BV, class Estimator, class Leaves = TriangleLeaves, bool kNodeFrames = false>
 class AdbHooks {
  public:
   /// key: the pair's estimate; tag: the estimate exceeded p_min and awaits confirmation, by its children's
@@ -160,10 +140,8 @@ class AdbHooks {
   [[gnu::always_inline]] double evaluate(const Pair& p) {
     if (!trees_.overlap(p)) return -1;
     ++trees_.counters.probability_evaluations;
-    const Box box_a = detail::with_min_thickness(trees_.box_a(p));
-    const Box box_b = detail::with_min_thickness(trees_.box_b(p));
-    const double overlap = detail::overlap_volume(box_a, box_b, trees_.b_to_a, abs_rotation_);
-    return estimate_(box_a, box_b, overlap, p.a, p.b);
+    const PairGeometry g = geometry(p);
+    return estimate_(g.a, g.b, g.overlap, p.a, p.b);
   }
 
   /// Decide, queue (possibly as a candidate), or drop.
@@ -245,6 +223,14 @@ class AdbHooks {
   }
 
  private:
+  [[gnu::always_inline]] PairGeometry geometry(const Pair& p) const {
+    if constexpr (kNodeFrames)
+      return node_frame_geometry(trees_.a.volume(p.a).oriented_box(), trees_.b.volume(p.b).oriented_box(),
+                                 trees_.b_to_a);
+    else
+      return tree_frame_geometry(trees_.box_a(p), trees_.box_b(p), trees_.b_to_a, abs_rotation_);
+  }
+
   Admission decide(double probability) {
     result_.collides = true;
     result_.exact = false;
@@ -292,7 +278,8 @@ Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransfor
     // The probability model: the only place the traversal reads it.
     const auto node_estimate = [&](const Box& box_a, const Box& box_b, double overlap, std::uint32_t i,
                                    std::uint32_t j) { return estimate(i, box_a, j, box_b, overlap); };
-    AdbHooks<BV, decltype(node_estimate), Leaves> hooks(trees, result, options, node_estimate);
+    AdbHooks<BV, decltype(node_estimate), Leaves, estimates_in_node_frames<D, BV>> hooks(
+        trees, result, options, node_estimate);
     traverse<typename Order::Queue, typename Order::Descent>(trees, hooks,
                                                              limit);  // frees its queue before it returns
   }

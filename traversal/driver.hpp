@@ -299,7 +299,7 @@ struct BestFirst {
     [[gnu::always_inline]] void push(const Pair& p) {
       // Room for a typical front at the first push: growing it pair by pair copies the whole heap each time
       // it doubles, a pause a deadline cannot interrupt. Not at construction: a root decision needs none.
-      if (items_.capacity() == 0) items_.reserve(kReservedPairs);
+      if (items_.capacity() == 0) items_.reserve_empty(kReservedPairs);
       items_.push(p);
     }
     [[gnu::always_inline]] Pair pop() {
@@ -314,7 +314,13 @@ struct BestFirst {
     };
     struct Heap : std::priority_queue<Pair, std::vector<Pair>, ByKey> {  // with access to its vector's room
       [[nodiscard]] std::size_t capacity() const { return this->c.capacity(); }
-      void reserve(std::size_t n) { this->c.reserve(n); }
+      /// Only while empty. Reserved in a fresh vector and swapped in: GCC 12 sees the vector's own reserve
+      /// read the storage it has just freed (-Wuse-after-free, a false positive) once the hooks inline.
+      void reserve_empty(std::size_t n) {
+        std::vector<Pair> room;
+        room.reserve(n);
+        this->c.swap(room);
+      }
     };
     // 16 KiB of pairs: far below malloc's mmap threshold, so the reservation costs one ordinary allocation.
     static constexpr std::size_t kReservedPairs = std::max<std::size_t>(64, 16384 / sizeof(Pair));

@@ -175,7 +175,7 @@ class PairRun {
   using Estimate = NodeEstimate<decltype(density_estimator(std::declval<const Tree<BV, D>&>(),
                                                            std::declval<const Tree<BV, D>&>(),
                                                            std::declval<const RigidTransform&>()))>;
-  using Hooks = AdbHooks<BV, Estimate>;
+  using Hooks = AdbHooks<BV, Estimate, TriangleLeaves, estimates_in_node_frames<D, BV>>;
   using Steps = Traversal<BestFirst, SplitBoth, BV, Hooks, TestCap>;
 
   PairRun(const FramePair<BV, D>& pair, const AdbOptions& options)

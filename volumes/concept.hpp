@@ -26,6 +26,10 @@
 // Optional
 //   BV::split_directions()      std::span<const Vec3>: directions the builder may split along
 //                               (defaults to x, y, z); the DOP-tree uses its own orientations.
+//   a.oriented_box()            OrientedBox (geometry.hpp): the volume as a box in a frame of its own (an
+//                               OBB's axes, centre and half-extents). A volume that has one is a
+//                               `FramedVolume`; the default ADB density lays its grid there instead of on
+//                               bounding_box() (adb/README.md, section 1).
 #pragma once
 
 #include "geometry.hpp"
@@ -50,6 +54,12 @@ concept BoundingVolume = std::is_trivially_copyable_v<BV> && std::is_standard_la
   { a.volume() } -> std::convertible_to<Scalar>;
   { a.bounding_box() } -> std::same_as<Box>;
   { a.contains(p) } -> std::same_as<bool>;
+};
+
+/// A volume that is a box in a frame of its own (the optional `oriented_box()` above).
+template <class BV>
+concept FramedVolume = BoundingVolume<BV> && requires(const BV& a) {
+  { a.oriented_box() } -> std::same_as<OrientedBox>;
 };
 
 /// Concept `HierarchicalVolume<HV>`: a node volume stored relative to its parent's, as in Zachmann's

@@ -44,6 +44,19 @@ struct Box {
   }
 };
 
+/// A box in a frame of its own: the points `center + axes * q` with |q_k| <= half_k (axes: orthonormal
+/// columns). How a volume with an orientation (an OBB) describes itself to the ADB density
+/// (volumes/concept.hpp, `oriented_box()`); empty when a half-extent is negative.
+struct OrientedBox {
+  Mat3 axes = Mat3::Identity();
+  Vec3 center = Vec3::Zero();
+  Vec3 half = Vec3::Constant(-1);
+
+  [[nodiscard]] bool empty() const { return (half.array() < 0).any(); }
+  /// p in the box's own coordinates (the same expression as the OBB's containment test).
+  [[nodiscard]] Vec3 local(const Vec3& p) const { return axes.transpose() * (p - center); }
+};
+
 /// Rigid motion x -> R x + t. R must be a proper rotation; `checked` enforces it for caller input.
 struct RigidTransform {
   Mat3 rotation = Mat3::Identity();

@@ -155,6 +155,12 @@ struct Obb {
     return {to_vec(center) - reach, to_vec(center) + reach};
   }
 
+  /// The box itself: its axes, centre and half-extents (FramedVolume).
+  [[nodiscard]] OrientedBox oriented_box() const {
+    if (empty()) return {};
+    return {axes_of(orientation), to_vec(center), to_vec(half)};
+  }
+
   [[nodiscard]] bool contains(const Vec3& p) const {
     if (empty()) return false;
     const Vec3 local = local_coordinates(axes_of(orientation), to_vec(center), p);
@@ -243,6 +249,6 @@ struct Obb {
   }
 };
 
-static_assert(BoundingVolume<Obb>);
+static_assert(BoundingVolume<Obb> && FramedVolume<Obb>);
 
 }  // namespace bvhlab

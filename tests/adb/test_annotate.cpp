@@ -211,6 +211,29 @@ TEST(PossibleCollisionCells, FlatNodeBoxCountsEveryLayer) {
   EXPECT_EQ(pc_of(t, box, 2, 3.01), 0);
 }
 
+TEST(PossibleCollisionCells, AFrameCountsItsTriangleAsTheSameShapeAxisAligned) {
+  // FlatNodeBoxCountsEveryLayer's triangle, turned and moved: counted in its own frame (the OBB's box, as
+  // thin as a rounding margin, hence flattened) it gives the counts of the axis-aligned original; the
+  // thresholds are kept away from its ties (1/8 and 1/4 of a cell, mean face area 1/12).
+  const Mat3 turn = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Vec3 shift(5, -2, 3);
+  std::vector<TrianglePoints> turned{{shift, turn * Vec3(1, 0, 0) + shift, turn * Vec3(0, 1, 0) + shift}};
+  const std::vector<OrientedBox> frames{{turn, turn * Vec3(0.5, 0.5, 0) + shift, Vec3(0.5, 0.5, 1e-9)}};
+  const std::vector<Range> ranges{{0, 1}};
+  const std::vector<TrianglePoints> flat{{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}};
+  const Box flat_box = box_of(Vec3(0, 0, 0), Vec3(1, 1, 0));
+  for (const double tau : {0.5, 1.4, 1.6, 2.9, 3.1}) {
+    AnnotateOptions options;
+    options.tau = tau;
+    const int in_frame = annotate_counts_in_frames(frames, ranges, turned, 2, options).counts.at(0);
+    EXPECT_EQ(in_frame, pc_of(flat, flat_box, 2, tau)) << "tau " << tau;
+  }
+  // On its axis-aligned bounding box the turned triangle is a slanted cut through a solid box: other counts.
+  Box around;
+  for (const Vec3& v : turned[0]) around.extend(v);
+  EXPECT_NE(pc_of(turned, around, 2, 1.6), pc_of(flat, flat_box, 2, 1.6));
+}
+
 TEST(PossibleCollisionCells, DegenerateTrianglesNeverCount) {
   const std::vector<TrianglePoints> t{{Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(0.5, 0.5, 0.5)},
                                       {Vec3(0.2, 0.2, 0.2), Vec3(0.2, 0.2, 0.2), Vec3(0.2, 0.2, 0.2)}};
@@ -372,6 +395,12 @@ TEST(Annotate, RejectsBadInputWithAClearMessage) {
   expect_error([&] { annotate_counts(std::vector<Box>{Box{}}, ranges, t, 2, options); }, "bounding box");
   const std::vector<TrianglePoints> nan_triangle{{Vec3(0, 0, 0), Vec3(std::nan(""), 0, 0), Vec3(0, 1, 0)}};
   expect_error([&] { annotate_counts(boxes, ranges, nan_triangle, 2, options); }, "non-finite");
+  // In frames: a frame that is not finite (a corrupt volume) for a node holding triangles, or a size
+  // mismatch.
+  const std::vector<OrientedBox> nan_frame{{Mat3::Constant(std::nan("")), Vec3::Zero(), Vec3::Ones()}};
+  expect_error([&] { annotate_counts_in_frames(nan_frame, ranges, t, 2, options); }, "non-finite frame");
+  expect_error([&] { annotate_counts_in_frames(nan_frame, std::vector<Range>{}, t, 2, options); },
+               "node ranges");
 
   auto bvh = Bvh<Aabb>::build(testing::make_torus(1.0, 0.3, 8, 4));
   auto stripped = Bvh<Aabb>::from_parts(bvh.nodes(), bvh.volumes(), bvh.triangle_ids());

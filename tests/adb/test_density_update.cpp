@@ -2,6 +2,7 @@
 #include "adb/update.hpp"
 #include "support/generated_meshes.hpp"
 #include "volumes/aabb.hpp"
+#include "volumes/obb.hpp"
 
 #include <gtest/gtest.h>
 
@@ -186,6 +187,23 @@ TEST_F(DensityUpdateTest, AStateIsRefusedOnAnotherTree) {
     EXPECT_THROW(U::update(copy.bvh, copy.density, state, kOneThread, nullptr), std::invalid_argument)
         << U::name();
   });
+}
+
+// On OBB trees "adb" counts in each node's own frame: the recounts follow it, the samples refuse.
+TEST_F(DensityUpdateTest, OnObbTreesRecountsUseTheNodesFramesAndSamplesAreRefused) {
+  auto obb = annotate_adb(Bvh<Obb>::build(rest), 2, kDefaultAdbTau, kOneThread);
+  auto state =
+      RecountMovedUpdate::start(obb.bvh, obb.density, update_params<RecountMovedUpdate>({{"fraction", 0}}));
+  obb.bvh.refit(twisted(rest, 0.8));
+  RecountMovedUpdate::update(obb.bvh, obb.density, state, kOneThread, nullptr);
+  const auto expected = annotate_adb(obb.bvh, 2, kDefaultAdbTau, kOneThread).density.possible_collision_cells;
+  EXPECT_EQ(obb.density.possible_collision_cells, expected);
+  try {
+    (void)SampledUpdate::start(obb.bvh, obb.density, update_params<SampledUpdate>());
+    ADD_FAILURE() << "samples accepted an OBB tree";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("own frame"), std::string::npos) << e.what();
+  }
 }
 
 TEST(DensityUpdateRegistry, NamesAreUniqueAndFound) {

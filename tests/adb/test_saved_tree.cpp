@@ -268,7 +268,12 @@ TEST(SavedTree, RejectsForeignFilesAndTypes) {
   bad = bytes;
   put_u32(bad, 80, 7);
   reseal(bad);
-  expect_rejected([&] { load_adb(bad); }, "density 'adb' data of version 7, this build reads version 1");
+  expect_rejected([&] { load_adb(bad); }, "density 'adb' data of version 7, this build reads version 2");
+  // Version 1 counted an OBB's cells on its bounding box: such a file is refused, not misread.
+  bad = bytes;
+  put_u32(bad, 80, 1);
+  reseal(bad);
+  expect_rejected([&] { load_adb(bad); }, "density 'adb' data of version 1, this build reads version 2");
   bad = bytes;
   std::memcpy(bad.data() + 64, "foo\0", 4);
   reseal(bad);

@@ -5,6 +5,7 @@
 #include "traversal/adb.hpp"
 #include "traversal/exact.hpp"
 #include "volumes/aabb.hpp"
+#include "volumes/obb.hpp"
 #include "volumes/restricted_box.hpp"
 
 #include <gtest/gtest.h>
@@ -290,6 +291,33 @@ TEST(AdbTraversal, FlatBoxesThatCrossGetAPositiveProbability) {
   const Result r = query_adb(a, b, RigidTransform::identity(), options);
   EXPECT_GT(r.probability, 0.0);
   EXPECT_FALSE(r.exact);
+}
+
+// A small closed box straddling a large slanted triangle (the size pair's case: the jeep's triangles against
+// the dragon). The triangle's OBB is a thin slab, its axis-aligned box a cube that holds the small box a
+// thousand times over. On OBB trees the default density counts cells in each node's own frame, so a node
+// the OBB test found inside the slab is likely to touch the triangle; read in the axis-aligned boxes, every
+// pair looked unlikely and the collision was missed.
+TEST(AdbTraversal, ASmallBoxInsideASlantedTrianglesObbIsFoundOnObbTrees) {
+  const Mesh slanted{{Vec3(10, 0, 0), Vec3(0, 10, 0), Vec3(0, 0, 10)}, {{0, 1, 2}}, "slanted"};
+  Mesh small = testing::make_torus(0.05, 0.02, 12, 8);
+  const auto a = annotate_adb(Bvh<Obb>::build(slanted), 2, kDefaultAdbTau);
+  const auto b = annotate_adb(Bvh<Obb>::build(small), 2, kDefaultAdbTau);
+  const Vec3 on_plane = Vec3::Constant(10.0 / 3);
+  for (const double turn : {0.0, 0.5, 1.3}) {
+    RigidTransform pose;
+    pose.rotation = Eigen::AngleAxisd(turn, Vec3(1, -1, 0.5).normalized()).toRotationMatrix();
+    pose.translation = on_plane;
+    ASSERT_TRUE(query_exact(a.bvh, b.bvh, pose).collides) << turn;
+    const Result r = query_adb(a, b, pose, AdbOptions{});  // p_min 0.9
+    EXPECT_TRUE(r.collides) << "turn " << turn << ": probability " << r.probability;
+    EXPECT_GT(r.probability, 0.9) << turn;
+    // Moved off the plane by twice its size along the normal: the OBBs are apart, an exact no.
+    pose.translation = on_plane + Vec3::Constant(0.1);
+    const Result apart = query_adb(a, b, pose, AdbOptions{});
+    EXPECT_FALSE(apart.collides);
+    EXPECT_TRUE(apart.exact);
+  }
 }
 
 }  // namespace

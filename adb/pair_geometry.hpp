@@ -1,0 +1,92 @@
+// What the ADB estimate reads of a node pair besides the counts: each node's box (extents only) and an upper
+// bound of the volume of their overlap (adb/README.md, section 2). Two geometries, chosen by the density:
+//   * the nodes' axis-aligned bounding boxes in their trees' frames (every BV; "adb_paper" on every BV);
+//   * the nodes' own frames, for a volume that is a box in a frame of its own (FramedVolume: the OBB) and a
+//     density that counts its cells there (D::cells_in_node_frames, "adb"). A slanted triangle's OBB is a
+//     thin slab; its axis-aligned box is as deep as it is wide, so a small node that the OBB test found
+//     inside the slab looked, in the axis-aligned box, like a random sub-box that rarely meets the surface.
+// Both bound the overlap the same way: each box re-boxed in the other's frame, the smaller intersection.
+// Both thicken flat boxes (kMinRelativeThickness), and the annotation flattens the same boxes (annotate.cpp).
+#pragma once
+
+#include "../volumes/concept.hpp"
+#include "../volumes/geometry.hpp"
+
+#include <algorithm>
+
+namespace bvhlab {
+
+/// Thinnest side of a box the estimate sees, relative to its longest side. A node of polygons in one plane
+/// has a box of thickness 0 (or, in an OBB's frame, of rounding noise): volume 0, overlap 0 with anything.
+inline constexpr double kMinRelativeThickness = 1e-3;
+
+/// `box`, each side at least kMinRelativeThickness times its longest one (same centre).
+[[gnu::always_inline]] inline Box with_min_thickness(const Box& box) {
+  if (box.empty()) return box;
+  const Vec3 extent = box.extent();
+  const Vec3 grow = (Vec3::Constant(kMinRelativeThickness * extent.maxCoeff()) - extent).cwiseMax(0.0) * 0.5;
+  return {box.min - grow, box.max + grow};
+}
+
+/// Volume of `box` ∩ (`other` re-boxed through rotation/translation): an upper bound of the overlap.
+inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rotation,
+                              const Mat3& abs_rotation, const Vec3& translation) {
+  const Vec3 center = rotation * other.center() + translation;
+  const Vec3 half = abs_rotation * (other.extent() * 0.5);
+  const Vec3 lo = box.min.cwiseMax(center - half), hi = box.max.cwiseMin(center + half);
+  return (hi - lo).cwiseMax(0.0).prod();
+}
+
+/// An upper bound of Vol(A ∩ B) for boxes a and b whose frames b_to_a relates (abs_rotation = |R|):
+/// re-boxing either box in the other's frame bounds the overlap from above, so the smaller bound is used.
+inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b_to_a,
+                             const Mat3& abs_rotation) {
+  if (a.empty() || b.empty()) return 0;
+  const double in_a = reboxed_overlap(a, b, b_to_a.rotation, abs_rotation, b_to_a.translation);
+  if (!(in_a > 0)) return 0;
+  const Mat3 r_t = b_to_a.rotation.transpose();
+  const double in_b = reboxed_overlap(b, a, r_t, abs_rotation.transpose(), -(r_t * b_to_a.translation));
+  return std::min(in_a, in_b);
+}
+
+/// The estimate's inputs for one node pair.
+struct PairGeometry {
+  Box a;           ///< A's box, thickened; only its extents are read
+  Box b;           ///< B's box, thickened
+  double overlap;  ///< upper bound of Vol(a ∩ b), the boxes placed as the pair lies
+};
+
+/// The inputs from axis-aligned boxes in the trees' frames (b_to_a maps B's tree frame into A's).
+[[gnu::always_inline]] inline PairGeometry tree_frame_geometry(const Box& a, const Box& b,
+                                                               const RigidTransform& b_to_a,
+                                                               const Mat3& abs_rotation) {
+  PairGeometry g{with_min_thickness(a), with_min_thickness(b), 0};
+  g.overlap = overlap_volume(g.a, g.b, b_to_a, abs_rotation);
+  return g;
+}
+
+/// The inputs from boxes in their own frames: each box is [-half, half] there, and B's frame is related to
+/// A's through both frames and the pose.
+[[gnu::always_inline]] inline PairGeometry node_frame_geometry(const OrientedBox& a, const OrientedBox& b,
+                                                               const RigidTransform& b_to_a) {
+  if (a.empty() || b.empty()) return {{}, {}, 0};
+  const Mat3 to_a = a.axes.transpose();
+  RigidTransform b_to_a_local;
+  b_to_a_local.rotation = to_a * (b_to_a.rotation * b.axes);
+  b_to_a_local.translation = to_a * (b_to_a.apply(b.center) - a.center);
+  PairGeometry g{with_min_thickness({-a.half, a.half}), with_min_thickness({-b.half, b.half}), 0};
+  g.overlap = overlap_volume(g.a, g.b, b_to_a_local, b_to_a_local.rotation.cwiseAbs());
+  return g;
+}
+
+/// Density D counts its cells in the nodes' own frames on trees of BV: D says so
+/// (`static constexpr bool cells_in_node_frames`) and BV is a box in a frame of its own, stored whole.
+template <class D, class BV>
+inline constexpr bool estimates_in_node_frames = [] {
+  if constexpr (requires { D::cells_in_node_frames; })
+    return D::cells_in_node_frames && FramedVolume<BV> && !HierarchicalVolume<BV>;
+  else
+    return false;
+}();
+
+}  // namespace bvhlab
