@@ -25,6 +25,9 @@ struct ParamSpec {
   bool sweep = false;
   /// Printed in series labels ("adb p_min=0.9").
   bool in_label = false;
+  /// With in_label: printed at its default value too. False for an option added later, so that the series
+  /// that do not use it keep their labels ("adb p_min=0.9", not "adb p_min=0.9 confirm_levels=0").
+  bool label_default = true;
 
   [[nodiscard]] bool required() const { return std::isnan(default_value); }
   /// "" when `value` is acceptable, else what is wrong with it ("must lie in [0, 1]").

@@ -698,9 +698,11 @@ ReportFiles write_report(const RunOutput& run, const std::filesystem::path& dir,
   if (options.figures) {
     const ReportSpec& r = run.scene.report;
     const QualityRange range = quality_range(run);
-    std::string arguments = " --quality-min " + fmt("%.17g", range.lo) + " --quality-max " +
-                            fmt("%.17g", range.hi) + " --quality-text " + shell_quote(range.text) +
-                            " --distance-label " + shell_quote(distance_label(run.scene));
+    // "--name=value": a range over all poses starts at -1e300, which argparse would take for an option.
+    std::string arguments = " --quality-min=" + fmt("%.17g", range.lo) +
+                            " --quality-max=" + fmt("%.17g", range.hi) + " --quality-text " +
+                            shell_quote(range.text) + " --distance-label " +
+                            shell_quote(distance_label(run.scene));
     if (!r.operating_hierarchy.empty())
       arguments += " --operating-strategy " + shell_quote(r.operating_strategy) + " --operating-hierarchy " +
                    shell_quote(r.operating_hierarchy) + " --operating-p-min " +

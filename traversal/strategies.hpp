@@ -30,7 +30,8 @@ inline constexpr ParamSpec kAdb[] = {
      .default_value = 0,
      .integer = true,
      .sweep = true,
-     .in_label = true},
+     .in_label = true,
+     .label_default = false},
 };
 inline constexpr ParamSpec kTimeCritical[] = {
     {.name = "p_min",

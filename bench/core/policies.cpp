@@ -114,7 +114,11 @@ std::string density_label(std::string_view density, const ParamValues& values) {
 }
 
 std::string strategy_label(std::string_view strategy, const ParamValues& values, const Budget& budget) {
-  const std::string params = describe_parameters(strategy_info(strategy).parameters, values,
+  ParamValues shown = values;
+  for (const ParamSpec& p : strategy_info(strategy).parameters)
+    if (!p.label_default && shown.contains(p.name) && shown.find(p.name)->second == p.default_value)
+      shown.erase(shown.find(p.name));
+  const std::string params = describe_parameters(strategy_info(strategy).parameters, shown,
                                                  [](const ParamSpec& p) { return p.in_label; });
   const std::string budget_text = budget_label(budget);
   return std::string(strategy) + (params.empty() ? "" : " " + params) +

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -85,6 +86,22 @@ TEST_F(ReportTest, PoseFileIsSummarisedOverAllItsPosesUnlessTheSceneSaysOtherwis
   ASSERT_EQ(operating_points(some).size(), 1u);
   EXPECT_EQ(operating_points(some)[0].adb.queries, 1u);
   EXPECT_NE(readme(some).find("distance 1.5 (1 of 4 poses)"), std::string::npos) << readme(some);
+}
+
+// A workload of random poses is summarised over all of them: the figures take that range too (its lower end,
+// -1e300, once reached the plot script as an option name and no figure was drawn).
+TEST_F(ReportTest, FiguresAreDrawnForRandomPoses) {
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0 &&
+      std::system("python3 -c 'import matplotlib' >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "no Python with matplotlib";
+  const Scene random = parse_scene(R"({"objects": [{"mesh": "torus.obj"}], "hierarchies": [{"bv": "aabb"}],
+      "annotation": {"type": "adb", "grid": 2, "tau": 0.5},
+      "strategies": [{"type": "exact"}, {"type": "adb", "p_min": 0.9}],
+      "workload": {"type": "random", "count": 8, "box": [[-1, -1, -1], [1, 1, 1]]}, "report": {"cgal_sample": 1}})",
+                                   dir.path(), "random.json");
+  const ReportFiles files = write_report(run_scene(random, options), dir / "report");
+  EXPECT_EQ(files.plot_error, "");
+  EXPECT_FALSE(files.figures.empty());
 }
 
 // A pair of two objects is labelled "a|b": in the README's tables the bar must not split a cell, so every
