@@ -138,7 +138,7 @@ class SweepAndPrune {
       const Entry& a = entries_[i];
       for (std::size_t j = i + 1; j < n && entries_[j].lo <= a.hi; ++j) {
         const Entry& b = entries_[j];
-        if ((b.lo1 <= a.hi1) & (a.lo1 <= b.hi1) & (b.lo2 <= a.hi2) & (a.lo2 <= b.hi2))
+        if (broad_phase_detail::all_hold(b.lo1 <= a.hi1, a.lo1 <= b.hi1, b.lo2 <= a.hi2, a.lo2 <= b.hi2))
           pairs_.push_back(broad_phase_detail::ordered_pair(a.id, b.id));
       }
     }
