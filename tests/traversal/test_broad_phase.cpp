@@ -288,6 +288,25 @@ TEST(DynamicAabbTree, StaysBalancedUnderSortedInsertion) {
   EXPECT_LE(tree.height(), 25);
 }
 
+// The tree's node boxes are floats rounded outwards: beyond the float range they reach infinity, among
+// subnormals they round to the smallest steps. Neither may lose or add a pair.
+TEST(DynamicAabbTree, FloatNodeBoxesKeepThePairsAtExtremeScales) {
+  for (const double scale : {1e-41, 1e-30, 1.0, 1e30, 1e39, 1e200}) {
+    std::mt19937_64 rng(21);
+    std::vector<Box> boxes = random_boxes(300, true, rng);
+    for (Box& b : boxes) b = {b.min * scale, b.max * scale};
+    // Pairs that only just touch, and only just miss, at this scale.
+    boxes.push_back(box_at(Vec3(0, 0, 0) * scale, Vec3(1, 1, 1) * scale));
+    boxes.push_back(box_at(Vec3(2, 0, 0) * scale, Vec3(1, 1, 1) * scale));
+    boxes.push_back(Box{Vec3(std::nextafter(3.0 * scale, 1e300), -scale, -scale), Vec3(4, 1, 1) * scale});
+    DynamicAabbTree tree;
+    BruteForce reference;
+    tree.update(boxes);
+    reference.update(boxes);
+    EXPECT_EQ(tree.pairs(), reference.pairs()) << "scale " << scale;
+  }
+}
+
 TEST(DynamicAabbTree, RejectsNegativeMargins) {
   EXPECT_THROW(DynamicAabbTree(DynamicAabbTree::Options{-0.1, 0}), std::invalid_argument);
   EXPECT_THROW(DynamicAabbTree(DynamicAabbTree::Options{0.1, std::numeric_limits<double>::quiet_NaN()}),
