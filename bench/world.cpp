@@ -223,11 +223,14 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
         FrameOptions options;
         options.policy = policy;
         options.p_min = spec.p_min;
+        options.adb.confirm_levels = static_cast<std::uint8_t>(spec.confirm_levels);
         options.budget = budget;
         WorldSeriesRow row;
+        // A confirming schedule is a line of its own in the figures, beside the same policy without it.
         row.schedule = policy;
+        if (spec.confirm_levels > 0) row.schedule += " confirm_levels=" + std::to_string(spec.confirm_levels);
         row.budget = budget_label(budget);
-        row.series = "frame " + policy + " " + row.budget + " p_min=" + parameter_text(spec.p_min);
+        row.series = "frame " + row.schedule + " " + row.budget + " p_min=" + parameter_text(spec.p_min);
         const std::vector<PairOutcome> outcomes = schedule(planned, candidates, options, row.micros);
         std::vector<char> answers(candidates.size()), flagged(candidates.size());
         for (std::size_t k = 0; k < outcomes.size(); ++k) {

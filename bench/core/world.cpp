@@ -138,7 +138,7 @@ std::vector<std::string> parse_names(const Node& node, const std::vector<std::st
 }
 
 FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
-  node.expect_object({"schedules", "budgets", "p_min", "hierarchies"});
+  node.expect_object({"schedules", "budgets", "p_min", "confirm_levels", "hierarchies"});
   FrameBudgetSpec spec;
   spec.schedules = parse_names(node.child("schedules"), frame_schedule_names());
   spec.budgets = parse_budgets(node.child("budgets"));
@@ -146,6 +146,8 @@ FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
     spec.p_min = node.child("p_min").number(0, 1);
     if (!(spec.p_min > 0)) node.child("p_min").fail("expected a number in (0, 1]; got 0");
   }
+  if (node.has("confirm_levels"))
+    spec.confirm_levels = static_cast<int>(node.child("confirm_levels").integer(0, 255));
   std::vector<std::string> hierarchy_names;
   for (const auto& h : scene.hierarchies) hierarchy_names.push_back(h.name);
   auto probability = [&](const HierarchySpec& h) {

@@ -182,6 +182,16 @@ TEST_F(WorldTest, OptionsThatDoNotApplyAreRefusedByName) {
       "frame_budgets": [{"schedules": ["greedy"], "budgets": [{"bv_tests": 100}], "hierarchies": ["aabb"]}]})",
                      "", kAnnotated),
          "/world/frame_budgets/0/schedules/0: expected one of adb_probability");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2},
+      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "confirm_levels": 256}]})",
+                     "", kAnnotated),
+         "/world/frame_budgets/0/confirm_levels: ");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2},
+      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "confirm_levels": 1.5}]})",
+                     "", kAnnotated),
+         "/world/frame_budgets/0/confirm_levels: expected an integer");
 }
 
 TEST_F(WorldTest, FrameBudgetsOnAHierarchyWithAProbabilityDensityAreKept) {
@@ -296,6 +306,34 @@ TEST_F(WorldTest, AFrameBudgetOfOneTestFlagsItsPairsAndAGenerousOneDecidesThemAl
   }
   EXPECT_GT(candidates, 0u);
   EXPECT_GT(starved, 0u);
+}
+
+// A frame budget that never runs out answers every pair as ADB does on its own, with the same confirming
+// generations: the scene's confirm_levels reaches every pair of the frame.
+TEST_F(WorldTest, AGenerousFrameBudgetWithConfirmLevelsAnswersAsAdbWithThem) {
+  const Scene scene = parse(crowded_world(
+      R"([{"bv": "aabb", "annotation": {"type": "adb"}}])",
+      R"([{"type": "adb", "p_min": 0.5, "confirm_levels": [0, 2]}])",
+      R"(, "frame_budgets": [{"schedules": ["adb_probability", "round_robin"], "budgets": [{"bv_tests": 10000000}],
+          "p_min": 0.5, "confirm_levels": 2}])"));
+  const WorldOutput out = run_world(scene, quiet_options());
+  std::map<std::pair<int, std::string>, const WorldSeriesRow*> rows;
+  for (const WorldSeriesRow& row : out.series) rows[{row.frame, row.series}] = &row;
+  std::size_t compared = 0, changed = 0;
+  for (const WorldSeriesRow& row : out.series) {
+    if (row.schedule.empty()) continue;
+    EXPECT_NE(row.schedule.find("confirm_levels=2"), std::string::npos) << row.schedule;
+    const WorldSeriesRow& adb = *rows.at({row.frame, "adb p_min=0.5 confirm_levels=2"});
+    const WorldSeriesRow& plain = *rows.at({row.frame, "adb p_min=0.5"});
+    EXPECT_EQ(row.answered, adb.answered) << row.series << " frame " << row.frame;
+    EXPECT_EQ(row.missed, adb.missed) << row.series << " frame " << row.frame;
+    EXPECT_EQ(row.false_pairs, adb.false_pairs) << row.series << " frame " << row.frame;
+    compared += row.candidates;
+    changed += row.answered != plain.answered;
+  }
+  EXPECT_GT(compared, 0u);
+  EXPECT_GT(changed,
+            0u);  // the confirming generations change some answers here, so the match means something
 }
 
 TEST_F(WorldTest, AnObjectWithoutTrianglesIsRefusedByName) {
