@@ -213,8 +213,10 @@ std::vector<PairOutcome> schedule(const PlannedHierarchy& planned, const std::ve
   return out;
 }
 
+/// Each schedule runs once untimed first when `warmup` > 0, as each per-pair query does (run_variant): the
+/// series of a frame then find the trees equally warm, whichever runs first.
 std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedHierarchy& planned,
-                                              const std::vector<Candidate>& candidates) {
+                                              const std::vector<Candidate>& candidates, int warmup) {
   std::vector<WorldSeriesRow> rows;
   for (const FrameBudgetSpec& spec : scene.world->frame_budgets) {
     if (!spec.applies_to(*planned.hierarchy)) continue;
@@ -231,6 +233,7 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
         if (spec.confirm_levels > 0) row.schedule += " confirm_levels=" + std::to_string(spec.confirm_levels);
         row.budget = budget_label(budget);
         row.series = "frame " + row.schedule + " " + row.budget + " p_min=" + parameter_text(spec.p_min);
+        if (warmup > 0) schedule(planned, candidates, options, row.micros);
         const std::vector<PairOutcome> outcomes = schedule(planned, candidates, options, row.micros);
         std::vector<char> answers(candidates.size()), flagged(candidates.size());
         for (std::size_t k = 0; k < outcomes.size(); ++k) {
@@ -420,7 +423,8 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
       std::vector<WorldSeriesRow> rows;
       for (const StrategyVariant& variant : h->planned().variants)
         rows.push_back(run_variant(variant, candidates, options.warmup_queries));
-      for (WorldSeriesRow& row : run_frame_budgets(scene, h->planned(), candidates)) rows.push_back(row);
+      for (WorldSeriesRow& row : run_frame_budgets(scene, h->planned(), candidates, options.warmup_queries))
+        rows.push_back(row);
       for (WorldSeriesRow& row : rows) {
         row.frame = frame;
         row.hierarchy = h->planned().hierarchy->name;

@@ -59,8 +59,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <limits>
+#include <optional>
 #include <queue>
 #include <span>
 #include <stdexcept>
@@ -168,7 +168,7 @@ double levels_below(const Bvh<BV>& tree, std::uint32_t node) {
 }
 
 /// One candidate pair's ADB traversal, resumable: the state query_adb keeps on its stack, kept between
-/// steps. Not movable (the traversal's parts refer to each other): kept in a std::deque.
+/// steps. Not movable (the traversal's parts refer to each other): built in place in a std::optional.
 template <TreeVolume BV, ProbabilityDensity D>
 class PairRun {
  public:
@@ -296,16 +296,17 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   const AdbOptions adb = options.pair_options();
   for (std::size_t k = 0; k < pairs.size(); ++k) frame_detail::validate_pair(pairs[k], k, adb);
 
-  std::deque<Run> runs;
-  for (const auto& pair : pairs) runs.emplace_back(pair, adb);
+  // Each pair's traversal is set up when its root is tested, in one block allocated up front: a deadline
+  // that ends the root round leaves the pairs after it unbuilt until their best-effort answer.
+  std::vector<std::optional<Run>> runs(pairs.size());
   frame_detail::TestBudget tests(options.budget.max_bv_tests, pairs.size(), policy.equal_shares);
   std::priority_queue<frame_detail::Ranked> next;
   const auto rank = [&](std::size_t k) {
-    next.push({policy.priority(runs[k].status(k, policy.uses_cost)), k});
+    next.push({policy.priority(runs[k]->status(k, policy.uses_cost)), k});
   };
   // Runs pair k's root or next step; true when the frame's budget of BV tests has run out.
   const auto advance = [&](std::size_t k, bool root) {
-    Run& run = runs[k];
+    Run& run = root ? runs[k].emplace(pairs[k], adb) : *runs[k];
     const std::uint64_t before = run.bv_tests();
     const TraversalState progress =
         root ? run.begin(tests.allowance(k, before)) : run.step(tests.allowance(k, before));
@@ -334,7 +335,8 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   }
   std::vector<PairOutcome> outcomes;  // 4. the undecided answer their best effort
   outcomes.reserve(runs.size());
-  for (Run& run : runs) {
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    Run& run = runs[k] ? *runs[k] : runs[k].emplace(pairs[k], adb);  // unreached: never begun
     run.end();
     outcomes.push_back(run.outcome());
   }
