@@ -56,8 +56,8 @@ struct Scene {
   std::string label;
   Environment env;
   std::vector<std::vector<RigidTransform>> frames;
-  std::vector<Bvh<Aabb>> trees;     // one per shape
-  std::vector<BoundingBall> balls;  // one per shape
+  std::vector<Bvh<Aabb>> trees;    // one per shape
+  std::vector<RootBounds> bounds;  // one per shape
 #ifdef BVHLAB_HAVE_FCL
   std::vector<std::vector<fcl::Transform3d>> fcl_frames;
   std::vector<std::shared_ptr<fcl::CollisionGeometryd>> models;  // one per shape
@@ -78,7 +78,7 @@ Scene make_scene(const std::string& label, std::size_t objects, std::size_t fram
   s.frames = broad_phase_env::make_frames(s.env, frames, motion);
   for (const Mesh& mesh : s.env.shapes) {
     s.trees.push_back(Bvh<Aabb>::build(mesh));
-    s.balls.push_back(bounding_ball(s.trees.back()));
+    s.bounds.push_back(root_bounds(s.trees.back()));
   }
 #ifdef BVHLAB_HAVE_FCL
   for (const auto& poses : s.frames) {
@@ -105,7 +105,7 @@ void world_boxes(const Scene& s, std::size_t frame, std::vector<Box>& boxes) {
   boxes.resize(poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const std::uint32_t shape = s.env.shape_of[i];
-    boxes[i] = world_box(s.trees[shape], poses[i], s.balls[shape]);
+    boxes[i] = world_box(s.trees[shape], poses[i], s.bounds[shape]);
   }
 }
 

@@ -32,7 +32,7 @@ template <class BV, class D>
 class BvhlabHierarchy final : public PreparedHierarchy {
  public:
   BvhlabHierarchy(std::shared_ptr<const Tree<BV, D>> a, std::shared_ptr<const Tree<BV, D>> b)
-      : a_(std::move(a)), b_(std::move(b)), ball_a_(bounding_ball(a_->bvh)) {}
+      : a_(std::move(a)), b_(std::move(b)), bounds_a_(root_bounds(a_->bvh)) {}
 
   void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
            std::vector<QueryRecord>& out) const override {
@@ -52,7 +52,7 @@ class BvhlabHierarchy final : public PreparedHierarchy {
     return query_exact(a_->bvh, b_->bvh, pose).collides;
   }
   [[nodiscard]] Box world_box(const RigidTransform& pose) const override {
-    return bvhlab::world_box(a_->bvh, pose, ball_a_);
+    return bvhlab::world_box(a_->bvh, pose, bounds_a_);
   }
   [[nodiscard]] const void* tree_a() const override { return a_.get(); }
   [[nodiscard]] const void* tree_b() const override { return b_.get(); }
@@ -72,7 +72,7 @@ class BvhlabHierarchy final : public PreparedHierarchy {
     });
   }
   std::shared_ptr<const Tree<BV, D>> a_, b_;
-  BoundingBall ball_a_;  ///< cuts A's world box for round objects (traversal/broad_phase/world_box.hpp)
+  RootBounds bounds_a_;  ///< A's bounding ball and DOP vertices (traversal/broad_phase/world_box.hpp)
 };
 
 #ifdef BVHLAB_HAVE_FCL

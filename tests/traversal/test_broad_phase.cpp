@@ -1,6 +1,8 @@
 // The broad phases against brute force (and brute force against Box::overlaps), their input rules, the
 // dynamic tree's fattened boxes, and world boxes against every transformed vertex.
 #include "bench/core/generators.hpp"
+#include "bvh/mesh_io.hpp"
+#include "support/meshes.hpp"
 #include "support/random_draws.hpp"
 #include "support/volume_lists.hpp"
 #include "traversal/broad_phase/registry.hpp"
@@ -400,6 +402,16 @@ TYPED_TEST(WorldBox, ContainsEveryTransformedVertexAndIsNoLargerThanTheRotatedRo
         ASSERT_TRUE(balled.contains(pose.apply(v))) << mesh.name << ", pose " << k << " (with the ball)";
       EXPECT_TRUE((balled.min.array() >= world.min.array()).all() &&
                   (balled.max.array() <= world.max.array()).all());
+      // With the root bounds (a k-DOP root's vertices): still every vertex, and no looser than with the
+      // ball alone but for the vertices' slack (a few 1e-9 of the root's size).
+      const RootBounds bounds = root_bounds(tree);
+      const Box bounded = world_box(tree, pose, bounds);
+      for (const Vec3& v : mesh.vertices)
+        ASSERT_TRUE(bounded.contains(pose.apply(v))) << mesh.name << ", pose " << k << " (root bounds)";
+      const double slack = 1e-8 * (local.extent().maxCoeff() + local.center().norm());
+      EXPECT_TRUE((bounded.min.array() >= balled.min.array() - slack).all() &&
+                  (bounded.max.array() <= balled.max.array() + slack).all())
+          << mesh.name << ", pose " << k;
       const Box reference = rotated_corners(local, pose);
       const double tolerance =
           1e-9 * (reference.extent().maxCoeff() + pose.translation.cwiseAbs().maxCoeff());
@@ -427,6 +439,98 @@ TEST(WorldBox, DopOfThePrototypeShapeGivesTheExactRotatedBox) {
     EXPECT_LT((world.max - exact.max).cwiseAbs().maxCoeff(), 1e-5) << "pose " << k;
     EXPECT_LT((world.min - exact.min).cwiseAbs().maxCoeff(), 1e-5) << "pose " << k;
   }
+}
+
+// The DOP's vertices by brute force, independently of dop_vertices: every triple of its planes solved by a
+// pivoting QR, the points inside every half-space kept, no merging.
+template <class Set>
+std::vector<Vec3> brute_force_dop_vertices(const KDop<Set>& dop) {
+  constexpr std::size_t kAxes = KDop<Set>::kAxes;
+  std::vector<Vec3> normals;
+  for (const auto& raw : Set::set.raw) normals.push_back(Vec3(raw[0], raw[1], raw[2]).normalized());
+  for (std::size_t a = 0; a < kAxes; ++a) normals.push_back(-normals[a]);
+  double scale = 0;
+  for (const float d : dop.offsets) scale = std::max(scale, std::abs(double(d)));
+  std::vector<Vec3> out;
+  for (std::size_t i = 0; i < normals.size(); ++i)
+    for (std::size_t j = i + 1; j < normals.size(); ++j)
+      for (std::size_t l = j + 1; l < normals.size(); ++l) {
+        Mat3 m;
+        m << normals[i].transpose(), normals[j].transpose(), normals[l].transpose();
+        const auto qr = m.colPivHouseholderQr();
+        if (qr.rank() < 3) continue;
+        const Vec3 x = qr.solve(Vec3(dop.offsets[i], dop.offsets[j], dop.offsets[l]));
+        bool inside = true;
+        for (std::size_t q = 0; q < normals.size(); ++q)
+          inside = inside && normals[q].dot(x) <= double(dop.offsets[q]) + 1e-9 * scale;
+        if (inside) out.push_back(x);
+      }
+  return out;
+}
+
+// The world box from the DOP's vertices, against the points the DOP was fitted to, the LP bound, and the
+// brute-force vertices, under random rotations.
+template <class Set>
+void expect_exact_dop_support(const std::vector<Vec3>& points, const std::string& label,
+                              std::mt19937_64& rng) {
+  const KDop<Set> dop = KDop<Set>::fit(points);
+  const DopVertices vertices = dop_vertices(dop);
+  ASSERT_FALSE(vertices.empty()) << label;
+  const std::vector<Vec3> brute = brute_force_dop_vertices(dop);
+  ASSERT_FALSE(brute.empty()) << label;
+  double size = 0;
+  for (const Vec3& p : points) size = std::max(size, p.cwiseAbs().maxCoeff());
+  for (int k = 0; k < 30; ++k) {
+    const RigidTransform pose = random_rigid(rng, k < 15 ? 10.0 : 1e4);
+    const Box box = world_box(vertices, pose);
+    for (const Vec3& p : points)
+      ASSERT_TRUE(box.contains(pose.apply(p)))
+          << label << ", pose " << k << ": " << pose.apply(p).transpose();
+    Box exact;
+    for (const Vec3& v : brute) exact.extend(pose.apply(v));
+    const Box lp = world_box(dop, pose);
+    const double tolerance = 1e-7 * (size + pose.translation.cwiseAbs().maxCoeff()) + 1e-12;
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_NEAR(box.max[axis], exact.max[axis], tolerance) << label << ", pose " << k << ", axis " << axis;
+      EXPECT_NEAR(box.min[axis], exact.min[axis], tolerance) << label << ", pose " << k << ", axis " << axis;
+      EXPECT_LE(box.max[axis], lp.max[axis] + tolerance) << label << ", pose " << k << ", axis " << axis;
+      EXPECT_GE(box.min[axis], lp.min[axis] - tolerance) << label << ", pose " << k << ", axis " << axis;
+    }
+  }
+}
+
+std::vector<std::pair<std::string, std::vector<Vec3>>> dop_test_point_sets() {
+  std::vector<std::pair<std::string, std::vector<Vec3>>> sets;
+  for (const char* file : {"pinion.off", "jeep1.ms3d", "teapot.obj"})
+    sets.emplace_back(file, load_mesh(testing::bundled_mesh(file)).mesh.vertices);
+  std::vector<Vec3> torus = generators::make_torus(3, 1, 24, 12).vertices;
+  for (auto& v : torus) v += Vec3(7, -2, 1);
+  sets.emplace_back("off-centre torus", torus);
+  // Degenerate DOPs: flat (equal offsets on the opposite z planes), a tilted triangle, a segment, points.
+  sets.emplace_back("flat quad", std::vector<Vec3>{{-1, -2, 0.5}, {3, -2, 0.5}, {3, 1, 0.5}, {-1, 1, 0.5}});
+  sets.emplace_back("tilted triangle",
+                    std::vector<Vec3>{{0.3, 1.7, -2.2}, {4.1, -0.6, 0.9}, {-1.3, 2.2, 3.5}});
+  sets.emplace_back("segment", std::vector<Vec3>{{1, 2, 3}, {-2, 0.5, 7}});
+  sets.emplace_back("point", std::vector<Vec3>{{2.5, -1.25, 4}});
+  sets.emplace_back("origin", std::vector<Vec3>{Vec3::Zero()});
+  return sets;
+}
+
+TEST(WorldBox, DopVerticesGiveTheExactSupportOfTheRotatedDop) {
+  std::mt19937_64 rng(23);
+  for (const auto& [label, points] : dop_test_point_sets()) {
+    expect_exact_dop_support<dop_sets::Zachmann24>(points, label + " (24-DOP)", rng);
+    // The 14-DOP's corners join more than three planes: many triples meet in one vertex.
+    expect_exact_dop_support<dop_sets::Dop14>(points, label + " (14-DOP)", rng);
+  }
+}
+
+TEST(WorldBox, DopVerticesOnlyForDopRootsAndNoneForAnEmptyDop) {
+  const Mesh box = generators::make_box(5, 10, 20);
+  EXPECT_FALSE(root_bounds(Bvh<Dop24>::build(box)).dop.empty());
+  EXPECT_TRUE(root_bounds(Bvh<Aabb>::build(box)).dop.empty());
+  EXPECT_TRUE(dop_vertices(Dop24{}).empty());
+  EXPECT_TRUE(world_box(dop_vertices(Dop24{}), RigidTransform{}).empty());
 }
 
 TEST(WorldBox, AabbRootUnder45DegreesIsTighterThanTheCubeAroundItsSphere) {
