@@ -91,6 +91,12 @@ struct AdbDepthFirst {
   using Queue = OrderedDepthFirst;
   using Descent = SplitBoth;
 };
+/// Best first, splitting only the larger node of a pair (the exact traversal's descent): a small object is
+/// not opened level by level against a large one's every level.
+struct AdbLargerFirst {
+  using Queue = BestFirst;
+  using Descent = SplitLarger;
+};
 
 namespace detail {
 

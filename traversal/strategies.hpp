@@ -117,19 +117,22 @@ struct AdbStrategy : GuidedExactStrategy {
   }
 };
 
-/// `Base` (a strategy running query_adb) in the depth-first order: the most probable child of the pair just
-/// expanded next. On the default density only: every (volume, density) pair a strategy accepts is one more
-/// traversal for the runner, the CLI and Python to compile, and the order does not depend on the density.
-template <class Base>
-struct InDepthFirstOrder : Base {
+/// `Base` (a strategy running query_adb) in another order (`Order`: AdbDepthFirst, AdbLargerFirst). On the
+/// default density only: every (volume, density) pair a strategy accepts is one more traversal for the
+/// runner, the CLI and Python to compile, and the order does not depend on the density.
+template <class Base, class Order>
+struct InOrder : Base {
   template <class D>
   static constexpr bool accepts = ProbabilityDensity<D>&& D::name() == std::string_view("adb");
   template <class TreeA, class TreeB>
   static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a,
                       const typename Base::Options& options) {
-    return query_adb<AdbDepthFirst>(a, b, b_to_a, options);
+    return query_adb<Order>(a, b, b_to_a, options);
   }
 };
+/// The depth-first order: the most probable child of the pair just expanded next.
+template <class Base>
+using InDepthFirstOrder = InOrder<Base, AdbDepthFirst>;
 
 /// Guided exact in the depth-first order.
 struct GuidedExactDfsStrategy : InDepthFirstOrder<GuidedExactStrategy> {
@@ -144,6 +147,14 @@ struct AdbDfsStrategy : InDepthFirstOrder<AdbStrategy> {
   static constexpr std::string_view name() { return "adb_dfs"; }
   static constexpr std::string_view description() {
     return "adb's answers, depth first into the most probable child pair";
+  }
+};
+
+/// ADB with p_min splitting only the larger node of a pair: for objects of very different size.
+struct AdbLargerStrategy : InOrder<AdbStrategy, AdbLargerFirst> {
+  static constexpr std::string_view name() { return "adb_larger"; }
+  static constexpr std::string_view description() {
+    return "adb, splitting only the larger node of a pair (the exact traversal's descent)";
   }
 };
 
@@ -167,6 +178,6 @@ struct TimeCriticalStrategy : AdbStrategy {
 
 static_assert(Strategy<ExactStrategy> && Strategy<AllContactsStrategy> && Strategy<GuidedExactStrategy> &&
               Strategy<AdbStrategy> && Strategy<TimeCriticalStrategy> && Strategy<GuidedExactDfsStrategy> &&
-              Strategy<AdbDfsStrategy>);
+              Strategy<AdbDfsStrategy> && Strategy<AdbLargerStrategy>);
 
 }  // namespace bvhlab

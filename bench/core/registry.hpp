@@ -41,8 +41,9 @@ using RegisteredVolumes = ShippedVolumes;
 
 #ifndef BVHLAB_TEST_POLICIES
 using RegisteredDensities = TypeList<NoDensity, AdbDensity, AdbPaperDensity, AdbNormalDensity>;
-using RegisteredStrategies = TypeList<ExactStrategy, AllContactsStrategy, GuidedExactStrategy, AdbStrategy,
-                                      TimeCriticalStrategy, GuidedExactDfsStrategy, AdbDfsStrategy>;
+using RegisteredStrategies =
+    TypeList<ExactStrategy, AllContactsStrategy, GuidedExactStrategy, AdbStrategy, TimeCriticalStrategy,
+             GuidedExactDfsStrategy, AdbDfsStrategy, AdbLargerStrategy>;
 #else
 /// The test variant adds one density and one strategy next to a few shipped ones: enough to show that a new
 /// policy needs nothing but its header and its line, while each left-out policy saves its instantiations

@@ -16,6 +16,7 @@ STRATEGIES = [  # (strategy, its parameters, density the trees need)
     ("adb", {"p_min": 0.5}, "adb"),
     ("adb", {"p_min": 0.95}, "adb"),
     ("adb_dfs", {"p_min": 0.9}, "adb"),
+    ("adb_larger", {"p_min": 0.9}, "adb"),
     ("time_critical", {"p_min": 0.9, "bv_tests": 40}, "adb"),
 ]
 EXACT = [("exact", "none"), ("all_contacts", "none"), ("guided_exact", "adb"), ("guided_exact_dfs", "adb")]

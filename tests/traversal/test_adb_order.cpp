@@ -1,6 +1,7 @@
-// The ADB traversal's two orders: best first (the paper's) and probability-ordered depth first. Guided exact
-// stays exact in either order; adb in depth-first order gives adb's answers; budgets and the best-effort
-// answer hold for a stack; and depth first reaches a leaf pair sooner.
+// The ADB traversal's orders: best first (the paper's), probability-ordered depth first, and best first
+// splitting only the larger node. Guided exact stays exact in either order; adb in depth-first order gives
+// adb's answers; budgets and the best-effort answer hold for a stack; depth first reaches a leaf pair
+// sooner; splitting the larger node stays honest and spends fewer tests on objects of very different size.
 #include "adb/adb_density.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/adb.hpp"
@@ -228,6 +229,75 @@ TEST(AdbDepthFirst, ReachesTheFirstLeafPairInFewerBvTests) {
   }
   EXPECT_GT(dfs_sooner, poses * 3 / 4);
   EXPECT_LT(dfs_total * 10, best_total);
+}
+
+/// A torus of size ~2 and one a hundred times smaller, annotated as shipped (2x2x2 cells, default tau).
+template <class BV>
+struct SizePair {
+  Mesh large = testing::make_torus(0.7, 0.25, 60, 30);
+  Mesh small = testing::make_torus(0.007, 0.0025, 16, 8);
+  Tree<BV, AdbDensity> tree_a = annotate_adb(Bvh<BV>::build(large));
+  Tree<BV, AdbDensity> tree_b = annotate_adb(Bvh<BV>::build(small));
+};
+
+/// The small torus placed on a vertex of the large one, turned at random and moved by up to `jitter`:
+/// about half the poses touch.
+RigidTransform on_the_surface(const Mesh& large, std::mt19937_64& rng, double jitter) {
+  RigidTransform pose = testing::random_pose(rng, jitter);
+  std::uniform_int_distribution<std::size_t> vertex(0, large.vertices.size() - 1);
+  pose.translation += large.vertices[vertex(rng)];
+  return pose;
+}
+
+/// adb_larger's and adb's work over poses of the small torus on the large one's surface, with adb_larger's
+/// honesty checked pose by pose: a colliding pose never gets probability 0, a decision exceeds p_min, and an
+/// answer marked exact is the exact one.
+struct SizePairTally {
+  int poses = 200, colliding = 0, agreeing = 0;
+  std::uint64_t larger_tests = 0, both_tests = 0;
+};
+template <class BV>
+SizePairTally run_size_pair() {
+  const SizePair<BV> scene;
+  std::mt19937_64 rng(73);
+  AdbOptions options;
+  options.p_min = 0.9;
+  SizePairTally tally;
+  for (int k = 0; k < tally.poses; ++k) {
+    const RigidTransform pose = on_the_surface(scene.large, rng, 0.02);
+    const Result larger = query_adb<AdbLargerFirst>(scene.tree_a, scene.tree_b, pose, options);
+    const Result both = query_adb(scene.tree_a, scene.tree_b, pose, options);
+    const bool truth = query_exact(scene.tree_a.bvh, scene.tree_b.bvh, pose).collides;
+    if (truth) {
+      EXPECT_GT(larger.probability, 0.0) << "pose " << k;
+    }
+    if (larger.collides) {
+      EXPECT_GT(larger.probability, options.p_min) << "pose " << k;
+    }
+    if (larger.exact) {
+      EXPECT_EQ(larger.collides, truth) << "pose " << k;
+    }
+    tally.colliding += truth;
+    tally.agreeing += larger.collides == truth;
+    tally.larger_tests += larger.counters.bv_tests;
+    tally.both_tests += both.counters.bv_tests;
+  }
+  EXPECT_GT(tally.colliding, tally.poses / 5);  // both kinds of pose occur
+  EXPECT_LT(tally.colliding, tally.poses * 4 / 5);
+  return tally;
+}
+
+TEST(AdbLargerFirst, IsHonestOnObjectsOfVeryDifferentSizeOnAabbs) {
+  run_size_pair<Aabb>();
+}
+
+// On OBBs, which fit the large torus's slanted triangles closely, splitting both nodes opens the small tree
+// against every level of the large one; splitting the larger node does not, and its answers still follow
+// the truth. (On AABBs the large nodes' boxes hold the small torus whole, and neither order helps much.)
+TEST(AdbLargerFirst, SpendsFewerTestsThanSplittingBothOnObbs) {
+  const SizePairTally tally = run_size_pair<Obb>();
+  EXPECT_GT(tally.agreeing, tally.poses * 3 / 4);
+  EXPECT_LT(2 * tally.larger_tests, tally.both_tests);
 }
 
 }  // namespace
