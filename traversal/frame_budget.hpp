@@ -241,15 +241,25 @@ class PairRun {
 /// Checks one pair (header comment, 1.); `index` names it.
 template <TreeVolume BV, ProbabilityDensity D>
 void validate_pair(const FramePair<BV, D>& pair, std::size_t index, const AdbOptions& options) {
-  const std::string name = "frame: pair " + std::to_string(index);
-  if (pair.a == nullptr || pair.b == nullptr) throw std::invalid_argument(name + " has a null tree");
+  // The name only on failure: built for every pair, it cost as much as the pair's root test.
+  const auto name = [index] { return "frame: pair " + std::to_string(index); };
+  if (pair.a == nullptr || pair.b == nullptr) throw std::invalid_argument(name() + " has a null tree");
   try {
     pair.b_to_a.validate();
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(name + ": " + e.what());
+    throw std::invalid_argument(name() + ": " + e.what());
   }
   if (options.exact_leaves && (!pair.a->bvh.has_polygons() || !pair.b->bvh.has_polygons()))
-    throw std::invalid_argument(name + ": guided exact needs trees with polygons");
+    throw std::invalid_argument(name() + ": guided exact needs trees with polygons");
+}
+
+/// The answer of a pair whose root the budget did not reach, without setting it up after the deadline: what
+/// a traversal stopped before its first test answers (AdbHooks::finish on an empty queue: no estimate,
+/// probability 0, flagged), or no contact for an empty tree (query_adb's answer).
+template <TreeVolume BV, ProbabilityDensity D>
+PairOutcome never_begun(const FramePair<BV, D>& pair, const AdbOptions& options) {
+  if (pair.a->bvh.empty() || pair.b->bvh.empty()) return {false, 0, false, true, {}};
+  return {0 >= options.best_effort_threshold, 0, true, false, {}};
 }
 
 /// The next pairs to step, ranked by the policy: (priority, index), highest priority first, then the lower
@@ -297,7 +307,7 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   for (std::size_t k = 0; k < pairs.size(); ++k) frame_detail::validate_pair(pairs[k], k, adb);
 
   // Each pair's traversal is set up when its root is tested, in one block allocated up front: a deadline
-  // that ends the root round leaves the pairs after it unbuilt until their best-effort answer.
+  // that ends the root round leaves the pairs after it unbuilt (never_begun gives their answers).
   std::vector<std::optional<Run>> runs(pairs.size());
   frame_detail::TestBudget tests(options.budget.max_bv_tests, pairs.size(), policy.equal_shares);
   std::priority_queue<frame_detail::Ranked> next;
@@ -336,9 +346,12 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   std::vector<PairOutcome> outcomes;  // 4. the undecided answer their best effort
   outcomes.reserve(runs.size());
   for (std::size_t k = 0; k < runs.size(); ++k) {
-    Run& run = runs[k] ? *runs[k] : runs[k].emplace(pairs[k], adb);  // unreached: never begun
-    run.end();
-    outcomes.push_back(run.outcome());
+    if (!runs[k]) {
+      outcomes.push_back(frame_detail::never_begun(pairs[k], adb));
+      continue;
+    }
+    runs[k]->end();
+    outcomes.push_back(runs[k]->outcome());
   }
   return outcomes;
 }

@@ -347,6 +347,25 @@ TEST(FrameBudget, RoundRobinReachesEveryPair) {
   EXPECT_GT(global_unexpanded, 0);  // the probability order does leave pairs at their root: the test matters
 }
 
+// A pair with an empty tree answers "no contact", unflagged and exact, as query_adb does: whether its turn
+// came or a deadline ended the frame before it.
+TEST(FrameBudget, AnEmptyTreeAnswersNoContactWithOrWithoutItsTurn) {
+  const auto& full = meshes<Aabb>().trees[0];
+  const Tree<Aabb, AdbDensity> empty{Bvh<Aabb>{}, full.density};  // no mesh builds one; a caller may
+  ASSERT_TRUE(empty.bvh.empty());
+  const Frame<Aabb> frame = {{&full, &empty, RigidTransform{}}, {&empty, &full, RigidTransform{}}};
+  const Result alone = query_adb(full, empty, RigidTransform{}, AdbOptions{});
+  FrameOptions generous, starved;
+  starved.budget.deadline_us = 1e-9;  // passed at the first look: no pair has its turn
+  for (const FrameOptions& options : {generous, starved})
+    for (const PairOutcome& o : schedule(frame, options)) {
+      EXPECT_EQ(o.collides, alone.collides);
+      EXPECT_EQ(o.exact, alone.exact);
+      EXPECT_EQ(o.budget_exhausted, alone.budget_exhausted);
+      EXPECT_EQ(o.probability, alone.probability);
+    }
+}
+
 TEST(FrameBudget, BadOptionsAreRefusedByName) {
   const auto& tree = meshes<Aabb>().trees[0];
   const Frame<Aabb> frame = {{&tree, &tree, RigidTransform{}}};
