@@ -8,23 +8,14 @@
                              frame, one point per density update and strategy on the ADB trees, with the
                              rebuilt and re-annotated tree as the reference
 """
-import argparse
-import csv
 import os
-import sys
 from collections import defaultdict
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def read_csv(path):
-    if not os.path.exists(path):
-        return []
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+from plot_common import report_main, save  # noqa: E402
 
 
 def frame_micros(r):
@@ -54,9 +45,7 @@ def figure_time_per_frame(rows, out):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     ax.set_title("Keeping a deforming object's tree: refit against rebuild")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save(fig, out, dpi=120)
 
 
 def figure_error_vs_time(rows, out):
@@ -78,20 +67,16 @@ def figure_error_vs_time(rows, out):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     ax.set_title("Error against time per density update")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save(fig, out, dpi=120)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("report_dir")
-    args = parser.parse_args()
-    rows = read_csv(os.path.join(args.report_dir, "deform_frames.csv"))
-    if not rows:
-        sys.exit("plot_deform.py: deform_frames.csv is missing or empty")
+def draw(args, rows):
     figure_time_per_frame(rows, os.path.join(args.report_dir, "deform_time_per_frame.png"))
     figure_error_vs_time(rows, os.path.join(args.report_dir, "deform_error_vs_time.png"))
+
+
+def main(argv=None):
+    report_main(__file__, __doc__, ["deform_frames.csv"], draw, argv=argv)
 
 
 if __name__ == "__main__":

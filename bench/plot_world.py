@@ -10,23 +10,14 @@
                                     lines); FCL's managers (rows of the hierarchy fcl_obbrss, timed at the
                                     scene's own count only) as single points
 """
-import argparse
-import csv
 import os
-import sys
 from collections import defaultdict
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def read_csv(path):
-    if not os.path.exists(path):
-        return []
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+from plot_common import report_main, save  # noqa: E402
 
 
 def budget_value(budget):
@@ -75,9 +66,7 @@ def figure_errors_vs_budget(rows, out):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle("Pair errors against the frame budget")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save(fig, out, dpi=120)
 
 
 FCL_HIERARCHY = "fcl_obbrss"  # world.hpp: kFclWorldHierarchy
@@ -119,22 +108,17 @@ def figure_broad_phase_vs_objects(scaling, broad, out):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title("Broad phase against the object count")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save(fig, out, dpi=120)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("report_dir")
-    args = parser.parse_args()
-    rows = read_csv(os.path.join(args.report_dir, "world_frames.csv"))
-    broad = read_csv(os.path.join(args.report_dir, "world_broad_phase.csv"))
-    if not rows or not broad:
-        sys.exit("plot_world.py: world_frames.csv or world_broad_phase.csv is missing or empty")
-    scaling = read_csv(os.path.join(args.report_dir, "world_scaling.csv"))
+def draw(args, rows, broad, scaling):
     figure_errors_vs_budget(rows, os.path.join(args.report_dir, "world_errors_vs_budget.png"))
     figure_broad_phase_vs_objects(scaling, broad, os.path.join(args.report_dir, "world_broad_phase_vs_objects.png"))
+
+
+def main(argv=None):
+    report_main(__file__, __doc__, ["world_frames.csv", "world_broad_phase.csv"], draw,
+                optional=["world_scaling.csv"], argv=argv)
 
 
 if __name__ == "__main__":
