@@ -1,5 +1,6 @@
 """What the report plot scripts (plot_report.py, plot_world.py, plot_deform.py, plot_points.py) share: reading
-a report's CSV files, the command line over REPORT_DIR with its refusal of empty input, and saving a figure.
+a report's CSV files and grouping their rows, the command line over REPORT_DIR with its refusal of empty input,
+and saving a figure.
 
 The scripts import it from their own folder (Python puts a script's folder first on sys.path), so it must stay
 beside them wherever they are run from.
@@ -8,6 +9,7 @@ import argparse
 import csv
 import os
 import sys
+from collections import defaultdict
 
 import matplotlib
 
@@ -21,6 +23,14 @@ def read_csv(path):
         return []
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
+
+
+def group_by(rows, key):
+    """{key(row): [rows with that key]}, the rows in their order."""
+    groups = defaultdict(list)
+    for r in rows:
+        groups[key(r)].append(r)
+    return groups
 
 
 def report_main(script, doc, required, draw, optional=(), add_options=None, refusal="is missing or empty",

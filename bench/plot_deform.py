@@ -9,32 +9,27 @@
                              rebuilt and re-annotated tree as the reference
 """
 import os
-from collections import defaultdict
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from plot_common import report_main, save  # noqa: E402
+from plot_common import group_by, report_main, save  # noqa: E402
 
 
 def frame_micros(r):
     return float(r["tree_micros"]) + float(r["density_micros"]) + float(r["query_total_micros"])
 
 
-def group_by(rows, key):
-    groups = defaultdict(list)
-    for r in rows:
-        groups[key(r)].append(r)
-    return groups
+def by_series(rows):
+    """[((hierarchy, update, series), its rows)], sorted: one line or point of a figure each."""
+    return sorted(group_by(rows, lambda r: (r["hierarchy"], r["update"], r["series"])).items())
 
 
 def figure_time_per_frame(rows, out):
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
     exact = [r for r in rows if r["exact_strategy"] == "1"]
-    for (hierarchy, update, series), group in sorted(
-        group_by(exact, lambda r: (r["hierarchy"], r["update"], r["series"])).items()
-    ):
+    for (hierarchy, update, series), group in by_series(exact):
         group.sort(key=lambda r: int(r["frame"]))
         style = "--" if "rebuild" in update else "-"
         ax.plot([int(r["frame"]) for r in group], [frame_micros(r) / 1000 for r in group], style, marker=".",
@@ -51,9 +46,7 @@ def figure_time_per_frame(rows, out):
 def figure_error_vs_time(rows, out):
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
     approximate = [r for r in rows if r["exact_strategy"] == "0"]
-    for (hierarchy, update, series), group in sorted(
-        group_by(approximate, lambda r: (r["hierarchy"], r["update"], r["series"])).items()
-    ):
+    for (hierarchy, update, series), group in by_series(approximate):
         queries = sum(int(r["queries"]) for r in group)
         wrong = sum(int(r["missed"]) + int(r["false_pairs"]) for r in group)
         times = sorted(frame_micros(r) for r in group)

@@ -189,19 +189,28 @@ def is_sweep(row, args):
     return row["strategy"] == args.operating_strategy and row["p_min"] and not row["budget"]
 
 
-def figure_time_vs_distance(rows, args, out):
+def exact_and_operating_panels(rows, args):
+    """Figures 1 and 5: a panel per mesh showing the exact strategies and the operating one. Returns the figure,
+    its axes and [(panel, mesh, [(series rows, (colour, line, marker), label)])]."""
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
     strategies = list(dict.fromkeys(r["strategy"] for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
+    panels = []
     for (ax,), mesh in zip(per_mesh, meshes):
         shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
                  if is_exact(s[0]) or is_operating(s[0], args)]
-        for i, series in enumerate(shown):
-            first = series[0]
-            colour, line, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
+        panels.append((ax, mesh, [(s, style_for(s[0]["hierarchy"], s[0]["strategy"], hierarchies, strategies),
+                                   f"{s[0]['hierarchy']}: {series_label(s[0])}") for s in shown]))
+    return fig, axes, panels
+
+
+def figure_time_vs_distance(rows, args, out):
+    fig, axes, panels = exact_and_operating_panels(rows, args)
+    for ax, mesh, shown in panels:
+        for i, (series, (colour, line, marker), label) in enumerate(shown):
             ax.plot([num(r["distance"]) for r in series], [num(r["mean_time_us"]) for r in series], line,
-                    marker=marker, color=colour, label=f"{first['hierarchy']}: {series_label(first)}", **layered(i))
+                    marker=marker, color=colour, label=label, **layered(i))
         log_axis(ax)
         ax.set_title(f"{mesh}: time per query")
         ax.set_xlabel(args.distance_label, fontsize=9)
@@ -451,20 +460,12 @@ def figure_calibration(calibration, rows, out):
 
 
 def figure_time_vs_size(rows, args, out):
-    meshes = meshes_of(rows)
-    hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
-    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
-    fig, per_mesh, axes = subplots(len(meshes))
-    for (ax,), mesh in zip(per_mesh, meshes):
-        shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
-                 if is_exact(s[0]) or is_operating(s[0], args)]
-        for i, series in enumerate(shown):
-            first = series[0]
+    fig, axes, panels = exact_and_operating_panels(rows, args)
+    for ax, mesh, shown in panels:
+        for i, (series, (colour, _, marker), label) in enumerate(shown):
             agg = aggregate(series, -1e300, 1e300)
             if agg is None or not math.isfinite(agg["bytes"]):
                 continue
-            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
-            label = f"{first['hierarchy']}: {series_label(first)}"
             ax.plot([agg["bytes"]], [agg["time"]], marker, color=colour, linestyle="none", label=label, **layered(i))
         log_axis(ax)
         ax.set_title(f"{mesh}: time vs model size (all distances)")

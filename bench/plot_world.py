@@ -17,7 +17,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from plot_common import report_main, save  # noqa: E402
+from plot_common import group_by, report_main, save  # noqa: E402
 
 
 def budget_value(budget):
@@ -32,21 +32,14 @@ def wrong_percent(rows):
     return 100.0 * wrong / candidates if candidates else 0.0
 
 
-def totals_by(rows, key):
-    groups = defaultdict(list)
-    for r in rows:
-        groups[key(r)].append(r)
-    return groups
-
-
 def figure_errors_vs_budget(rows, out):
     budgeted = [r for r in rows if r["schedule"]]
     kinds = sorted({budget_value(r["budget"])[0] for r in budgeted}) or ["bv_tests"]
     fig, axes = plt.subplots(1, len(kinds), figsize=(6.2 * len(kinds), 4.4), squeeze=False)
-    references = totals_by([r for r in rows if not r["schedule"]], lambda r: (r["hierarchy"], r["series"]))
+    references = group_by([r for r in rows if not r["schedule"]], lambda r: (r["hierarchy"], r["series"]))
     for ax, kind in zip(axes[0], kinds):
         lines = defaultdict(dict)
-        for (hierarchy, schedule, budget), group in totals_by(
+        for (hierarchy, schedule, budget), group in group_by(
             budgeted, lambda r: (r["hierarchy"], r["schedule"], r["budget"])
         ).items():
             k, value = budget_value(budget)
@@ -75,7 +68,7 @@ FCL_HIERARCHY = "fcl_obbrss"  # world.hpp: kFclWorldHierarchy
 def scene_medians(broad):
     """{(hierarchy, broad phase): {objects: median µs per frame of world boxes + update}} at the scene's count."""
     points = defaultdict(dict)
-    for key, group in totals_by(broad, lambda r: (r["hierarchy"], r["broad_phase"])).items():
+    for key, group in group_by(broad, lambda r: (r["hierarchy"], r["broad_phase"])).items():
         times = sorted(float(r["boxes_micros"]) + float(r["update_micros"]) for r in group)
         points[key][int(group[0]["objects"])] = times[len(times) // 2]
     return points
