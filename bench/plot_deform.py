@@ -8,42 +8,28 @@
                              frame, one point per density update and strategy on the ADB trees, with the
                              rebuilt and re-annotated tree as the reference
 """
-import argparse
-import csv
 import os
-import sys
-from collections import defaultdict
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def read_csv(path):
-    if not os.path.exists(path):
-        return []
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+from plot_common import group_by, report_main, save  # noqa: E402
 
 
 def frame_micros(r):
     return float(r["tree_micros"]) + float(r["density_micros"]) + float(r["query_total_micros"])
 
 
-def group_by(rows, key):
-    groups = defaultdict(list)
-    for r in rows:
-        groups[key(r)].append(r)
-    return groups
+def by_series(rows):
+    """[((hierarchy, update, series), its rows)], sorted: one line or point of a figure each."""
+    return sorted(group_by(rows, lambda r: (r["hierarchy"], r["update"], r["series"])).items())
 
 
 def figure_time_per_frame(rows, out):
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
     exact = [r for r in rows if r["exact_strategy"] == "1"]
-    for (hierarchy, update, series), group in sorted(
-        group_by(exact, lambda r: (r["hierarchy"], r["update"], r["series"])).items()
-    ):
+    for (hierarchy, update, series), group in by_series(exact):
         group.sort(key=lambda r: int(r["frame"]))
         style = "--" if "rebuild" in update else "-"
         ax.plot([int(r["frame"]) for r in group], [frame_micros(r) / 1000 for r in group], style, marker=".",
@@ -54,17 +40,13 @@ def figure_time_per_frame(rows, out):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     ax.set_title("Keeping a deforming object's tree: refit against rebuild")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save(fig, out, dpi=120)
 
 
 def figure_error_vs_time(rows, out):
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
     approximate = [r for r in rows if r["exact_strategy"] == "0"]
-    for (hierarchy, update, series), group in sorted(
-        group_by(approximate, lambda r: (r["hierarchy"], r["update"], r["series"])).items()
-    ):
+    for (hierarchy, update, series), group in by_series(approximate):
         queries = sum(int(r["queries"]) for r in group)
         wrong = sum(int(r["missed"]) + int(r["false_pairs"]) for r in group)
         times = sorted(frame_micros(r) for r in group)
@@ -78,20 +60,16 @@ def figure_error_vs_time(rows, out):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     ax.set_title("Error against time per density update")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save(fig, out, dpi=120)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("report_dir")
-    args = parser.parse_args()
-    rows = read_csv(os.path.join(args.report_dir, "deform_frames.csv"))
-    if not rows:
-        sys.exit("plot_deform.py: deform_frames.csv is missing or empty")
+def draw(args, rows):
     figure_time_per_frame(rows, os.path.join(args.report_dir, "deform_time_per_frame.png"))
     figure_error_vs_time(rows, os.path.join(args.report_dir, "deform_error_vs_time.png"))
+
+
+def main(argv=None):
+    report_main(__file__, __doc__, ["deform_frames.csv"], draw, argv=argv)
 
 
 if __name__ == "__main__":

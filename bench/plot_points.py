@@ -8,24 +8,15 @@
   points_fp_fn.png          FP and FN (percent of each distance's clear poses) against the protocol distance,
                             one row of two panels per pair and density, one colour per series
 """
-import argparse
-import csv
 import os
-import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import report_main, save  # noqa: E402
 
 GOAL_PERCENT = 4.0
-
-
-def read_csv(path):
-    if not os.path.exists(path):
-        return []
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def percent(part, whole):
@@ -94,9 +85,7 @@ def figure_error_vs_time(summary, out):
         ax.set_visible(False)
     flat[0].legend(fontsize=6, loc="upper right")
     fig.suptitle("Point clouds: error outside the ambiguous band against time")
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    save(fig, out, dpi=110)
 
 
 def figure_fp_fn(rows, out):
@@ -118,21 +107,16 @@ def figure_fp_fn(rows, out):
             ax.set_title(f"{pair}, {points} points: {what}", fontsize=9)
             ax.grid(True, alpha=0.3)
     axes[0][0].legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    save(fig, out, dpi=110)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("report_dir")
-    args = parser.parse_args()
-    summary = read_csv(os.path.join(args.report_dir, "points_summary.csv"))
-    rows = read_csv(os.path.join(args.report_dir, "points_rows.csv"))
-    if not summary or not rows:
-        sys.exit("plot_points.py: points_summary.csv or points_rows.csv is missing or empty")
+def draw(args, summary, rows):
     figure_error_vs_time(summary, os.path.join(args.report_dir, "points_error_vs_time.png"))
     figure_fp_fn(rows, os.path.join(args.report_dir, "points_fp_fn.png"))
+
+
+def main(argv=None):
+    report_main(__file__, __doc__, ["points_summary.csv", "points_rows.csv"], draw, argv=argv)
 
 
 if __name__ == "__main__":

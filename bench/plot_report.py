@@ -18,28 +18,21 @@ Figures (PNG, in REPORT_DIR):
   fig3_error_vs_time.png      error against mean time over p_min (the Pareto curve)
   fig4_calibration.png        reported probability against observed collision frequency, a panel per series
   fig5_time_vs_size.png       mean time per query against model size
-`bvhlab report` runs this; it needs only matplotlib and the standard library.
+`bvhlab report` runs this; it needs only matplotlib, the standard library and plot_common.py beside it.
 """
-import argparse
-import csv
 import math
 import os
-import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import report_main  # noqa: E402
 
 DEFAULT_DISTANCE_LABEL = "distance d of B's centre"
 TIME_LABEL = "mean time per query (µs)"
 CALIBRATION_MIN_ANSWERS = 50  # deciles with fewer answers are drawn but not judged, as in the README
 CALIBRATION_TOLERANCE = 0.05  # the target gap between reported and observed
-
-
-def read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def num(value):
@@ -196,19 +189,28 @@ def is_sweep(row, args):
     return row["strategy"] == args.operating_strategy and row["p_min"] and not row["budget"]
 
 
-def figure_time_vs_distance(rows, args, out):
+def exact_and_operating_panels(rows, args):
+    """Figures 1 and 5: a panel per mesh showing the exact strategies and the operating one. Returns the figure,
+    its axes and [(panel, mesh, [(series rows, (colour, line, marker), label)])]."""
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
     strategies = list(dict.fromkeys(r["strategy"] for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
+    panels = []
     for (ax,), mesh in zip(per_mesh, meshes):
         shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
                  if is_exact(s[0]) or is_operating(s[0], args)]
-        for i, series in enumerate(shown):
-            first = series[0]
-            colour, line, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
+        panels.append((ax, mesh, [(s, style_for(s[0]["hierarchy"], s[0]["strategy"], hierarchies, strategies),
+                                   f"{s[0]['hierarchy']}: {series_label(s[0])}") for s in shown]))
+    return fig, axes, panels
+
+
+def figure_time_vs_distance(rows, args, out):
+    fig, axes, panels = exact_and_operating_panels(rows, args)
+    for ax, mesh, shown in panels:
+        for i, (series, (colour, line, marker), label) in enumerate(shown):
             ax.plot([num(r["distance"]) for r in series], [num(r["mean_time_us"]) for r in series], line,
-                    marker=marker, color=colour, label=f"{first['hierarchy']}: {series_label(first)}", **layered(i))
+                    marker=marker, color=colour, label=label, **layered(i))
         log_axis(ax)
         ax.set_title(f"{mesh}: time per query")
         ax.set_xlabel(args.distance_label, fontsize=9)
@@ -458,20 +460,12 @@ def figure_calibration(calibration, rows, out):
 
 
 def figure_time_vs_size(rows, args, out):
-    meshes = meshes_of(rows)
-    hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
-    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
-    fig, per_mesh, axes = subplots(len(meshes))
-    for (ax,), mesh in zip(per_mesh, meshes):
-        shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
-                 if is_exact(s[0]) or is_operating(s[0], args)]
-        for i, series in enumerate(shown):
-            first = series[0]
+    fig, axes, panels = exact_and_operating_panels(rows, args)
+    for ax, mesh, shown in panels:
+        for i, (series, (colour, _, marker), label) in enumerate(shown):
             agg = aggregate(series, -1e300, 1e300)
             if agg is None or not math.isfinite(agg["bytes"]):
                 continue
-            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
-            label = f"{first['hierarchy']}: {series_label(first)}"
             ax.plot([agg["bytes"]], [agg["time"]], marker, color=colour, linestyle="none", label=label, **layered(i))
         log_axis(ax)
         ax.set_title(f"{mesh}: time vs model size (all distances)")
@@ -484,9 +478,7 @@ def figure_time_vs_size(rows, args, out):
     plt.close(fig)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("report_dir")
+def add_options(parser):
     parser.add_argument("--quality-min", type=float, default=1.2)
     parser.add_argument("--quality-max", type=float, default=2.0)
     parser.add_argument("--quality-text", default="the quality distances")
@@ -494,19 +486,19 @@ def main():
     parser.add_argument("--operating-strategy", default="")
     parser.add_argument("--operating-hierarchy", default="")
     parser.add_argument("--operating-p-min", type=float, default=-1)
-    args = parser.parse_args()
 
-    rows = read_csv(os.path.join(args.report_dir, "results.csv"))
-    if not rows:
-        sys.exit("plot_report.py: results.csv has no rows")
-    calibration_path = os.path.join(args.report_dir, "calibration.csv")
-    calibration = read_csv(calibration_path) if os.path.exists(calibration_path) else []
 
+def draw(args, rows, calibration):
     figure_time_vs_distance(rows, args, os.path.join(args.report_dir, "fig1_time_vs_distance.png"))
     figure_errors_vs_distance(rows, args, os.path.join(args.report_dir, "fig2_errors_vs_distance.png"))
     figure_error_vs_time(rows, args, os.path.join(args.report_dir, "fig3_error_vs_time.png"))
     figure_calibration(calibration, rows, os.path.join(args.report_dir, "fig4_calibration.png"))
     figure_time_vs_size(rows, args, os.path.join(args.report_dir, "fig5_time_vs_size.png"))
+
+
+def main(argv=None):
+    report_main(__file__, __doc__, ["results.csv"], draw, optional=["calibration.csv"], add_options=add_options,
+                refusal="has no rows", argv=argv)
 
 
 if __name__ == "__main__":

@@ -10,23 +10,14 @@
                                     lines); FCL's managers (rows of the hierarchy fcl_obbrss, timed at the
                                     scene's own count only) as single points
 """
-import argparse
-import csv
 import os
-import sys
 from collections import defaultdict
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def read_csv(path):
-    if not os.path.exists(path):
-        return []
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+from plot_common import group_by, report_main, save  # noqa: E402
 
 
 def budget_value(budget):
@@ -41,21 +32,14 @@ def wrong_percent(rows):
     return 100.0 * wrong / candidates if candidates else 0.0
 
 
-def totals_by(rows, key):
-    groups = defaultdict(list)
-    for r in rows:
-        groups[key(r)].append(r)
-    return groups
-
-
 def figure_errors_vs_budget(rows, out):
     budgeted = [r for r in rows if r["schedule"]]
     kinds = sorted({budget_value(r["budget"])[0] for r in budgeted}) or ["bv_tests"]
     fig, axes = plt.subplots(1, len(kinds), figsize=(6.2 * len(kinds), 4.4), squeeze=False)
-    references = totals_by([r for r in rows if not r["schedule"]], lambda r: (r["hierarchy"], r["series"]))
+    references = group_by([r for r in rows if not r["schedule"]], lambda r: (r["hierarchy"], r["series"]))
     for ax, kind in zip(axes[0], kinds):
         lines = defaultdict(dict)
-        for (hierarchy, schedule, budget), group in totals_by(
+        for (hierarchy, schedule, budget), group in group_by(
             budgeted, lambda r: (r["hierarchy"], r["schedule"], r["budget"])
         ).items():
             k, value = budget_value(budget)
@@ -75,9 +59,7 @@ def figure_errors_vs_budget(rows, out):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle("Pair errors against the frame budget")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save(fig, out, dpi=120)
 
 
 FCL_HIERARCHY = "fcl_obbrss"  # world.hpp: kFclWorldHierarchy
@@ -86,7 +68,7 @@ FCL_HIERARCHY = "fcl_obbrss"  # world.hpp: kFclWorldHierarchy
 def scene_medians(broad):
     """{(hierarchy, broad phase): {objects: median µs per frame of world boxes + update}} at the scene's count."""
     points = defaultdict(dict)
-    for key, group in totals_by(broad, lambda r: (r["hierarchy"], r["broad_phase"])).items():
+    for key, group in group_by(broad, lambda r: (r["hierarchy"], r["broad_phase"])).items():
         times = sorted(float(r["boxes_micros"]) + float(r["update_micros"]) for r in group)
         points[key][int(group[0]["objects"])] = times[len(times) // 2]
     return points
@@ -119,22 +101,17 @@ def figure_broad_phase_vs_objects(scaling, broad, out):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title("Broad phase against the object count")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save(fig, out, dpi=120)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("report_dir")
-    args = parser.parse_args()
-    rows = read_csv(os.path.join(args.report_dir, "world_frames.csv"))
-    broad = read_csv(os.path.join(args.report_dir, "world_broad_phase.csv"))
-    if not rows or not broad:
-        sys.exit("plot_world.py: world_frames.csv or world_broad_phase.csv is missing or empty")
-    scaling = read_csv(os.path.join(args.report_dir, "world_scaling.csv"))
+def draw(args, rows, broad, scaling):
     figure_errors_vs_budget(rows, os.path.join(args.report_dir, "world_errors_vs_budget.png"))
     figure_broad_phase_vs_objects(scaling, broad, os.path.join(args.report_dir, "world_broad_phase_vs_objects.png"))
+
+
+def main(argv=None):
+    report_main(__file__, __doc__, ["world_frames.csv", "world_broad_phase.csv"], draw,
+                optional=["world_scaling.csv"], argv=argv)
 
 
 if __name__ == "__main__":

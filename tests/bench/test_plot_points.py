@@ -3,14 +3,11 @@ against the distance, computed from the rows.
 
 Run by ctest with BVHLAB_SOURCE_DIR set; plain unittest, so it needs nothing beyond matplotlib.
 """
-import os
-import sys
-import tempfile
 import unittest
 
-sys.path.insert(0, os.path.join(os.environ.get("BVHLAB_SOURCE_DIR", "."), "bench"))
+from plot_script_checks import ReportScriptChecks  # first: it puts bench/ on sys.path
 
-import plot_points  # noqa: E402
+import plot_points
 
 
 def row(points, series, distance, clear, fp, fn, mean_us):
@@ -20,7 +17,19 @@ def row(points, series, distance, clear, fp, fn, mean_us):
             "mean_us": str(mean_us)}
 
 
-class PointsFigures(unittest.TestCase):
+def tables():
+    series = ("exact_points", "adb p_min=0.9", "adb p_min=0.99", "fcl_octree res=1")
+    rows = [row(p, s, d, 8, k % 2, 0, 10.0 * (k + 1)) for p in (500, 2000) for d in (0.4, 1.2)
+            for k, s in enumerate(series)]
+    summary = [dict(r, distance="") for r in rows if r["distance"] == "0.4"]
+    return {"points_summary.csv": summary, "points_rows.csv": rows}
+
+
+class PointsFigures(ReportScriptChecks, unittest.TestCase):
+    script = plot_points
+    required = ["points_summary.csv", "points_rows.csv"]
+    figures = ["points_error_vs_time.png", "points_fp_fn.png"]
+
     def test_error_is_fp_plus_fn_of_the_clear_poses_only(self):
         self.assertAlmostEqual(plot_points.error_percent(row(100, "adb p_min=0.9", 1.0, 8, 1, 1, 3.0)), 25.0)
         self.assertEqual(plot_points.error_percent(row(100, "adb p_min=0.9", 1.0, 0, 0, 0, 3.0)), 0.0)
@@ -35,15 +44,10 @@ class PointsFigures(unittest.TestCase):
         self.assertEqual(len(set(colours.values())), len(names))
 
     def test_both_figures_are_drawn(self):
-        series = ("exact_points", "adb p_min=0.9", "adb p_min=0.99", "fcl_octree res=1")
-        rows = [row(p, s, d, 8, k % 2, 0, 10.0 * (k + 1)) for p in (500, 2000) for d in (0.4, 1.2)
-                for k, s in enumerate(series)]
-        summary = [dict(r, distance="") for r in rows if r["distance"] == "0.4"]
-        with tempfile.TemporaryDirectory() as d:
-            plot_points.figure_error_vs_time(summary, os.path.join(d, "a.png"))
-            plot_points.figure_fp_fn(rows, os.path.join(d, "b.png"))
-            self.assertGreater(os.path.getsize(os.path.join(d, "a.png")), 1000)
-            self.assertGreater(os.path.getsize(os.path.join(d, "b.png")), 1000)
+        self.assertDrawsItsFigures(tables())
+
+    def test_refuses_without_the_summary_or_the_rows(self):
+        self.assertRefusesWithoutEachRequiredTable(tables())
 
 
 if __name__ == "__main__":

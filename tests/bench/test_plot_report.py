@@ -4,15 +4,13 @@ labels apart, numbers on short log axes, series side by side rather than on top 
 Run by ctest with BVHLAB_SOURCE_DIR set; plain unittest, so it needs nothing beyond matplotlib.
 """
 import math
-import os
-import sys
 import unittest
 
-sys.path.insert(0, os.path.join(os.environ.get("BVHLAB_SOURCE_DIR", "."), "bench"))
+from plot_script_checks import ReportScriptChecks  # first: it puts bench/ on sys.path
 
-import plot_report  # noqa: E402
-from matplotlib import pyplot as plt  # noqa: E402
-from matplotlib.colors import to_rgba  # noqa: E402
+import plot_report
+from matplotlib import pyplot as plt
+from matplotlib.colors import to_rgba
 
 
 def calibration_bin(low, count=60, p_min="0.9", mesh="m", reported=None, observed=None):
@@ -136,6 +134,16 @@ class CalibratedSeries(unittest.TestCase):
         self.assertEqual(colours[0], colours[1])
         self.assertIn("calibrated", axes[("m", ("aabb", "adb p_min=0.9 calibrated"))].get_title())
         plt.close(fig)
+
+
+class Script(ReportScriptChecks, unittest.TestCase):
+    """The command line; `bvhlab report`'s tests (test_bench_run) draw the five figures from a real run."""
+
+    script = plot_report
+    required = ["results.csv"]
+
+    def test_refuses_without_results(self):
+        self.assertRefusesWithoutEachRequiredTable({"results.csv": [result_row("0.9")]})
 
 
 class Dodge(unittest.TestCase):

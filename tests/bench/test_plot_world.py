@@ -3,14 +3,13 @@ missed plus false over candidates, and the broad-phase time against the object c
 
 Run by ctest with BVHLAB_SOURCE_DIR set; plain unittest, so it needs nothing beyond matplotlib.
 """
-import os
-import sys
 import tempfile
 import unittest
+from unittest import mock
 
-sys.path.insert(0, os.path.join(os.environ.get("BVHLAB_SOURCE_DIR", "."), "bench"))
+from plot_script_checks import ReportScriptChecks, write_tables  # first: it puts bench/ on sys.path
 
-import plot_world  # noqa: E402
+import plot_world
 
 
 def frame_row(schedule, budget, candidates, missed, false_pairs, series=None):
@@ -19,7 +18,24 @@ def frame_row(schedule, budget, candidates, missed, false_pairs, series=None):
             "false_pairs": str(false_pairs)}
 
 
-class WorldFigures(unittest.TestCase):
+def broad_row(objects, micros, hierarchy="aabb"):
+    return {"frame": "0", "hierarchy": hierarchy, "broad_phase": "sweep_and_prune", "objects": str(objects),
+            "boxes_micros": "1", "update_micros": str(micros)}
+
+
+def tables():
+    rows = [frame_row("adb_probability", "bv_tests=100", 10, 0, 1), frame_row("adb_probability", "bv_tests=1000", 10, 0, 0),
+            frame_row("", "", 10, 0, 0, series="exact")]
+    scaling = [broad_row(n, n) for n in (100, 1000)]
+    broad = [broad_row(100, 90), broad_row(100, 110), broad_row(100, 300, hierarchy="fcl_obbrss")]
+    return {"world_frames.csv": rows, "world_broad_phase.csv": broad, "world_scaling.csv": scaling}
+
+
+class WorldFigures(ReportScriptChecks, unittest.TestCase):
+    script = plot_world
+    required = ["world_frames.csv", "world_broad_phase.csv"]
+    figures = ["world_errors_vs_budget.png", "world_broad_phase_vs_objects.png"]
+
     def test_wrong_pairs_count_missed_and_false_over_all_frames(self):
         rows = [frame_row("equal_split", "bv_tests=100", 10, 1, 1), frame_row("equal_split", "bv_tests=100", 30, 0, 2)]
         self.assertAlmostEqual(plot_world.wrong_percent(rows), 100.0 * 4 / 40)
@@ -29,15 +45,23 @@ class WorldFigures(unittest.TestCase):
         self.assertEqual(plot_world.budget_value("deadline_us=50;bv_tests=3"), ("deadline_us", 50.0))
 
     def test_both_figures_are_drawn(self):
-        rows = [frame_row("adb_probability", "bv_tests=100", 10, 0, 1), frame_row("adb_probability", "bv_tests=1000", 10, 0, 0),
-                frame_row("", "", 10, 0, 0, series="exact")]
-        scaling = [{"hierarchy": "aabb", "broad_phase": "sweep_and_prune", "objects": n, "boxes_micros": "1",
-                    "update_micros": str(n)} for n in ("100", "1000")]
-        with tempfile.TemporaryDirectory() as d:
-            plot_world.figure_errors_vs_budget(rows, os.path.join(d, "a.png"))
-            plot_world.figure_broad_phase_vs_objects(scaling, [], os.path.join(d, "b.png"))
-            self.assertGreater(os.path.getsize(os.path.join(d, "a.png")), 1000)
-            self.assertGreater(os.path.getsize(os.path.join(d, "b.png")), 1000)
+        self.assertDrawsItsFigures(tables())
+
+    def test_both_figures_are_drawn_without_a_scaling_run(self):
+        self.assertDrawsItsFigures({k: v for k, v in tables().items() if k != "world_scaling.csv"})
+
+    def test_refuses_without_the_frames_or_the_broad_phase(self):
+        self.assertRefusesWithoutEachRequiredTable(tables())
+
+    def test_the_scaling_run_and_the_scenes_broad_phase_reach_the_figure_in_their_roles(self):
+        given = tables()
+        with tempfile.TemporaryDirectory() as d, mock.patch.object(plot_world, "figure_errors_vs_budget"), \
+                mock.patch.object(plot_world, "figure_broad_phase_vs_objects") as figure:
+            write_tables(d, given)
+            plot_world.main([d])
+        scaling, broad, _ = figure.call_args.args
+        self.assertEqual(scaling, given["world_scaling.csv"])
+        self.assertEqual(broad, given["world_broad_phase.csv"])
 
 
 if __name__ == "__main__":
