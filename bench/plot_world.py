@@ -48,10 +48,14 @@ def figure_errors_vs_budget(rows, out):
         for (hierarchy, schedule), points in sorted(lines.items()):
             xs = sorted(points)
             ax.plot(xs, [points[x] for x in xs], marker="o", label=f"{schedule} ({hierarchy})")
+        # References at one level (the exact series, all at 0) share a line and one label, not overprinted ones.
+        levels = defaultdict(list)
         for (hierarchy, series), group in sorted(references.items()):
-            ax.axhline(wrong_percent(group), linestyle=":", linewidth=1, color="grey")
-            ax.annotate(f"{series} ({hierarchy})", (0.01, wrong_percent(group)), xycoords=("axes fraction", "data"),
-                        fontsize=7, color="grey", va="bottom")
+            levels[round(wrong_percent(group), 2)].append(f"{series} ({hierarchy})")
+        for level, labels in sorted(levels.items()):
+            ax.axhline(level, linestyle=":", linewidth=1, color="grey")
+            ax.annotate(", ".join(labels), (0.01, level), xycoords=("axes fraction", "data"), fontsize=7,
+                        color="grey", va="bottom")
         ax.set_xscale("log")
         ax.set_xlabel("frame budget, " + ("BV tests" if kind == "bv_tests" else "microseconds"))
         ax.set_ylabel("wrong pairs, % of candidate pairs (missed + false)")
