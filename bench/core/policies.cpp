@@ -116,8 +116,9 @@ std::string density_label(std::string_view density, const ParamValues& values) {
 std::string strategy_label(std::string_view strategy, const ParamValues& values, const Budget& budget) {
   ParamValues shown = values;
   for (const ParamSpec& p : strategy_info(strategy).parameters)
-    if (!p.label_default && shown.contains(p.name) && shown.find(p.name)->second == p.default_value)
-      shown.erase(shown.find(p.name));
+    if (const auto it = shown.find(p.name);
+        !p.label_default && it != shown.end() && it->second == p.default_value)
+      shown.erase(it);
   const std::string params = describe_parameters(strategy_info(strategy).parameters, shown,
                                                  [](const ParamSpec& p) { return p.in_label; });
   const std::string budget_text = budget_label(budget);
