@@ -74,7 +74,7 @@ FrameSet make_frames(const std::shared_ptr<const std::vector<AdbTree>>& trees, i
     while (static_cast<int>(frame.size()) < n) {
       const bool colliding = frame.size() % 3 == 0;
       FramePair<Aabb, AdbDensity> pair{&(*trees)[mesh(rng)], &(*trees)[mesh(rng)],
-                                       pose_at(rng, distance(rng))};
+                                       pose_at(rng, distance(rng)), std::nullopt};
       const Result exact = query_exact(pair.a->bvh, pair.b->bvh, pair.b_to_a);
       if (exact.collides != colliding || exact.counters.bv_tests < 3) continue;
       set.exact_cost += exact.counters.bv_tests;

@@ -71,6 +71,8 @@ class WorldHierarchy {
   }
 
   [[nodiscard]] const PlannedHierarchy& planned() const { return planned_; }
+  /// The frame schedules' memories of the previous frame, by series (run_frame_budgets).
+  std::map<std::string, FrameMemory>& memories() { return memories_; }
 
   /// The prepared trees of two objects (by name), made on first use.
   const PreparedHierarchy& trees(const std::string& a, const std::string& b) {
@@ -153,6 +155,7 @@ class WorldHierarchy {
   std::vector<std::unique_ptr<AnyBroadPhase>> broad_phases_;
   std::vector<const PreparedHierarchy*> instance_trees_;
   std::map<std::pair<std::string, std::string>, std::unique_ptr<PreparedHierarchy>> pairs_;
+  std::map<std::string, FrameMemory> memories_;
 };
 
 /// Counts one series' answers against the truth.
@@ -188,9 +191,10 @@ WorldSeriesRow run_variant(const StrategyVariant& variant, const std::vector<Can
   return row;
 }
 
-/// One frame budget on every candidate pair at once, through the trees' own type (schedule_frame).
+/// One frame budget on every candidate pair at once, through the trees' own type (schedule_frame), with
+/// the schedule's memory of the previous frame when it keeps one (each pair named by its two instances).
 std::vector<PairOutcome> schedule(const PlannedHierarchy& planned, const std::vector<Candidate>& candidates,
-                                  const FrameOptions& options, double& micros) {
+                                  const FrameOptions& options, FrameMemory* memory, double& micros) {
   std::vector<PairOutcome> out;
   with_volume(planned.hierarchy->bv, [&]<class BV>(std::type_identity<BV>) {
     with_density(planned.density.name, [&]<class D>(std::type_identity<D>) {
@@ -199,10 +203,11 @@ std::vector<PairOutcome> schedule(const PlannedHierarchy& planned, const std::ve
         for (const Candidate& c : candidates) {
           if (c.trees->tree_type() != typeid(Tree<BV, D>)) throw std::logic_error("frame budget: tree type");
           pairs.push_back({static_cast<const Tree<BV, D>*>(c.trees->tree_a()),
-                           static_cast<const Tree<BV, D>*>(c.trees->tree_b()), c.b_to_a});
+                           static_cast<const Tree<BV, D>*>(c.trees->tree_b()), c.b_to_a,
+                           std::uint64_t{c.instances.a} << 32 | c.instances.b});
         }
         const auto start = Clock::now();
-        out = schedule_frame<BV, D>(pairs, options);
+        out = schedule_frame<BV, D>(pairs, options, memory);
         micros = micros_since(start);
       } else {
         throw std::invalid_argument("frame budgets need a probability density; hierarchy " +
@@ -214,9 +219,12 @@ std::vector<PairOutcome> schedule(const PlannedHierarchy& planned, const std::ve
 }
 
 /// Each schedule runs once untimed first when `warmup` > 0, as each per-pair query does (run_variant): the
-/// series of a frame then find the trees equally warm, whichever runs first.
+/// series of a frame then find the trees equally warm, whichever runs first. A schedule with memory keeps
+/// one FrameMemory over the frames in `memories` (by series); its warm-up runs on a copy, so the timed run
+/// recalls the previous frame, not the warm-up's answers for this one.
 std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedHierarchy& planned,
-                                              const std::vector<Candidate>& candidates, int warmup) {
+                                              const std::vector<Candidate>& candidates, int warmup,
+                                              std::map<std::string, FrameMemory>& memories) {
   std::vector<WorldSeriesRow> rows;
   for (const FrameBudgetSpec& spec : scene.world->frame_budgets) {
     if (!spec.applies_to(*planned.hierarchy)) continue;
@@ -231,10 +239,16 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
         // A confirming schedule is a line of its own in the figures, beside the same policy without it.
         row.schedule = policy;
         if (spec.confirm_levels > 0) row.schedule += " confirm_levels=" + std::to_string(spec.confirm_levels);
+        if (spec.memory) row.schedule += " memory";
         row.budget = budget_label(budget);
         row.series = "frame " + row.schedule + " " + row.budget + " p_min=" + parameter_text(spec.p_min);
-        if (warmup > 0) schedule(planned, candidates, options, row.micros);
-        const std::vector<PairOutcome> outcomes = schedule(planned, candidates, options, row.micros);
+        FrameMemory* memory = spec.memory ? &memories[row.series] : nullptr;
+        if (warmup > 0) {
+          std::optional<FrameMemory> scratch;
+          if (memory) scratch = *memory;
+          schedule(planned, candidates, options, scratch ? &*scratch : nullptr, row.micros);
+        }
+        const std::vector<PairOutcome> outcomes = schedule(planned, candidates, options, memory, row.micros);
         std::vector<char> answers(candidates.size()), flagged(candidates.size());
         for (std::size_t k = 0; k < outcomes.size(); ++k) {
           answers[k] = outcomes[k].collides;
@@ -423,7 +437,8 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
       std::vector<WorldSeriesRow> rows;
       for (const StrategyVariant& variant : h->planned().variants)
         rows.push_back(run_variant(variant, candidates, options.warmup_queries));
-      for (WorldSeriesRow& row : run_frame_budgets(scene, h->planned(), candidates, options.warmup_queries))
+      for (WorldSeriesRow& row :
+           run_frame_budgets(scene, h->planned(), candidates, options.warmup_queries, h->memories()))
         rows.push_back(row);
       for (WorldSeriesRow& row : rows) {
         row.frame = frame;

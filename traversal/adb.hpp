@@ -36,9 +36,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 namespace bvhlab {
 
@@ -155,13 +157,13 @@ class AdbHooks {
     if (probability < 0) return Admission::Drop;  // volumes apart: provably no contact below
     if (!options_.exact_leaves) {
       if (probability > options_.p_min) {
-        if (trees_.is_leaf_pair(p)) return decide(probability);
+        if (trees_.is_leaf_pair(p)) return decide(probability, p);
         if (options_.confirm_levels > 0) {
           // A candidate's child carries its count down; any other pair starts a chain.
           p.tag = parent_levels_ > 0 ? parent_levels_ - 1 : options_.confirm_levels;
-          if (p.tag == 0) return decide(probability);
+          if (p.tag == 0) return decide(probability, p);
         } else {
-          if (!options_.confirm_with_children) return decide(probability);
+          if (!options_.confirm_with_children) return decide(probability, p);
           p.tag = 1;
         }
       } else if (probability <= 0) {
@@ -228,6 +230,12 @@ class AdbHooks {
     result_.probability = options_.exact_leaves ? 0 : best_dropped_;
   }
 
+  /// The node pair whose own estimate decided "collision" (A's node, B's node); none when no single pair
+  /// did (undecided, or decided by combined leaf or children evidence). What a frame remembers.
+  [[nodiscard]] std::optional<std::pair<std::uint32_t, std::uint32_t>> decided_at() const {
+    return decided_at_;
+  }
+
  private:
   [[gnu::always_inline]] PairGeometry geometry(const Pair& p) const {
     if constexpr (kNodeFrames)
@@ -237,6 +245,10 @@ class AdbHooks {
       return tree_frame_geometry(trees_.box_a(p), trees_.box_b(p), trees_.b_to_a, abs_rotation_);
   }
 
+  Admission decide(double probability, const Pair& p) {
+    decided_at_.emplace(p.a, p.b);
+    return decide(probability);
+  }
   Admission decide(double probability) {
     result_.collides = true;
     result_.exact = false;
@@ -253,6 +265,7 @@ class AdbHooks {
   double best_dropped_ = 0;
   double no_contact_in_leaves_ = 1;  // prod(1 - p) over leaf pairs left below p_min
   std::uint8_t parent_levels_ = 0;   // the tag of the pair whose children are being admitted
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> decided_at_;
 };
 
 /// ADB query on two trees annotated with a ProbabilityDensity (adb/concept.hpp). `b_to_a` maps B's frame

@@ -1,6 +1,7 @@
 // The frame scheduler's options and its registry of policies (traversal/frame_budget.hpp).
 #include "frame_budget.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -51,6 +52,30 @@ const FramePolicy kPolicies[] = {
 };
 
 }  // namespace
+
+const FrameMemory::Entry* FrameMemory::recall(std::uint64_t identity, const void* tree_a,
+                                              const void* tree_b) const {
+  const auto it = std::lower_bound(previous_.begin(), previous_.end(), identity,
+                                   [](const Entry& e, std::uint64_t id) { return e.identity < id; });
+  if (it == previous_.end() || it->identity != identity || it->tree_a != tree_a || it->tree_b != tree_b)
+    return nullptr;
+  return &*it;
+}
+
+void FrameMemory::end_frame() {
+  std::sort(next_.begin(), next_.end(),
+            [](const Entry& x, const Entry& y) { return x.identity < y.identity; });
+  const auto twice = std::adjacent_find(
+      next_.begin(), next_.end(), [](const Entry& x, const Entry& y) { return x.identity == y.identity; });
+  if (twice != next_.end()) {
+    const std::uint64_t identity = twice->identity;
+    next_.clear();  // the memory stays as the previous frame left it
+    throw std::invalid_argument("frame memory: two pairs of one frame have identity " +
+                                std::to_string(identity));
+  }
+  previous_.swap(next_);
+  next_.clear();
+}
 
 std::span<const FramePolicy> frame_policies() {
   return kPolicies;

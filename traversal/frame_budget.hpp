@@ -5,6 +5,7 @@
 // (traversal/driver.hpp, "Resumable"); the scheduler decides which pair takes the next step.
 //
 //   std::vector<PairOutcome> out = schedule_frame<BV, D>(pairs, options);   // one outcome per pair, in order
+//   schedule_frame<BV, D>(pairs, options, &memory);   // with frame-to-frame fronts (FrameMemory)
 //
 // The schedule, in order:
 //   1. Options and pairs are checked (FrameOptions::validate; a null tree, a bad pose, or guided exact on
@@ -13,7 +14,8 @@
 //   2. Roots: every pair's root BV pair is tested, in the order given, before any pair is expanded further.
 //      This is the guard against starvation: however the policy ranks them, every pair has its root test and
 //      an estimate (a pair whose root boxes are apart is decided "no contact" exactly by it), unless the
-//      budget ends during this round; the pairs it did not reach answer as in 4.
+//      budget ends during this round; the pairs it did not reach answer as in 4. With a FrameMemory, a pair
+//      its root leaves open then tests the node pair the previous frame decided on (FrameMemory).
 //   3. Steps: while the budget lasts and some pair is undecided, the policy picks the pair whose next step
 //      ranks highest (ties: the pair given first), and that pair takes one step: its most probable queued BV
 //      pair is taken off its queue and expanded (up to four BV tests), or tested as a leaf pair. Then:
@@ -27,7 +29,7 @@
 //      undecided pair answers from its best remaining estimate, as ADB's best effort does: the highest
 //      estimate still queued (or its leaf pairs' combined evidence); "collision" iff that is at least
 //      adb.best_effort_threshold (default 0.5), flagged budget_exhausted, never exact. A pair that had no
-//      test at all answers probability 0, "no", flagged.
+//      test at all answers probability 0, "no", flagged (with a FrameMemory: the estimate it remembers).
 //
 // The budget: max_bv_tests counts every BV test of every pair and is never exceeded in total. The deadline
 // is checked before each step, reading the clock with BudgetLimit's adaptive stride (every 1 to 4 steps,
@@ -78,6 +80,44 @@ struct FramePair {
   const Tree<BV, D>* a = nullptr;
   const Tree<BV, D>* b = nullptr;
   RigidTransform b_to_a;
+  /// Names the pair across frames (e.g. its two instances), for a FrameMemory; unique within a frame. A
+  /// pair without one is neither recalled nor remembered.
+  std::optional<std::uint64_t> identity;
+};
+
+/// Frame-to-frame fronts (optional; schedule_frame's `memory`): what one frame leaves to the next. For each
+/// pair a frame decided "collision" on one node pair's own estimate, that node pair and the estimate. In the
+/// next frame, when the pair is a candidate again on the same trees and its root test leaves it open, that
+/// node pair is tested next and decides "collision" at once if its estimate still exceeds p_min: one BV test
+/// where the descent from the root took many, since contacts persist over the frames of a continuous
+/// motion. Otherwise the pair goes on from its root, one test later. A pair the budget leaves without a
+/// root test answers the remembered estimate as its best effort (flagged), not 0. Such a decision applies
+/// ADB's rule to one node pair without its ancestors: where a child's volume is not inside its parent's
+/// (OBBs), the descent from the root might have proved the pair apart first; the errors are measured as
+/// any schedule's. Identities must be unique within a frame: two remembered pairs with one identity are
+/// refused. Keep one object per motion and schedule; a copy keeps a state to return to (a warm-up run).
+class FrameMemory {
+ public:
+  struct Entry {
+    std::uint64_t identity = 0;
+    const void* tree_a = nullptr;  ///< the trees the node indices refer to
+    const void* tree_b = nullptr;
+    std::uint32_t node_a = 0, node_b = 0;
+    double probability = 0;  ///< the estimate that decided
+  };
+  /// The previous frame's entry for a pair, when it was decided on the same trees; null otherwise.
+  [[nodiscard]] const Entry* recall(std::uint64_t identity, const void* tree_a, const void* tree_b) const;
+  /// Keeps an entry for the next frame.
+  void remember(const Entry& entry) { next_.push_back(entry); }
+  /// Ends a frame: what it remembered becomes what the next recalls. std::invalid_argument when two entries
+  /// share an identity (the memory then stays as it was).
+  void end_frame();
+  /// Entries the next frame may recall.
+  [[nodiscard]] std::size_t size() const { return previous_.size(); }
+
+ private:
+  std::vector<Entry> previous_;  ///< sorted by identity
+  std::vector<Entry> next_;
 };
 
 struct FrameOptions {
@@ -183,15 +223,26 @@ class PairRun {
         trees_(pair.a->bvh, pair.b->bvh, pair.b_to_a, context_, result_.counters),
         estimate_{density_estimator(*pair.a, *pair.b, pair.b_to_a)},
         hooks_(trees_, result_, options, estimate_),
+        p_min_(options.p_min),
         state_(pair.a->bvh.empty() || pair.b->bvh.empty() ? TraversalState::Done : TraversalState::Stopped) {}
   PairRun(const PairRun&) = delete;
   PairRun& operator=(const PairRun&) = delete;
 
-  /// The root test, with at most `allowance` BV tests.
-  TraversalState begin(std::uint64_t allowance) {
+  /// The root test, with at most `allowance` BV tests; then, when the root leaves the pair open and the
+  /// allowance a test, the node pair the previous frame decided on (FrameMemory). After the root: a root
+  /// that decides or disproves the pair (most pairs) costs no recall.
+  TraversalState begin(std::uint64_t allowance, const FrameMemory::Entry* remembered = nullptr) {
     if (state_ == TraversalState::Done) return state_;  // an empty tree: no contact (query_adb's answer)
     TestCap cap = cap_after(allowance);
-    return state_ = steps(cap).begin();
+    state_ = steps(cap).begin();
+    if (state_ == TraversalState::Running && remembered && cap.allows_test(result_.counters) &&
+        decides_again(remembered->node_a, remembered->node_b))
+      state_ = TraversalState::Done;
+    return state_;
+  }
+  /// The node pair the traversal decided "collision" on, by its own estimate (AdbHooks::decided_at).
+  [[nodiscard]] std::optional<std::pair<std::uint32_t, std::uint32_t>> decided_at() const {
+    return hooks_.decided_at();
   }
   /// One step, with at most `allowance` BV tests. Only while running (or stopped, to resume).
   TraversalState step(std::uint64_t allowance) {
@@ -228,6 +279,19 @@ class PairRun {
   }
   Steps steps(TestCap& cap) { return Steps(trees_, hooks_, cap, queue_, staged_); }
 
+  /// Node pair (i, j) decides "collision" on its own estimate (one BV test): what the traversal would
+  /// decide on reaching it. Volumes whose walkers carry state down from the root cannot start below it.
+  bool decides_again(std::uint32_t i, std::uint32_t j) {
+    if constexpr (!std::is_empty_v<typename VolumeWalker<BV>::Working>) {
+      return false;
+    } else {
+      if (i >= trees_.a.nodes().size() || j >= trees_.b.nodes().size()) return false;
+      typename Hooks::Pair pair{{}, i, j, {}, {}, {}};
+      const double probability = hooks_.evaluate(pair);
+      return probability > p_min_ && hooks_.admit(pair, probability) == Admission::Decide;
+    }
+  }
+
   typename VolumeWalker<BV>::Context context_;
   Result result_;
   TreePair<BV> trees_;
@@ -235,6 +299,7 @@ class PairRun {
   Hooks hooks_;
   typename Steps::Queue queue_;
   typename Steps::Staged staged_;
+  double p_min_;
   TraversalState state_;  ///< Stopped until begun; Done at once for an empty tree
 };
 
@@ -256,10 +321,13 @@ void validate_pair(const FramePair<BV, D>& pair, std::size_t index, const AdbOpt
 /// The answer of a pair whose root the budget did not reach, without setting it up after the deadline: what
 /// a traversal stopped before its first test answers (AdbHooks::finish on an empty queue: no estimate,
 /// probability 0, flagged), or no contact for an empty tree (query_adb's answer).
+/// With a memory, a pair the previous frame decided "collision" carries that decision's estimate instead.
 template <TreeVolume BV, ProbabilityDensity D>
-PairOutcome never_begun(const FramePair<BV, D>& pair, const AdbOptions& options) {
+PairOutcome never_begun(const FramePair<BV, D>& pair, const AdbOptions& options,
+                        const FrameMemory::Entry* remembered = nullptr) {
   if (pair.a->bvh.empty() || pair.b->bvh.empty()) return {false, 0, false, true, {}};
-  return {0 >= options.best_effort_threshold, 0, true, false, {}};
+  const double probability = remembered ? remembered->probability : 0;
+  return {probability >= options.best_effort_threshold, probability, true, false, {}};
 }
 
 /// The next pairs to step, ranked by the policy: (priority, index), highest priority first, then the lower
@@ -293,18 +361,34 @@ class TestBudget {
   bool equal_shares_;
 };
 
+/// A memory recalls decisions made by one node pair's own estimate (FrameMemory).
+inline void validate_memory(const AdbOptions& options) {
+  if (options.confirm_levels > 0 || options.confirm_with_children || options.exact_leaves)
+    throw std::invalid_argument(
+        "frame memory: recalls decisions made by one node pair's estimate; not with confirm_levels, "
+        "confirm_with_children or exact leaves");
+}
+
+/// The previous frame's decision for pair k, if any (FrameMemory::recall).
+template <TreeVolume BV, ProbabilityDensity D>
+const FrameMemory::Entry* recalled(const FrameMemory* memory, const FramePair<BV, D>& pair) {
+  return memory && pair.identity ? memory->recall(*pair.identity, pair.a, pair.b) : nullptr;
+}
+
 }  // namespace frame_detail
 
-/// Schedules one frame (header comment). Const and thread-safe on shared trees: all state is local.
+/// Schedules one frame (header comment). Const and thread-safe on shared trees: all state is local, but
+/// for `memory` (FrameMemory: frame-to-frame fronts), which it reads and then updates for the next frame.
 template <TreeVolume BV, ProbabilityDensity D>
-std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
-                                        const FrameOptions& options) {
+std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs, const FrameOptions& options,
+                                        FrameMemory* memory = nullptr) {
   using Run = frame_detail::PairRun<BV, D>;
   BudgetLimit clock(Budget{0, options.budget.deadline_us});  // the deadline counts from here
   options.validate();
   const FramePolicy& policy = frame_policy(options.policy);
   const AdbOptions adb = options.pair_options();
   for (std::size_t k = 0; k < pairs.size(); ++k) frame_detail::validate_pair(pairs[k], k, adb);
+  if (memory) frame_detail::validate_memory(adb);
 
   // Each pair's traversal is set up when its root is tested, in one block allocated up front: a deadline
   // that ends the root round leaves the pairs after it unbuilt (never_begun gives their answers).
@@ -319,7 +403,8 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
     Run& run = root ? runs[k].emplace(pairs[k], adb) : *runs[k];
     const std::uint64_t before = run.bv_tests();
     const TraversalState progress =
-        root ? run.begin(tests.allowance(k, before)) : run.step(tests.allowance(k, before));
+        root ? run.begin(tests.allowance(k, before), frame_detail::recalled(memory, pairs[k]))
+             : run.step(tests.allowance(k, before));
     tests.spend(run.bv_tests() - before);
     if (progress == TraversalState::Running) rank(k);
     return progress == TraversalState::Stopped && !policy.equal_shares;
@@ -347,12 +432,17 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   outcomes.reserve(runs.size());
   for (std::size_t k = 0; k < runs.size(); ++k) {
     if (!runs[k]) {
-      outcomes.push_back(frame_detail::never_begun(pairs[k], adb));
+      outcomes.push_back(frame_detail::never_begun(pairs[k], adb, frame_detail::recalled(memory, pairs[k])));
       continue;
     }
     runs[k]->end();
     outcomes.push_back(runs[k]->outcome());
+    const auto at = runs[k]->decided_at();
+    if (memory && pairs[k].identity && at && !outcomes.back().budget_exhausted)
+      memory->remember(
+          {*pairs[k].identity, pairs[k].a, pairs[k].b, at->first, at->second, outcomes.back().probability});
   }
+  if (memory) memory->end_frame();
   return outcomes;
 }
 

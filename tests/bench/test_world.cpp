@@ -192,6 +192,17 @@ TEST_F(WorldTest, OptionsThatDoNotApplyAreRefusedByName) {
       "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "confirm_levels": 1.5}]})",
                      "", kAnnotated),
          "/world/frame_budgets/0/confirm_levels: expected an integer");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2},
+      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "memory": "yes"}]})",
+                     "", kAnnotated),
+         "/world/frame_budgets/0/memory: expected true or false");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2},
+      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "confirm_levels": 1,
+                         "memory": true}]})",
+                     "", kAnnotated),
+         "/world/frame_budgets/0/memory: recalls decisions made by one node pair");
 }
 
 TEST_F(WorldTest, FrameBudgetsOnAHierarchyWithAProbabilityDensityAreKept) {
@@ -334,6 +345,33 @@ TEST_F(WorldTest, AGenerousFrameBudgetWithConfirmLevelsAnswersAsAdbWithThem) {
   EXPECT_GT(compared, 0u);
   EXPECT_GT(changed,
             0u);  // the confirming generations change some answers here, so the match means something
+}
+
+// A schedule with frame-to-frame fronts is a series of its own; its memory carries one frame to the next and
+// saves tests on a slow walk, and the warm-up run does not feed it (the timed run would recall the very
+// frame it answers, and spend fewer tests with a warm-up than without).
+TEST_F(WorldTest, AFrameMemoryCarriesFramesOnAndTheWarmUpDoesNotFeedIt) {
+  const Scene scene = parse(R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "ring.obj"}],
+      "hierarchies": [{"bv": "aabb", "annotation": {"type": "adb"}}], "strategies": [{"type": "exact"}],
+      "world": {"instances": [{"object": "torus", "count": 8}, {"object": "ring", "count": 6}],
+        "region": {"min": [-2, -2, -2], "max": [2, 2, 2]},
+        "motion": {"type": "random_walk", "frames": 8, "seed": 11, "step": 0.02, "turn_deg": 1},
+        "frame_budgets": [{"schedules": ["adb_probability"], "budgets": [{"bv_tests": 10000000}], "p_min": 0.99},
+                          {"schedules": ["adb_probability"], "budgets": [{"bv_tests": 10000000}], "p_min": 0.99,
+                           "memory": true}]}})");
+  RunOptions warm = quiet_options();
+  warm.warmup_queries = 1;
+  const WorldOutput cold = run_world(scene, quiet_options()), warmed = run_world(scene, warm);
+  std::map<std::string, std::uint64_t> tests;
+  for (const WorldSeriesRow& row : cold.series)
+    if (!row.schedule.empty()) tests[row.schedule] += row.bv_tests;
+  ASSERT_EQ(tests.size(), 2u);
+  EXPECT_LT(tests.at("adb_probability memory"), tests.at("adb_probability"));
+  for (std::size_t k = 0; k < cold.series.size(); ++k) {
+    if (cold.series[k].schedule.empty()) continue;
+    EXPECT_EQ(warmed.series[k].bv_tests, cold.series[k].bv_tests)
+        << cold.series[k].series << " frame " << cold.series[k].frame;
+  }
 }
 
 TEST_F(WorldTest, AnObjectWithoutTrianglesIsRefusedByName) {

@@ -65,7 +65,7 @@ Frame<BV> random_frame(std::mt19937_64& rng, int n, double near, double far) {
   std::uniform_real_distribution<double> distance(near, far);
   Frame<BV> frame;
   for (int k = 0; k < n; ++k)
-    frame.push_back({&trees[mesh(rng)], &trees[mesh(rng)], pose_at(rng, distance(rng))});
+    frame.push_back({&trees[mesh(rng)], &trees[mesh(rng)], pose_at(rng, distance(rng)), std::nullopt});
   return frame;
 }
 
@@ -353,7 +353,8 @@ TEST(FrameBudget, AnEmptyTreeAnswersNoContactWithOrWithoutItsTurn) {
   const auto& full = meshes<Aabb>().trees[0];
   const Tree<Aabb, AdbDensity> empty{Bvh<Aabb>{}, full.density};  // no mesh builds one; a caller may
   ASSERT_TRUE(empty.bvh.empty());
-  const Frame<Aabb> frame = {{&full, &empty, RigidTransform{}}, {&empty, &full, RigidTransform{}}};
+  const Frame<Aabb> frame = {{&full, &empty, RigidTransform{}, std::nullopt},
+                             {&empty, &full, RigidTransform{}, std::nullopt}};
   const Result alone = query_adb(full, empty, RigidTransform{}, AdbOptions{});
   FrameOptions generous, starved;
   starved.budget.deadline_us = 1e-9;  // passed at the first look: no pair has its turn
@@ -366,9 +367,110 @@ TEST(FrameBudget, AnEmptyTreeAnswersNoContactWithOrWithoutItsTurn) {
     }
 }
 
+// Frame-to-frame fronts (FrameMemory): pairs that touch deeply, named, then the same frame again.
+Frame<Aabb> named_close_frame(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  Frame<Aabb> frame = random_frame<Aabb>(rng, 30, 0.8, 1.6);
+  for (std::size_t k = 0; k < frame.size(); ++k) frame[k].identity = 1000 + k;
+  return frame;
+}
+
+/// The pairs decided "collision" below their roots: what a memory can save.
+std::size_t decided_below_root(const std::vector<PairOutcome>& outcomes) {
+  std::size_t n = 0;
+  for (const auto& o : outcomes) n += o.collides && !o.budget_exhausted && o.counters.bv_tests > 1;
+  return n;
+}
+
+TEST(FrameMemory, TheSameFrameAgainDecidesItsCollisionsAfterTheRootAndOneTest) {
+  const Frame<Aabb> frame = named_close_frame(11);
+  for (const auto& name : policy_names()) {
+    FrameOptions options;
+    options.policy = name;
+    FrameMemory memory;
+    const auto first = schedule_frame<Aabb, AdbDensity>(frame, options, &memory);
+    ASSERT_GT(decided_below_root(first), 3u) << name << ": the test needs pairs decided below their roots";
+    std::size_t remembered = 0;
+    for (const auto& o : first) remembered += o.collides;
+    EXPECT_EQ(memory.size(), remembered) << name;  // every collision here is one node pair's decision
+    const auto again = schedule_frame<Aabb, AdbDensity>(frame, options, &memory);
+    for (std::size_t k = 0; k < frame.size(); ++k) {
+      const std::string where = name + ", pair " + std::to_string(k);
+      EXPECT_EQ(again[k].collides, first[k].collides) << where;
+      if (first[k].collides)
+        EXPECT_LE(again[k].counters.bv_tests, 2u) << where;  // the root, then the remembered pair
+      else
+        EXPECT_EQ(again[k].counters.bv_tests, first[k].counters.bv_tests) << where;
+    }
+    // Without a memory the second frame is the first again.
+    EXPECT_EQ(total_bv_tests(schedule(frame, options)), total_bv_tests(first)) << name;
+  }
+}
+
+TEST(FrameMemory, APairWithoutARootTestAnswersWhatItRemembers) {
+  const Frame<Aabb> frame = named_close_frame(12);
+  FrameOptions options;
+  FrameMemory memory;
+  const auto first = schedule_frame<Aabb, AdbDensity>(frame, options, &memory);
+  FrameOptions none = options;
+  none.budget = {0, 1e-9};  // a deadline that has passed at the first look: no root test at all
+  FrameMemory kept = memory;
+  const auto late = schedule_frame<Aabb, AdbDensity>(frame, none, &kept);
+  const auto forgetful = schedule(frame, none);
+  for (std::size_t k = 0; k < frame.size(); ++k) {
+    const std::string where = "pair " + std::to_string(k);
+    EXPECT_TRUE(late[k].budget_exhausted) << where;
+    EXPECT_EQ(late[k].counters.bv_tests, 0u) << where;
+    EXPECT_EQ(late[k].collides, first[k].collides) << where;
+    EXPECT_EQ(late[k].probability, first[k].collides ? first[k].probability : 0.0) << where;
+    EXPECT_FALSE(forgetful[k].collides) << where;
+  }
+  EXPECT_EQ(kept.size(), 0u);  // flagged answers are not remembered
+}
+
+TEST(FrameMemory, OtherTreesOrAnotherIdentityRecallNothing) {
+  const Frame<Aabb> frame = named_close_frame(13);
+  FrameOptions options;
+  FrameMemory memory;
+  const auto first = schedule_frame<Aabb, AdbDensity>(frame, options, &memory);
+  Frame<Aabb> renamed = frame, swapped = frame;
+  for (auto& pair : renamed) *pair.identity += 1000;
+  const auto& trees = meshes<Aabb>().trees;
+  for (auto& pair : swapped) pair.a = &trees[(pair.a - trees.data() + 1) % trees.size()];
+  for (const Frame<Aabb>* other : {&renamed, &swapped}) {
+    FrameMemory copy = memory;
+    const auto with = schedule_frame<Aabb, AdbDensity>(*other, options, &copy);
+    const auto without = schedule(*other, options);
+    EXPECT_EQ(total_bv_tests(with), total_bv_tests(without));
+  }
+}
+
+/// Runs `run`; it must throw std::invalid_argument whose message contains `name`.
+template <class Run>
+void expect_refused(Run&& run, const std::string& name) {
+  try {
+    run();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    return;
+  }
+  ADD_FAILURE() << "not refused: " << name;
+}
+
+TEST(FrameMemory, ConfirmationsAndRepeatedIdentitiesAreRefused) {
+  Frame<Aabb> frame = named_close_frame(14);
+  FrameMemory memory;
+  FrameOptions confirming;
+  confirming.adb.confirm_levels = 1;
+  expect_refused([&] { schedule_frame<Aabb, AdbDensity>(frame, confirming, &memory); }, "confirm_levels");
+  for (auto& pair : frame) pair.identity = 7;
+  expect_refused([&] { schedule_frame<Aabb, AdbDensity>(frame, FrameOptions{}, &memory); }, "identity 7");
+  EXPECT_EQ(memory.size(), 0u);
+}
+
 TEST(FrameBudget, BadOptionsAreRefusedByName) {
   const auto& tree = meshes<Aabb>().trees[0];
-  const Frame<Aabb> frame = {{&tree, &tree, RigidTransform{}}};
+  const Frame<Aabb> frame = {{&tree, &tree, RigidTransform{}, std::nullopt}};
   const auto refused = [&](const FrameOptions& options, const std::string& name) {
     try {
       schedule(frame, options);
@@ -397,7 +499,7 @@ TEST(FrameBudget, BadOptionsAreRefusedByName) {
   threshold.adb.best_effort_threshold = 2;
   refused(threshold, "best_effort_threshold");
 
-  const Frame<Aabb> null_tree = {{&tree, nullptr, RigidTransform{}}};
+  const Frame<Aabb> null_tree = {{&tree, nullptr, RigidTransform{}, std::nullopt}};
   EXPECT_THROW(schedule(null_tree, FrameOptions{}), std::invalid_argument);
   try {
     schedule(null_tree, FrameOptions{});
