@@ -51,8 +51,9 @@ def report_main(script, doc, required, draw, optional=(), add_options=None, refu
     draw(args, *tables)
 
 
-def save(fig, out, dpi):
-    """Lays the figure out, writes it to `out` and frees it (a report draws several in one process)."""
-    fig.tight_layout()
+def save(fig, out, dpi, rect=(0, 0, 1, 1)):
+    """Lays the figure out within `rect` (figure fractions: room left for a legend beside it), writes it to
+    `out` and frees it (a report draws several in one process)."""
+    fig.tight_layout(rect=rect)
     fig.savefig(out, dpi=dpi)
     plt.close(fig)

@@ -32,11 +32,24 @@ def wrong_percent(rows):
     return 100.0 * wrong / candidates if candidates else 0.0
 
 
+LINE_STYLES = ["-", "--", ":", "-."]
+
+
+def schedule_style(schedule, colors, styles):
+    """A colour per policy (the schedule's first word), a line style per variant (the rest: memory, confirm_levels=L):
+    the same across both panels."""
+    policy, _, variant = schedule.partition(" ")
+    color = colors.setdefault(policy, f"C{len(colors) % 10}")
+    style = styles.setdefault(variant, LINE_STYLES[len(styles) % len(LINE_STYLES)])
+    return {"color": color, "linestyle": style}
+
+
 def figure_errors_vs_budget(rows, out):
     budgeted = [r for r in rows if r["schedule"]]
     kinds = sorted({budget_value(r["budget"])[0] for r in budgeted}) or ["bv_tests"]
-    fig, axes = plt.subplots(1, len(kinds), figsize=(6.2 * len(kinds), 4.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(kinds), figsize=(5.6 * len(kinds) + 3.2, 4.4), squeeze=False)
     references = group_by([r for r in rows if not r["schedule"]], lambda r: (r["hierarchy"], r["series"]))
+    colors, styles, legend = {}, {}, {}
     for ax, kind in zip(axes[0], kinds):
         lines = defaultdict(dict)
         for (hierarchy, schedule, budget), group in group_by(
@@ -47,7 +60,9 @@ def figure_errors_vs_budget(rows, out):
                 lines[(hierarchy, schedule)][value] = wrong_percent(group)
         for (hierarchy, schedule), points in sorted(lines.items()):
             xs = sorted(points)
-            ax.plot(xs, [points[x] for x in xs], marker="o", label=f"{schedule} ({hierarchy})")
+            (line,) = ax.plot(xs, [points[x] for x in xs], marker="o", markersize=4,
+                              **schedule_style(schedule, colors, styles))
+            legend.setdefault(f"{schedule} ({hierarchy})", line)
         # References at one level (the exact series, all at 0) share a line and one label, not overprinted ones.
         levels = defaultdict(list)
         for (hierarchy, series), group in sorted(references.items()):
@@ -61,9 +76,10 @@ def figure_errors_vs_budget(rows, out):
         ax.set_ylabel("wrong pairs, % of candidate pairs (missed + false)")
         ax.set_ylim(bottom=0)
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
+    # One legend beside the panels: a schedule keeps its colour and style in both.
+    fig.legend(list(legend.values()), list(legend.keys()), loc="center right", fontsize=7)
     fig.suptitle("Pair errors against the frame budget")
-    save(fig, out, dpi=120)
+    save(fig, out, dpi=120, rect=(0, 0, 1 - 2.9 / fig.get_figwidth(), 1))
 
 
 FCL_HIERARCHY = "fcl_obbrss"  # world.hpp: kFclWorldHierarchy

@@ -44,6 +44,18 @@ class WorldFigures(ReportScriptChecks, unittest.TestCase):
         self.assertEqual(plot_world.budget_value("bv_tests=200"), ("bv_tests", 200.0))
         self.assertEqual(plot_world.budget_value("deadline_us=50;bv_tests=3"), ("deadline_us", 50.0))
 
+    def test_a_policy_keeps_its_colour_and_a_variant_its_line_style(self):
+        colors, styles = {}, {}
+        plain = plot_world.schedule_style("adb_probability", colors, styles)
+        memory = plot_world.schedule_style("adb_probability memory", colors, styles)
+        other = plot_world.schedule_style("equal_split memory", colors, styles)
+        confirming = plot_world.schedule_style("equal_split confirm_levels=1", colors, styles)
+        self.assertEqual(plain["color"], memory["color"])
+        self.assertNotEqual(memory["color"], other["color"])
+        self.assertEqual(memory["linestyle"], other["linestyle"])
+        self.assertEqual(len({plain["linestyle"], memory["linestyle"], confirming["linestyle"]}), 3)
+        self.assertEqual(plot_world.schedule_style("adb_probability", colors, styles), plain)
+
     def test_both_figures_are_drawn(self):
         self.assertDrawsItsFigures(tables())
 
