@@ -158,6 +158,29 @@ class WorldHierarchy {
   std::map<std::string, FrameMemory> memories_;
 };
 
+/// The pair rows a run keeps (RunOptions::per_pose): every answer, or only the wrong ones.
+struct PairRows {
+  PerPose mode = PerPose::none;
+  const std::vector<WorldInstance>* instances = nullptr;
+  std::vector<WorldPairRow> rows;
+
+  void add(const std::string& series, const Candidate& c, bool collides, bool flagged, double probability,
+           double micros, std::uint64_t bv_tests) {
+    if (mode == PerPose::none || (mode == PerPose::wrong && collides == c.truth)) return;
+    rows.push_back({0,
+                    {},
+                    series,
+                    (*instances)[c.instances.a].name,
+                    (*instances)[c.instances.b].name,
+                    c.truth,
+                    collides,
+                    flagged,
+                    probability,
+                    micros,
+                    bv_tests});
+  }
+};
+
 /// Counts one series' answers against the truth.
 void count(WorldSeriesRow& row, const std::vector<Candidate>& candidates, const std::vector<char>& answers,
            const std::vector<char>& flagged) {
@@ -173,7 +196,7 @@ void count(WorldSeriesRow& row, const std::vector<Candidate>& candidates, const 
 
 /// A per-pair strategy on every candidate pair, each query timed alone (as the pair runner times them).
 WorldSeriesRow run_variant(const StrategyVariant& variant, const std::vector<Candidate>& candidates,
-                           int warmup) {
+                           int warmup, PairRows& pair_rows) {
   WorldSeriesRow row;
   row.series = variant.label();
   row.exact_strategy = strategy_info(variant.strategy).exact;
@@ -186,6 +209,8 @@ WorldSeriesRow run_variant(const StrategyVariant& variant, const std::vector<Can
     row.bv_tests += records.front().counters.bv_tests;
     answers[k] = records.front().collides;
     flagged[k] = records.front().budget_exhausted;
+    pair_rows.add(row.series, candidates[k], answers[k], flagged[k], records.front().probability,
+                  records.front().micros, records.front().counters.bv_tests);
   }
   count(row, candidates, answers, flagged);
   return row;
@@ -224,7 +249,8 @@ std::vector<PairOutcome> schedule(const PlannedHierarchy& planned, const std::ve
 /// recalls the previous frame, not the warm-up's answers for this one.
 std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedHierarchy& planned,
                                               const std::vector<Candidate>& candidates, int warmup,
-                                              std::map<std::string, FrameMemory>& memories) {
+                                              std::map<std::string, FrameMemory>& memories,
+                                              PairRows& pair_rows) {
   std::vector<WorldSeriesRow> rows;
   for (const FrameBudgetSpec& spec : scene.world->frame_budgets) {
     if (!spec.applies_to(*planned.hierarchy)) continue;
@@ -254,6 +280,8 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
           answers[k] = outcomes[k].collides;
           flagged[k] = outcomes[k].budget_exhausted;
           row.bv_tests += outcomes[k].counters.bv_tests;
+          pair_rows.add(row.series, candidates[k], answers[k], flagged[k], outcomes[k].probability, -1,
+                        outcomes[k].counters.bv_tests);
         }
         count(row, candidates, answers, flagged);
         rows.push_back(std::move(row));
@@ -428,22 +456,29 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
 #ifdef BVHLAB_HAVE_FCL
   FclSide fcl(scene, preparation);
 #endif
+  PairRows pair_rows{options.per_pose, &scene.world->instances, {}};
+  output.per_pose = options.per_pose;
   for (int frame = 0; frame < scene.world->frames; ++frame) {
     const auto& poses = scene.world->poses[static_cast<std::size_t>(frame)];
     std::map<std::pair<std::uint32_t, std::uint32_t>, bool> truth;
     for (auto& h : hierarchies) {
       const std::vector<ObjectPair> pairs = h->candidates(frame, poses, output.broad);
       const std::vector<Candidate> candidates = with_truth(*h, scene, pairs, poses, truth);
+      const std::size_t first_pair_row = pair_rows.rows.size();
       std::vector<WorldSeriesRow> rows;
       for (const StrategyVariant& variant : h->planned().variants)
-        rows.push_back(run_variant(variant, candidates, options.warmup_queries));
-      for (WorldSeriesRow& row :
-           run_frame_budgets(scene, h->planned(), candidates, options.warmup_queries, h->memories()))
+        rows.push_back(run_variant(variant, candidates, options.warmup_queries, pair_rows));
+      for (WorldSeriesRow& row : run_frame_budgets(scene, h->planned(), candidates, options.warmup_queries,
+                                                   h->memories(), pair_rows))
         rows.push_back(row);
       for (WorldSeriesRow& row : rows) {
         row.frame = frame;
         row.hierarchy = h->planned().hierarchy->name;
         output.series.push_back(std::move(row));
+      }
+      for (std::size_t k = first_pair_row; k < pair_rows.rows.size(); ++k) {
+        pair_rows.rows[k].frame = frame;
+        pair_rows.rows[k].hierarchy = h->planned().hierarchy->name;
       }
     }
 #ifdef BVHLAB_HAVE_FCL
@@ -457,6 +492,7 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
     for (auto& row : fcl.scaling(count)) output.scaling.push_back(row);
 #endif
   }
+  output.pairs = std::move(pair_rows.rows);
   output.models = preparation.models();
   output.stats.wall_seconds = std::chrono::duration<double>(Clock::now() - wall).count();
   return output;

@@ -42,6 +42,22 @@ struct WorldSeriesRow {
   std::uint64_t bv_tests = 0;
 };
 
+/// One candidate pair's answer in one frame, kept when RunOptions::per_pose asks for it (a row of
+/// world_pairs.csv): every answer ("all") or the wrong ones ("wrong"), of the per-pair strategies and the
+/// frame budgets on the scene's hierarchies (not FCL's).
+struct WorldPairRow {
+  int frame = 0;
+  std::string hierarchy;
+  std::string series;      ///< as in WorldSeriesRow
+  std::string a, b;        ///< the instances' names
+  bool truth = false;      ///< the exact answer
+  bool collides = false;   ///< the series' answer
+  bool flagged = false;    ///< a best effort (budget ran out)
+  double probability = 0;  ///< the estimate it decided on (1 or 0 when exact)
+  double micros = -1;      ///< the pair's query alone; -1 under a frame budget (timed as a whole frame)
+  std::uint64_t bv_tests = 0;
+};
+
 /// One frame of one broad phase on one hierarchy's world boxes.
 struct BroadPhaseRow {
   int frame = 0;
@@ -65,6 +81,8 @@ struct WorldOutput {
   std::size_t instances = 0;
   int frames = 0;
   std::vector<WorldSeriesRow> series;
+  std::vector<WorldPairRow> pairs;  ///< per RunOptions::per_pose (none: empty)
+  PerPose per_pose = PerPose::none;
   std::vector<BroadPhaseRow> broad;
   std::vector<ScalingRow> scaling;
   std::vector<ModelInfo> models;
@@ -74,11 +92,13 @@ struct WorldOutput {
 /// Runs a world scene (scene.world set). Throws std::invalid_argument for a scene without one.
 WorldOutput run_world(const Scene& scene, const RunOptions& options);
 
-/// world_frames.csv, world_broad_phase.csv and world_scaling.csv in `dir` (columns: the rows' fields).
+/// world_frames.csv, world_broad_phase.csv and world_scaling.csv in `dir` (columns: the rows' fields), and
+/// world_pairs.csv when the run kept pair rows (per_pose all or wrong).
 void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir);
 
 /// The rows as JSON (Python's run_scene on a world scene): {"scene", "instances", "frames", "series": [...],
-/// "broad_phase": [...], "scaling": [...]}, each row keyed like its CSV columns.
+/// "broad_phase": [...], "scaling": [...]}, and "pairs": [...] when the run kept pair rows; each row keyed
+/// like its CSV columns.
 nlohmann::json world_document(const WorldOutput& output);
 
 /// The whole report: the CSV files, the figures (bench/plot_world.py, when `figures`) and README.md.

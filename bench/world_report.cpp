@@ -47,6 +47,21 @@ std::vector<SeriesTotals> totals(const std::vector<WorldSeriesRow>& rows) {
 
 }  // namespace
 
+namespace {
+
+/// world_pairs.csv: one row per kept pair answer (WorldPairRow); micros empty under a frame budget.
+void write_world_pairs_csv(const WorldOutput& output, const std::filesystem::path& file) {
+  std::ofstream pairs = open_csv(file);
+  pairs << "frame,hierarchy,series,a,b,truth,collides,flagged,probability,micros,bv_tests\n";
+  for (const WorldPairRow& r : output.pairs)
+    pairs << fmt::format("{},{},\"{}\",\"{}\",\"{}\",{},{},{},{:.6g},{},{}\n", r.frame, r.hierarchy, r.series,
+                         r.a, r.b, r.truth ? 1 : 0, r.collides ? 1 : 0, r.flagged ? 1 : 0, r.probability,
+                         r.micros < 0 ? std::string() : fmt::format("{:.3f}", r.micros), r.bv_tests);
+  if (!pairs) throw std::runtime_error(file.string() + ": writing failed");
+}
+
+}  // namespace
+
 void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
   std::ofstream frames = open_csv(dir / "world_frames.csv");
@@ -68,6 +83,7 @@ void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir
                            r.boxes_micros, r.update_micros);
   if (!frames || !broad || !scaling)
     throw std::runtime_error(dir.string() + ": writing the world CSV files failed");
+  if (output.per_pose != PerPose::none) write_world_pairs_csv(output, dir / "world_pairs.csv");
 }
 
 namespace {
@@ -203,8 +219,25 @@ nlohmann::json world_document(const WorldOutput& output) {
                        {"candidates", r.candidates},
                        {"boxes_micros", r.boxes_micros},
                        {"update_micros", r.update_micros}});
-  return {{"scene", output.scene}, {"instances", output.instances}, {"frames", output.frames},
-          {"series", series},      {"broad_phase", broad},          {"scaling", scaling}};
+  nlohmann::json document = {{"scene", output.scene},   {"instances", output.instances},
+                             {"frames", output.frames}, {"series", series},
+                             {"broad_phase", broad},    {"scaling", scaling}};
+  if (output.per_pose == PerPose::none) return document;
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const WorldPairRow& r : output.pairs)
+    pairs.push_back({{"frame", r.frame},
+                     {"hierarchy", r.hierarchy},
+                     {"series", r.series},
+                     {"a", r.a},
+                     {"b", r.b},
+                     {"truth", r.truth},
+                     {"collides", r.collides},
+                     {"flagged", r.flagged},
+                     {"probability", r.probability},
+                     {"micros", r.micros < 0 ? nlohmann::json() : nlohmann::json(r.micros)},
+                     {"bv_tests", r.bv_tests}});
+  document["pairs"] = std::move(pairs);
+  return document;
 }
 
 std::string write_world_report(const WorldOutput& output, const std::filesystem::path& dir, bool figures) {

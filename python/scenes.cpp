@@ -47,8 +47,8 @@ py::object run(const py::object& scene_argument, const py::object& cache, int th
   options.log = [quiet](const std::string& line) {
     if (!quiet) std::cerr << line << '\n';
   };
-  if ((scene.world || scene.deform) && options.per_pose != PerPose::none)
-    throw py::value_error("per_pose: does not apply to a world or deform scene (its rows are per frame)");
+  if (scene.deform && options.per_pose != PerPose::none)
+    throw py::value_error("per_pose: does not apply to a deform scene (its rows are per frame)");
   nlohmann::json document;
   {
     py::gil_scoped_release release;
@@ -78,7 +78,9 @@ void bind_scenes(py::module_& m) {
         "per_pose=\"all\" or \"wrong\" adds \"poses\", the records of poses.csv (`bvhlab run --per-pose`), "
         "one dict per query or per wrong answer. A world scene (\"world\") returns its rows instead: "
         "\"series\" (per frame, hierarchy and series: candidates, colliding, missed, false_pairs, flagged, "
-        "micros), \"broad_phase\" and \"scaling\", keyed like the columns of its CSV files. A deform scene "
+        "micros), \"broad_phase\" and \"scaling\", keyed like the columns of its CSV files, and with "
+        "per_pose \"pairs\" (world_pairs.csv: per candidate pair and series, every answer or the wrong "
+        "ones). A deform scene "
         "(\"deform\") returns \"rows\" (per frame, hierarchy, update and strategy), keyed like "
         "deform_frames.csv.");
   m.def(

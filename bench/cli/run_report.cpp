@@ -37,6 +37,15 @@ RunOptions scene_run_options(const SceneArgs& args) {
   return options;
 }
 
+/// --per-pose asks for one row per query of a pair scene or per candidate pair of a world scene; deform and
+/// points scenes keep no such rows, so it is refused there rather than ignored.
+void check_per_pose_applies(const Scene& scene, const RunOptions& options) {
+  if (options.per_pose == PerPose::none || !(scene.deform || scene.points)) return;
+  throw CLI::ValidationError("--per-pose", std::string("does not apply to a ") +
+                                               (scene.deform ? "deform" : "points") + " scene (scene " +
+                                               scene.name + ")");
+}
+
 /// poses.csv, when --per-pose asked for it.
 void write_poses(const RunOutput& output, const fs::path& dir) {
   if (output.per_pose != PerPose::none) write_poses_csv(output, dir / "poses.csv");
@@ -131,6 +140,7 @@ int run_points_scene(const Scene& scene, const fs::path& dir, bool figures, bool
 int run_command(const SceneArgs& args) {
   const RunOptions options = scene_run_options(args);
   const Scene scene = load_scene(args.scene_file);
+  check_per_pose_applies(scene, options);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / scene.name : fs::path(args.out_dir);
   if (scene.world) return run_world_scene(scene, options, dir, false, args.quiet);
   if (scene.deform) return run_deform_scene(scene, options, dir, false, args.quiet);
@@ -186,6 +196,7 @@ int report_command(const SceneArgs& args) {
   job.start = Clock::now();
   job.options = scene_run_options(args);
   job.scene = load_scene(args.scene_file);
+  check_per_pose_applies(job.scene, job.options);
   job.dir = args.out_dir;
   job.snippet_file = args.snippet_file;
   job.figures = !args.no_figures;

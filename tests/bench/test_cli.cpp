@@ -282,6 +282,18 @@ TEST_F(Cli, PerPoseIsWrittenOnlyWhenAsked) {
   EXPECT_EQ(wrong[0][9], "pose");
 }
 
+// A deform scene keeps rows per frame, not per query: --per-pose is refused there by name, not ignored.
+TEST_F(Cli, PerPoseIsRefusedForADeformScene) {
+  testing::write_obj(testing::make_torus(0.7, 0.25, 12, 8), dir / "torus.obj");
+  testing::write_text(dir / "d.json", R"({"objects": [{"mesh": "torus.obj"}], "hierarchies": [{"bv": "aabb"}],
+      "strategies": [{"type": "exact"}], "deform": {"object": "torus", "deformation": "twist:amplitude=2",
+      "frames": 2, "poses": {"distances": [1.2], "steps": 4}}})");
+  expect_refused("run d.json -o out -q --per-pose all", "--per-pose: does not apply to a deform scene");
+  expect_refused("report d.json -o out -q --no-figures --per-pose wrong",
+                 "--per-pose: does not apply to a deform scene");
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
 // The pose column pasted into `bvhlab query` (as a pose list, one per line as --pose takes it) gives the
 // run's answer for each series, and the exact strategy the truth.
 TEST_F(Cli, PosesOfPerPoseOutputQueryBackToTheSameAnswers) {

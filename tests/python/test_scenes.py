@@ -142,8 +142,33 @@ def test_world_scene_rows(gear, gear_file, cli, tmp_path):
     with open(tmp_path / "out" / "world_frames.csv") as f:
         rows = [r for r in csv.DictReader(f) if r["series"] == "exact" and r["hierarchy"] == "aabb"]
     assert [int(r["colliding"]) for r in rows] == [r["colliding"] for r in exact]
-    with pytest.raises(ValueError, match="per_pose: does not apply to a world or deform scene"):
-        bvhlab.run_scene(world_scene(gear_file), per_pose="all")
+
+
+def test_world_pair_rows_add_up_to_the_frame_rows(gear_file, cli, tmp_path):
+    everything = bvhlab.run_scene(world_scene(gear_file), per_pose="all")
+    wrong = bvhlab.run_scene(world_scene(gear_file), per_pose="wrong")
+    assert "pairs" not in bvhlab.run_scene(world_scene(gear_file))
+    frames = [r for r in everything["series"] if r["hierarchy"] == "aabb"]
+    for row in frames:
+        mine = [p for p in everything["pairs"]
+                if p["frame"] == row["frame"] and p["series"] == row["series"] and p["hierarchy"] == "aabb"]
+        assert len(mine) == row["candidates"]
+        assert sum(p["truth"] for p in mine) == row["colliding"]
+        assert sum(p["collides"] and not p["truth"] for p in mine) == row["false_pairs"]
+        assert sum(p["truth"] and not p["collides"] for p in mine) == row["missed"]
+        assert sum(p["flagged"] for p in mine) == row["flagged"]
+        assert sum(p["bv_tests"] for p in mine) == row["bv_tests"]
+        timed = [p["micros"] for p in mine]
+        assert all(t is None for t in timed) if row["schedule"] else all(t >= 0 for t in timed)
+    assert wrong["pairs"] == [p for p in everything["pairs"] if p["collides"] != p["truth"]] != []
+    # The CLI writes the same rows to world_pairs.csv.
+    file = tmp_path / "world.json"
+    file.write_text(json.dumps(world_scene(gear_file)))
+    cli("run", file, "-o", tmp_path / "out", "--quiet", "--per-pose", "wrong", parse_json=False)
+    with open(tmp_path / "out" / "world_pairs.csv") as f:
+        written = list(csv.DictReader(f))
+    assert [(int(r["frame"]), r["series"], r["a"], r["b"], int(r["collides"])) for r in written] == [
+        (p["frame"], p["series"], p["a"], p["b"], int(p["collides"])) for p in wrong["pairs"]]
 
 
 def deform_scene(gear_file):
@@ -176,5 +201,5 @@ def test_deform_scene_rows(gear_file, cli, tmp_path):
         written = list(csv.DictReader(f))
     assert [(r["hierarchy"], r["update"], int(r["colliding"])) for r in written] == [
         (r["hierarchy"], r["update"], r["colliding"]) for r in rows]
-    with pytest.raises(ValueError, match="per_pose: does not apply to a world or deform scene"):
+    with pytest.raises(ValueError, match="per_pose: does not apply to a deform scene"):
         bvhlab.run_scene(deform_scene(gear_file), per_pose="all")
