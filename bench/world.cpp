@@ -158,25 +158,20 @@ class WorldHierarchy {
   std::map<std::string, FrameMemory> memories_;
 };
 
-/// The pair rows a run keeps (RunOptions::per_pose): every answer, or only the wrong ones.
+/// The pair rows a run keeps (RunOptions::per_pose): every answer, or only the wrong ones, each of the frame
+/// and hierarchy being run.
 struct PairRows {
   PerPose mode = PerPose::none;
   const std::vector<WorldInstance>* instances = nullptr;
+  int frame = 0;
+  std::string hierarchy;
   std::vector<WorldPairRow> rows;
 
   void add(const std::string& series, const Candidate& c, bool collides, bool flagged, double probability,
            double micros, std::uint64_t bv_tests) {
     if (mode == PerPose::none || (mode == PerPose::wrong && collides == c.truth)) return;
-    rows.push_back({0,
-                    {},
-                    series,
-                    (*instances)[c.instances.a].name,
-                    (*instances)[c.instances.b].name,
-                    c.truth,
-                    collides,
-                    flagged,
-                    probability,
-                    micros,
+    rows.push_back({frame, hierarchy, series, (*instances)[c.instances.a].name,
+                    (*instances)[c.instances.b].name, c.truth, collides, flagged, probability, micros,
                     bv_tests});
   }
 };
@@ -456,7 +451,7 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
 #ifdef BVHLAB_HAVE_FCL
   FclSide fcl(scene, preparation);
 #endif
-  PairRows pair_rows{options.per_pose, &scene.world->instances, {}};
+  PairRows pair_rows{options.per_pose, &scene.world->instances, 0, {}, {}};
   output.per_pose = options.per_pose;
   for (int frame = 0; frame < scene.world->frames; ++frame) {
     const auto& poses = scene.world->poses[static_cast<std::size_t>(frame)];
@@ -464,7 +459,8 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
     for (auto& h : hierarchies) {
       const std::vector<ObjectPair> pairs = h->candidates(frame, poses, output.broad);
       const std::vector<Candidate> candidates = with_truth(*h, scene, pairs, poses, truth);
-      const std::size_t first_pair_row = pair_rows.rows.size();
+      pair_rows.frame = frame;
+      pair_rows.hierarchy = h->planned().hierarchy->name;
       std::vector<WorldSeriesRow> rows;
       for (const StrategyVariant& variant : h->planned().variants)
         rows.push_back(run_variant(variant, candidates, options.warmup_queries, pair_rows));
@@ -475,10 +471,6 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
         row.frame = frame;
         row.hierarchy = h->planned().hierarchy->name;
         output.series.push_back(std::move(row));
-      }
-      for (std::size_t k = first_pair_row; k < pair_rows.rows.size(); ++k) {
-        pair_rows.rows[k].frame = frame;
-        pair_rows.rows[k].hierarchy = h->planned().hierarchy->name;
       }
     }
 #ifdef BVHLAB_HAVE_FCL

@@ -45,10 +45,6 @@ std::vector<SeriesTotals> totals(const std::vector<WorldSeriesRow>& rows) {
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 /// world_pairs.csv: one row per kept pair answer (WorldPairRow); micros empty under a frame budget.
 void write_world_pairs_csv(const WorldOutput& output, const std::filesystem::path& file) {
   std::ofstream pairs = open_csv(file);
