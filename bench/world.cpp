@@ -255,10 +255,12 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
         options.policy = policy;
         options.p_min = spec.p_min;
         options.adb.confirm_levels = static_cast<std::uint8_t>(spec.confirm_levels);
+        options.order = frame_order(spec.order);
         options.budget = budget;
         WorldSeriesRow row;
         // A confirming schedule is a line of its own in the figures, beside the same policy without it.
         row.schedule = policy;
+        if (options.order != FrameOrder::best_first) row.schedule += " " + spec.order;
         if (spec.confirm_levels > 0) row.schedule += " confirm_levels=" + std::to_string(spec.confirm_levels);
         if (spec.memory) row.schedule += " memory";
         row.budget = budget_label(budget);

@@ -89,6 +89,17 @@ const FramePolicy& frame_policy(std::string_view name) {
   throw std::invalid_argument("frame: unknown policy '" + std::string(name) + "' (known: " + known + ")");
 }
 
+std::string_view frame_order_name(FrameOrder order) {
+  return order == FrameOrder::depth_first ? "depth_first" : "best_first";
+}
+
+FrameOrder frame_order(std::string_view name) {
+  for (FrameOrder order : {FrameOrder::best_first, FrameOrder::depth_first})
+    if (frame_order_name(order) == name) return order;
+  throw std::invalid_argument("frame: unknown order '" + std::string(name) +
+                              "' (known: best_first, depth_first)");
+}
+
 void FrameOptions::validate() const {
   if (!(p_min > 0 && p_min <= 1))
     throw std::invalid_argument("frame: p_min must lie in (0, 1], got " + std::to_string(p_min));
@@ -99,6 +110,8 @@ void FrameOptions::validate() const {
     throw std::invalid_argument(
         "frame: adb.budget must be empty; the frame's budget is FrameOptions::budget");
   frame_policy(policy);
+  if (order != FrameOrder::best_first && order != FrameOrder::depth_first)
+    throw std::invalid_argument("frame: order is neither best_first nor depth_first");
   pair_options().validate();
 }
 

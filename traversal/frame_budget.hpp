@@ -1,7 +1,8 @@
 // One budget for a whole frame of candidate object pairs (issue #14): the broad phase yields the pairs, and
 // one scheduler spends one budget of BV tests and/or microseconds on all of them, expanding the BV pairs
 // whose answer matters most first. Each candidate pair runs the ADB traversal of traversal/adb.hpp (AdbHooks,
-// BestFirst, SplitBoth: the same estimate, decisions and best-effort answer), cut into steps
+// SplitBoth: the same estimate, decisions and best-effort answer) in the order FrameOptions::order names
+// (best first, the paper's, or depth first into the most probable child, as adb_dfs), cut into steps
 // (traversal/driver.hpp, "Resumable"); the scheduler decides which pair takes the next step.
 //
 //   std::vector<PairOutcome> out = schedule_frame<BV, D>(pairs, options);   // one outcome per pair, in order
@@ -17,8 +18,11 @@
 //      budget ends during this round; the pairs it did not reach answer as in 4. With a FrameMemory, a pair
 //      its root leaves open then tests the node pair the previous frame decided on (FrameMemory).
 //   3. Steps: while the budget lasts and some pair is undecided, the policy picks the pair whose next step
-//      ranks highest (ties: the pair given first), and that pair takes one step: its most probable queued BV
-//      pair is taken off its queue and expanded (up to four BV tests), or tested as a leaf pair. Then:
+//      ranks highest (ties: the pair given first), and that pair takes one step: its next BV pair (best
+//      first: its most probable queued one; depth first: the most probable child of its last expansion,
+//      else of the one before) is taken off its queue and expanded (up to four BV tests), or tested as a
+//      leaf pair. Without a budget, both orders give each pair the answer query_adb gives in that order.
+//      Then:
 //        - a pair whose estimate exceeds p_min (one BV pair's, or its children's / leaf pairs' combined
 //          evidence, as ADB's options say) is decided colliding: its remaining entries are dropped;
 //        - a pair whose queue runs empty is decided not colliding: exactly when every BV pair was
@@ -40,7 +44,8 @@
 // Policies (frame_policy(name); each is one small struct and one registry line in frame_budget.cpp):
 //   adb_probability       the BV pair with the highest ADB estimate among all pairs' queues first: the order
 //                         of one global priority queue over every pair's BV pairs (kept as the maximum over
-//                         the per-pair queues, which is the same order).
+//                         the per-pair queues, which is the same order). Depth first: the pair whose next
+//                         BV pair has the highest estimate.
 //   uncertainty_per_cost  the pair whose best BV pair maximises p (1 - p) / cost: p its estimate, cost the
 //                         expected BV tests to settle it: four per level down to the leaves along the deeper
 //                         of its two nodes (SplitBoth descends both at once, up to four tests per level). A
@@ -120,9 +125,20 @@ class FrameMemory {
   std::vector<Entry> next_;
 };
 
+/// The order of each pair's own traversal (header comment, 3.).
+enum class FrameOrder {
+  best_first,   ///< the most probable queued BV pair next (AdbBestFirst, the paper's)
+  depth_first,  ///< the most probable child of the last expansion next (AdbDepthFirst, as adb_dfs)
+};
+/// "best_first" or "depth_first".
+std::string_view frame_order_name(FrameOrder order);
+/// The order named `name`; std::invalid_argument listing the known names otherwise.
+FrameOrder frame_order(std::string_view name);
+
 struct FrameOptions {
   std::string policy = "adb_probability";  ///< a name of frame_policies()
-  double p_min = 0.9;                      ///< a pair is decided colliding once its estimate exceeds this
+  FrameOrder order = FrameOrder::best_first;
+  double p_min = 0.9;  ///< a pair is decided colliding once its estimate exceeds this
   /// ADB's options for every pair (leaf evidence, confirmation, best_effort_threshold, exact leaves). Its
   /// p_min is not read (the frame's is), and its budget must be empty: the budget is the frame's.
   AdbOptions adb;
@@ -147,7 +163,7 @@ struct PairOutcome {
 /// What a policy sees of an undecided pair with BV pairs queued.
 struct PairStatus {
   std::size_t index = 0;   ///< position in the frame
-  double probability = 0;  ///< the highest estimate in its queue (the BV pair it expands next)
+  double probability = 0;  ///< the estimate of the BV pair it expands next (best first: its queue's highest)
   double cost = 0;         ///< expected BV tests to settle it (header comment); 0 unless the policy uses it
   std::uint64_t expansions = 0;  ///< steps taken so far (BV pairs taken off its queue)
 };
@@ -208,15 +224,16 @@ double levels_below(const Bvh<BV>& tree, std::uint32_t node) {
 }
 
 /// One candidate pair's ADB traversal, resumable: the state query_adb keeps on its stack, kept between
-/// steps. Not movable (the traversal's parts refer to each other): built in place in a std::optional.
-template <TreeVolume BV, ProbabilityDensity D>
+/// steps, in the order of `Queue` (BestFirst or OrderedDepthFirst). Not movable (the traversal's parts refer
+/// to each other): built in place in a std::optional.
+template <TreeVolume BV, ProbabilityDensity D, class Queue>
 class PairRun {
  public:
   using Estimate = NodeEstimate<decltype(density_estimator(std::declval<const Tree<BV, D>&>(),
                                                            std::declval<const Tree<BV, D>&>(),
                                                            std::declval<const RigidTransform&>()))>;
   using Hooks = AdbHooks<BV, Estimate, TriangleLeaves, estimates_in_node_frames<D, BV>>;
-  using Steps = Traversal<BestFirst, SplitBoth, BV, Hooks, TestCap>;
+  using Steps = Traversal<Queue, SplitBoth, BV, Hooks, TestCap>;
 
   PairRun(const FramePair<BV, D>& pair, const AdbOptions& options)
       : context_(VolumeWalker<BV>::make_context(pair.b_to_a)),
@@ -375,26 +392,22 @@ const FrameMemory::Entry* recalled(const FrameMemory* memory, const FramePair<BV
   return memory && pair.identity ? memory->recall(*pair.identity, pair.a, pair.b) : nullptr;
 }
 
-}  // namespace frame_detail
-
-/// Schedules one frame (header comment). Const and thread-safe on shared trees: all state is local, but
-/// for `memory` (FrameMemory: frame-to-frame fronts), which it reads and then updates for the next frame.
-template <TreeVolume BV, ProbabilityDensity D>
-std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs, const FrameOptions& options,
-                                        FrameMemory* memory = nullptr) {
-  using Run = frame_detail::PairRun<BV, D>;
-  BudgetLimit clock(Budget{0, options.budget.deadline_us});  // the deadline counts from here
-  options.validate();
+/// schedule_frame with each pair's traversal in the order of `Queue`; `clock` runs from the call.
+template <class Queue, TreeVolume BV, ProbabilityDensity D>
+std::vector<PairOutcome> schedule_in_order(std::span<const FramePair<BV, D>> pairs,
+                                           const FrameOptions& options, FrameMemory* memory,
+                                           BudgetLimit& clock) {
+  using Run = PairRun<BV, D, Queue>;
   const FramePolicy& policy = frame_policy(options.policy);
   const AdbOptions adb = options.pair_options();
-  for (std::size_t k = 0; k < pairs.size(); ++k) frame_detail::validate_pair(pairs[k], k, adb);
-  if (memory) frame_detail::validate_memory(adb);
+  for (std::size_t k = 0; k < pairs.size(); ++k) validate_pair(pairs[k], k, adb);
+  if (memory) validate_memory(adb);
 
   // Each pair's traversal is set up when its root is tested, in one block allocated up front: a deadline
   // that ends the root round leaves the pairs after it unbuilt (never_begun gives their answers).
   std::vector<std::optional<Run>> runs(pairs.size());
-  frame_detail::TestBudget tests(options.budget.max_bv_tests, pairs.size(), policy.equal_shares);
-  std::priority_queue<frame_detail::Ranked> next;
+  TestBudget tests(options.budget.max_bv_tests, pairs.size(), policy.equal_shares);
+  std::priority_queue<Ranked> next;
   const auto rank = [&](std::size_t k) {
     next.push({policy.priority(runs[k]->status(k, policy.uses_cost)), k});
   };
@@ -402,9 +415,8 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   const auto advance = [&](std::size_t k, bool root) {
     Run& run = root ? runs[k].emplace(pairs[k], adb) : *runs[k];
     const std::uint64_t before = run.bv_tests();
-    const TraversalState progress =
-        root ? run.begin(tests.allowance(k, before), frame_detail::recalled(memory, pairs[k]))
-             : run.step(tests.allowance(k, before));
+    const TraversalState progress = root ? run.begin(tests.allowance(k, before), recalled(memory, pairs[k]))
+                                         : run.step(tests.allowance(k, before));
     tests.spend(run.bv_tests() - before);
     if (progress == TraversalState::Running) rank(k);
     return progress == TraversalState::Stopped && !policy.equal_shares;
@@ -432,7 +444,7 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   outcomes.reserve(runs.size());
   for (std::size_t k = 0; k < runs.size(); ++k) {
     if (!runs[k]) {
-      outcomes.push_back(frame_detail::never_begun(pairs[k], adb, frame_detail::recalled(memory, pairs[k])));
+      outcomes.push_back(never_begun(pairs[k], adb, recalled(memory, pairs[k])));
       continue;
     }
     runs[k]->end();
@@ -444,6 +456,20 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
   }
   if (memory) memory->end_frame();
   return outcomes;
+}
+
+}  // namespace frame_detail
+
+/// Schedules one frame (header comment). Const and thread-safe on shared trees: all state is local, but
+/// for `memory` (FrameMemory: frame-to-frame fronts), which it reads and then updates for the next frame.
+template <TreeVolume BV, ProbabilityDensity D>
+std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs, const FrameOptions& options,
+                                        FrameMemory* memory = nullptr) {
+  BudgetLimit clock(Budget{0, options.budget.deadline_us});  // the deadline counts from here
+  options.validate();
+  if (options.order == FrameOrder::depth_first)
+    return frame_detail::schedule_in_order<OrderedDepthFirst>(pairs, options, memory, clock);
+  return frame_detail::schedule_in_order<BestFirst>(pairs, options, memory, clock);
 }
 
 }  // namespace bvhlab

@@ -170,6 +170,7 @@ struct FrameBudgetSpec {
   std::vector<Budget> budgets;           ///< one run per budget (BV tests and/or microseconds per frame)
   double p_min = 0.9;                    ///< a pair whose estimate reaches it is decided colliding
   int confirm_levels = 0;                ///< AdbOptions::confirm_levels of every pair (0: the paper's rule)
+  std::string order = "best_first";      ///< each pair's traversal order (frame_order: FrameOptions::order)
   bool memory = false;                   ///< frame-to-frame fronts (FrameMemory) across the frames
   std::vector<std::string> hierarchies;  ///< where it runs: as given, else each with a probability density
   [[nodiscard]] bool applies_to(const HierarchySpec& h) const {

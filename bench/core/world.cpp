@@ -138,7 +138,7 @@ std::vector<std::string> parse_names(const Node& node, const std::vector<std::st
 }
 
 FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
-  node.expect_object({"schedules", "budgets", "p_min", "confirm_levels", "memory", "hierarchies"});
+  node.expect_object({"schedules", "budgets", "p_min", "confirm_levels", "order", "memory", "hierarchies"});
   FrameBudgetSpec spec;
   spec.schedules = parse_names(node.child("schedules"), frame_schedule_names());
   spec.budgets = parse_budgets(node.child("budgets"));
@@ -148,6 +148,9 @@ FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
   }
   if (node.has("confirm_levels"))
     spec.confirm_levels = static_cast<int>(node.child("confirm_levels").integer(0, 255));
+  if (node.has("order"))
+    spec.order = node.child("order").choice({std::string(frame_order_name(FrameOrder::best_first)),
+                                             std::string(frame_order_name(FrameOrder::depth_first))});
   if (node.has("memory")) {
     spec.memory = node.child("memory").boolean();
     if (spec.memory && spec.confirm_levels > 0)

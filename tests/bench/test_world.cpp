@@ -203,6 +203,11 @@ TEST_F(WorldTest, OptionsThatDoNotApplyAreRefusedByName) {
                          "memory": true}]})",
                      "", kAnnotated),
          "/world/frame_budgets/0/memory: recalls decisions made by one node pair");
+  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+      "motion": {"type": "random_walk", "frames": 2},
+      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "order": "sideways"}]})",
+                     "", kAnnotated),
+         "/world/frame_budgets/0/order: expected one of best_first, depth_first");
 }
 
 TEST_F(WorldTest, FrameBudgetsOnAHierarchyWithAProbabilityDensityAreKept) {
@@ -345,6 +350,40 @@ TEST_F(WorldTest, AGenerousFrameBudgetWithConfirmLevelsAnswersAsAdbWithThem) {
   EXPECT_GT(compared, 0u);
   EXPECT_GT(changed,
             0u);  // the confirming generations change some answers here, so the match means something
+}
+
+// A depth-first schedule (the entry's "order") names itself so, and with a budget that never runs out each
+// pair runs as adb_dfs with the same options, test for test; the best-first schedule spends other tests.
+TEST_F(WorldTest, ADepthFirstScheduleAnswersAsAdbDfsTestForTest) {
+  const Scene scene = parse(crowded_world(
+      R"([{"bv": "aabb", "annotation": {"type": "adb"}}])",
+      R"([{"type": "adb_dfs", "p_min": 0.9, "confirm_levels": 2}])",
+      R"(, "frame_budgets": [{"schedules": ["adb_probability", "round_robin"], "budgets": [{"bv_tests": 10000000}],
+          "p_min": 0.9, "confirm_levels": 2, "order": "depth_first"},
+          {"schedules": ["adb_probability"], "budgets": [{"bv_tests": 10000000}], "p_min": 0.9, "confirm_levels": 2}])"));
+  const WorldOutput out = run_world(scene, quiet_options());
+  std::map<std::pair<int, std::string>, const WorldSeriesRow*> rows;
+  for (const WorldSeriesRow& row : out.series) rows[{row.frame, row.series}] = &row;
+  std::size_t compared = 0;
+  std::uint64_t depth_first_tests = 0, best_first_tests = 0;
+  for (const WorldSeriesRow& row : out.series) {
+    if (row.schedule.empty()) continue;
+    if (row.schedule.find("depth_first") == std::string::npos) {
+      best_first_tests += row.bv_tests;
+      continue;
+    }
+    EXPECT_TRUE(row.schedule == "adb_probability depth_first confirm_levels=2" ||
+                row.schedule == "round_robin depth_first confirm_levels=2")
+        << row.schedule;
+    const WorldSeriesRow& dfs = *rows.at({row.frame, "adb_dfs p_min=0.9 confirm_levels=2"});
+    EXPECT_EQ(row.answered, dfs.answered) << row.series << " frame " << row.frame;
+    EXPECT_EQ(row.false_pairs, dfs.false_pairs) << row.series << " frame " << row.frame;
+    EXPECT_EQ(row.bv_tests, dfs.bv_tests) << row.series << " frame " << row.frame;
+    if (row.schedule.starts_with("adb_probability")) depth_first_tests += row.bv_tests;
+    compared += row.candidates;
+  }
+  EXPECT_GT(compared, 0u);
+  EXPECT_NE(depth_first_tests, best_first_tests);
 }
 
 // A schedule with frame-to-frame fronts is a series of its own; its memory carries one frame to the next and

@@ -1,6 +1,7 @@
 // The frame scheduler (traversal/frame_budget.hpp): exact answers without a budget, the budget kept in total
 // and per share, best-effort answers on exhaustion, every pair's root tested first, equal_split as the
-// single-pair ADB, the global order against equal shares, and refused options.
+// single-pair ADB, each pair as query_adb in the frame's order (best or depth first), the global order
+// against equal shares, and refused options.
 #include "adb/adb_density.hpp"
 #include "bvh/mesh_io.hpp"
 #include "support/generated_meshes.hpp"
@@ -233,31 +234,41 @@ TEST(FrameBudget, PairsFarApartAreDecidedExactlyAfterOneTest) {
 }
 
 // equal_split runs each pair as the single-pair time-critical ADB under its share.
+/// query_adb in the traversal order a frame's pairs take.
+Result query_in_order(const FramePair<Aabb, AdbDensity>& pair, const AdbOptions& options, FrameOrder order) {
+  return order == FrameOrder::depth_first ? query_adb<AdbDepthFirst>(*pair.a, *pair.b, pair.b_to_a, options)
+                                          : query_adb<AdbBestFirst>(*pair.a, *pair.b, pair.b_to_a, options);
+}
+
 TEST(FrameBudget, EqualSplitIsTheSinglePairAdbUnderItsShare) {
   std::mt19937_64 rng(13);
   const Frame<Aabb> frame = random_frame<Aabb>(rng, 25, 0.2, 1.6);
   const std::uint64_t n = frame.size();
   int flagged = 0;
-  for (const auto& [p_min, budget] : {std::pair{0.9, n}, {0.9, 3 * n + 7}, {0.9, 20 * n + 3}, {1.0, 5 * n}}) {
-    FrameOptions options;
-    options.policy = "equal_split";
-    options.p_min = p_min;
-    options.budget.max_bv_tests = budget;
-    const auto outcomes = schedule(frame, options);
-    for (std::size_t k = 0; k < n; ++k) {
-      AdbOptions single = options.pair_options();
-      single.budget.max_bv_tests = budget / n + (k < budget % n ? 1 : 0);
-      const Result r = query_adb(*frame[k].a, *frame[k].b, frame[k].b_to_a, single);
-      const std::string where = "budget " + std::to_string(budget) + ", pair " + std::to_string(k);
-      EXPECT_EQ(outcomes[k].collides, r.collides) << where;
-      EXPECT_EQ(outcomes[k].probability, r.probability) << where;
-      EXPECT_EQ(outcomes[k].budget_exhausted, r.budget_exhausted) << where;
-      EXPECT_EQ(outcomes[k].exact, r.exact) << where;
-      EXPECT_EQ(outcomes[k].counters.bv_tests, r.counters.bv_tests) << where;
-      EXPECT_EQ(outcomes[k].counters.nodes_visited, r.counters.nodes_visited) << where;
-      flagged += r.budget_exhausted;
+  for (const FrameOrder order : {FrameOrder::best_first, FrameOrder::depth_first})
+    for (const auto& [p_min, budget] :
+         {std::pair{0.9, n}, {0.9, 3 * n + 7}, {0.9, 20 * n + 3}, {1.0, 5 * n}}) {
+      FrameOptions options;
+      options.policy = "equal_split";
+      options.order = order;
+      options.p_min = p_min;
+      options.budget.max_bv_tests = budget;
+      const auto outcomes = schedule(frame, options);
+      for (std::size_t k = 0; k < n; ++k) {
+        AdbOptions single = options.pair_options();
+        single.budget.max_bv_tests = budget / n + (k < budget % n ? 1 : 0);
+        const Result r = query_in_order(frame[k], single, order);
+        const std::string where = std::string(frame_order_name(order)) + ", budget " +
+                                  std::to_string(budget) + ", pair " + std::to_string(k);
+        EXPECT_EQ(outcomes[k].collides, r.collides) << where;
+        EXPECT_EQ(outcomes[k].probability, r.probability) << where;
+        EXPECT_EQ(outcomes[k].budget_exhausted, r.budget_exhausted) << where;
+        EXPECT_EQ(outcomes[k].exact, r.exact) << where;
+        EXPECT_EQ(outcomes[k].counters.bv_tests, r.counters.bv_tests) << where;
+        EXPECT_EQ(outcomes[k].counters.nodes_visited, r.counters.nodes_visited) << where;
+        flagged += r.budget_exhausted;
+      }
     }
-  }
   EXPECT_GT(flagged, 10);
 }
 
@@ -276,6 +287,37 @@ TEST(FrameBudget, WithoutABudgetEveryPolicyGivesAdbsAnswers) {
       EXPECT_EQ(outcomes[k].exact, r.exact) << name << ", pair " << k;
       EXPECT_FALSE(outcomes[k].budget_exhausted) << name << ", pair " << k;
     }
+  }
+}
+
+// Without a budget, each pair runs as query_adb in the frame's order, test for test: the depth-first order
+// is ADB's depth-first query (adb_dfs), with and without confirming generations. The two orders differ in
+// their work on this frame, so the comparison sees which one ran.
+TEST(FrameBudget, WithoutABudgetEachPairRunsAsQueryAdbInTheFramesOrder) {
+  std::mt19937_64 rng(29);
+  const Frame<Aabb> frame = random_frame<Aabb>(rng, 30, 0.3, 1.8);
+  for (const int levels : {0, 2}) {
+    std::uint64_t tests[2] = {0, 0};
+    for (const FrameOrder order : {FrameOrder::best_first, FrameOrder::depth_first})
+      for (const auto& name : policy_names()) {
+        FrameOptions options;
+        options.policy = name;
+        options.order = order;
+        options.p_min = 0.999;
+        options.adb.confirm_levels = static_cast<std::uint8_t>(levels);
+        const auto outcomes = schedule(frame, options);
+        for (std::size_t k = 0; k < frame.size(); ++k) {
+          const Result r = query_in_order(frame[k], options.pair_options(), order);
+          const std::string where = name + " " + std::string(frame_order_name(order)) + ", confirm_levels " +
+                                    std::to_string(levels) + ", pair " + std::to_string(k);
+          EXPECT_EQ(outcomes[k].collides, r.collides) << where;
+          EXPECT_EQ(outcomes[k].probability, r.probability) << where;
+          EXPECT_EQ(outcomes[k].exact, r.exact) << where;
+          EXPECT_EQ(outcomes[k].counters.bv_tests, r.counters.bv_tests) << where;
+        }
+        tests[order == FrameOrder::depth_first] = total_bv_tests(outcomes);
+      }
+    EXPECT_NE(tests[0], tests[1]) << "confirm_levels " << levels;
   }
 }
 
@@ -492,6 +534,18 @@ TEST(FrameBudget, BadOptionsAreRefusedByName) {
   unknown.policy = "fastest";
   refused(unknown, "unknown policy 'fastest'");
   refused(unknown, "adb_probability, uncertainty_per_cost, equal_split, round_robin");
+  try {
+    frame_order("sideways");
+    ADD_FAILURE() << "order 'sideways' not refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown order 'sideways' (known: best_first, depth_first)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(frame_order("depth_first"), FrameOrder::depth_first);
+  FrameOptions no_order;
+  no_order.order = static_cast<FrameOrder>(7);
+  refused(no_order, "order");
   FrameOptions inner;
   inner.adb.budget.max_bv_tests = 10;
   refused(inner, "adb.budget");
