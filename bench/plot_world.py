@@ -47,7 +47,7 @@ def schedule_style(schedule, colors, styles):
 def figure_errors_vs_budget(rows, out):
     budgeted = [r for r in rows if r["schedule"]]
     kinds = sorted({budget_value(r["budget"])[0] for r in budgeted}) or ["bv_tests"]
-    fig, axes = plt.subplots(1, len(kinds), figsize=(5.6 * len(kinds) + 3.2, 4.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(kinds), figsize=(5.6 * len(kinds), 4.4), squeeze=False)
     references = group_by([r for r in rows if not r["schedule"]], lambda r: (r["hierarchy"], r["series"]))
     colors, styles, legend = {}, {}, {}
     for ax, kind in zip(axes[0], kinds):
@@ -77,9 +77,12 @@ def figure_errors_vs_budget(rows, out):
         ax.set_ylim(bottom=0)
         ax.grid(True, alpha=0.3)
     # One legend beside the panels: a schedule keeps its colour and style in both.
-    fig.legend(list(legend.values()), list(legend.keys()), loc="center right", fontsize=7)
+    # The figure is widened by what the legend measures, so long schedule names never cover a panel.
+    drawn = fig.legend(list(legend.values()), list(legend.keys()), loc="center right", fontsize=7)
+    legend_inches = drawn.get_window_extent(fig.canvas.get_renderer()).width / fig.dpi + 0.2
+    fig.set_figwidth(5.6 * len(kinds) + legend_inches)
     fig.suptitle("Pair errors against the frame budget")
-    save(fig, out, dpi=120, rect=(0, 0, 1 - 2.9 / fig.get_figwidth(), 1))
+    save(fig, out, dpi=120, rect=(0, 0, 1 - legend_inches / fig.get_figwidth(), 1))
 
 
 FCL_HIERARCHY = "fcl_obbrss"  # world.hpp: kFclWorldHierarchy
