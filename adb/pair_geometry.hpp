@@ -65,18 +65,24 @@ struct PairGeometry {
   return g;
 }
 
-/// The inputs from boxes in their own frames: each box is [-half, half] there, and B's frame is related to
-/// A's through both frames and the pose.
+/// The inputs from boxes in their own frames, placed as the pair lies: each box is [-half, half] there.
+[[gnu::always_inline]] inline PairGeometry node_frame_geometry(const PlacedBoxes& placed) {
+  if (placed.empty()) return {{}, {}, 0};
+  PairGeometry g{with_min_thickness({-placed.half_a, placed.half_a}),
+                 with_min_thickness({-placed.half_b, placed.half_b}), 0};
+  g.overlap = overlap_volume(g.a, g.b, placed.b_in_a, placed.b_in_a.rotation.cwiseAbs());
+  return g;
+}
+
+/// The same from the two boxes and the pose: B's frame is related to A's through both frames and the pose.
 [[gnu::always_inline]] inline PairGeometry node_frame_geometry(const OrientedBox& a, const OrientedBox& b,
                                                                const RigidTransform& b_to_a) {
   if (a.empty() || b.empty()) return {{}, {}, 0};
   const Mat3 to_a = a.axes.transpose();
-  RigidTransform b_to_a_local;
-  b_to_a_local.rotation = to_a * (b_to_a.rotation * b.axes);
-  b_to_a_local.translation = to_a * (b_to_a.apply(b.center) - a.center);
-  PairGeometry g{with_min_thickness({-a.half, a.half}), with_min_thickness({-b.half, b.half}), 0};
-  g.overlap = overlap_volume(g.a, g.b, b_to_a_local, b_to_a_local.rotation.cwiseAbs());
-  return g;
+  PlacedBoxes placed{a.half, b.half, {}};
+  placed.b_in_a.rotation = to_a * (b_to_a.rotation * b.axes);
+  placed.b_in_a.translation = to_a * (b_to_a.apply(b.center) - a.center);
+  return node_frame_geometry(placed);
 }
 
 /// Density D counts its cells in the nodes' own frames on trees of BV: D says so

@@ -146,10 +146,19 @@ class AdbHooks {
 
   /// Estimated probability of a pair; negative when the volumes do not overlap (provably no contact).
   [[gnu::always_inline]] double evaluate(const Pair& p) {
-    if (!trees_.overlap(p)) return -1;
-    ++trees_.counters.probability_evaluations;
-    const PairGeometry g = geometry(p);
-    return estimate_(g.a, g.b, g.overlap, p.a, p.b);
+    if constexpr (kNodeFrames && FramePlacingVolume<BV>) {
+      // The test places the two boxes in A's box frame; the estimate reads that, not a second placement.
+      PlacedBoxes placed;
+      if (!trees_.overlap(p, placed)) return -1;
+      ++trees_.counters.probability_evaluations;
+      const PairGeometry g = node_frame_geometry(placed);
+      return estimate_(g.a, g.b, g.overlap, p.a, p.b);
+    } else {
+      if (!trees_.overlap(p)) return -1;
+      ++trees_.counters.probability_evaluations;
+      const PairGeometry g = geometry(p);
+      return estimate_(g.a, g.b, g.overlap, p.a, p.b);
+    }
   }
 
   /// Decide, queue (possibly as a candidate), or drop.

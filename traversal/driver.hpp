@@ -219,6 +219,17 @@ class TreePair {
     else
       return Walker::overlap(a, p.a, p.wa, b, p.b, p.wb, context) && leaves.may_touch(p.a, p.b);
   }
+  /// overlap(p), also writing the volumes' placement (a FramePlacingVolume's test computes it anyway).
+  template <class Pair>
+  [[gnu::always_inline]] bool overlap(const Pair& p,
+                                      PlacedBoxes& placed) const requires FramePlacingVolume<BV> {
+    ++counters.bv_tests;
+    const bool volumes = BV::overlap(a.volume(p.a), b.volume(p.b), context, placed);
+    if constexpr (Leaves::kTriangles)
+      return volumes;
+    else
+      return volumes && leaves.may_touch(p.a, p.b);
+  }
   template <class Pair>
   [[gnu::always_inline]] [[nodiscard]] Box box_a(const Pair& p) const {
     return Walker::box(a, p.a, p.wa);

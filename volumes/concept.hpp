@@ -30,6 +30,10 @@
 //                               OBB's axes, centre and half-extents). A volume that has one is a
 //                               `FramedVolume`; the default ADB density lays its grid there instead of on
 //                               bounding_box() (adb/README.md, section 1).
+//   BV::overlap(a, b, ctx, pl)  With oriented_box(): overlap(a, b, ctx) that also writes to `pl`
+//                               (PlacedBoxes&, geometry.hpp) the two boxes as the pair lies, which the test
+//                               computes anyway. A volume that has it is a `FramePlacingVolume`: the ADB
+//                               estimate in the nodes' frames reads that placement instead of its own.
 #pragma once
 
 #include "geometry.hpp"
@@ -60,6 +64,13 @@ concept BoundingVolume = std::is_trivially_copyable_v<BV> && std::is_standard_la
 template <class BV>
 concept FramedVolume = BoundingVolume<BV> && requires(const BV& a) {
   { a.oriented_box() } -> std::same_as<OrientedBox>;
+};
+
+/// A framed volume whose overlap test hands on the boxes' placement (the optional 4-argument overlap above).
+template <class BV>
+concept FramePlacingVolume = FramedVolume<BV> &&
+    requires(const BV& a, const BV& b, const typename BV::PairContext& context, PlacedBoxes& placed) {
+  { BV::overlap(a, b, context, placed) } -> std::same_as<bool>;
 };
 
 /// Concept `HierarchicalVolume<HV>`: a node volume stored relative to its parent's, as in Zachmann's

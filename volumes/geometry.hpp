@@ -107,4 +107,15 @@ struct RigidTransform {
   }
 };
 
+/// Two boxes in frames of their own, as a pair lies: each one's half-extents, and B's box frame in A's box
+/// frame (B's axes as columns and B's centre, in A's box coordinates). What an oriented box's overlap test
+/// computes first, handed on to the ADB estimate in the nodes' frames (volumes/concept.hpp).
+struct PlacedBoxes {
+  Vec3 half_a = Vec3::Constant(-1);
+  Vec3 half_b = Vec3::Constant(-1);
+  RigidTransform b_in_a;
+
+  [[nodiscard]] bool empty() const { return (half_a.array() < 0).any() || (half_b.array() < 0).any(); }
+};
+
 }  // namespace bvhlab

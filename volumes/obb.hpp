@@ -103,33 +103,13 @@ struct Obb {
   }
 
   [[gnu::flatten]] static bool overlap(const Obb& a, const Obb& b, const PairContext& c) {
-    const Mat3 ra = axes_of(a.orientation), rb = axes_of(b.orientation);
-    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center), ha = to_vec(a.half), hb = to_vec(b.half);
-    const auto rotation = c.rotation.map();
-    // B's axes (columns) and the centre offset in A's box frame.
-    const Mat3 m = ra.transpose() * (rotation * rb);
-    const Vec3 t = ra.transpose() * (rotation * cb + to_vec(c.translation) - ca);
-    const Mat3 abs_m = m.cwiseAbs().array() + Scalar(8) * std::numeric_limits<Scalar>::epsilon();
-
-    const double slack = 64 * std::numeric_limits<double>::epsilon() *
-                         (a.magnitude() + b.magnitude() + c.translation_magnitude);
-    double gap = -std::numeric_limits<double>::infinity();  // largest (|T . L| - radii) over the axes
-    for (int i = 0; i < 3; ++i) gap = std::max(gap, std::abs(t[i]) - ha[i] - abs_m.row(i).dot(hb));
-    for (int j = 0; j < 3; ++j) gap = std::max(gap, std::abs(t.dot(m.col(j))) - abs_m.col(j).dot(ha) - hb[j]);
-    // One branch: most pairs a traversal tests are separated by a face axis, so skip the 9 edge axes.
-    if (gap > slack) return false;
-    for (int i = 0; i < 3; ++i) {
-      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
-      for (int j = 0; j < 3; ++j) {
-        const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-        // L = a_i x b_j in A's frame.
-        const double distance = std::abs(t[i2] * m(i1, j) - t[i1] * m(i2, j));
-        const double radius_a = ha[i1] * abs_m(i2, j) + ha[i2] * abs_m(i1, j);
-        const double radius_b = hb[j1] * abs_m(i, j2) + hb[j2] * abs_m(i, j1);
-        gap = std::max(gap, distance - radius_a - radius_b);
-      }
-    }
-    return gap <= slack;
+    return test(a, b, c, nullptr);
+  }
+  /// The same test, also handing on the placement it computes (FramePlacingVolume): for the ADB estimate
+  /// in the nodes' frames, which would otherwise compute it again.
+  [[gnu::flatten]] static bool overlap(const Obb& a, const Obb& b, const PairContext& c,
+                                       PlacedBoxes& placed) {
+    return test(a, b, c, &placed);
   }
 
   [[nodiscard]] bool empty() const { return half[0] < 0; }
@@ -168,6 +148,39 @@ struct Obb {
   }
 
  private:
+  // The 15-axis test; with `placed`, what it computed of the placement is written there.
+  [[gnu::always_inline]] static bool test(const Obb& a, const Obb& b, const PairContext& c,
+                                          PlacedBoxes* placed) {
+    const Mat3 ra = axes_of(a.orientation), rb = axes_of(b.orientation);
+    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center), ha = to_vec(a.half), hb = to_vec(b.half);
+    const auto rotation = c.rotation.map();
+    // B's axes (columns) and the centre offset in A's box frame.
+    const Mat3 m = ra.transpose() * (rotation * rb);
+    const Vec3 t = ra.transpose() * (rotation * cb + to_vec(c.translation) - ca);
+    if (placed) *placed = {ha, hb, {m, t}};
+    const Mat3 abs_m = m.cwiseAbs().array() + Scalar(8) * std::numeric_limits<Scalar>::epsilon();
+
+    const double slack = 64 * std::numeric_limits<double>::epsilon() *
+                         (a.magnitude() + b.magnitude() + c.translation_magnitude);
+    double gap = -std::numeric_limits<double>::infinity();  // largest (|T . L| - radii) over the axes
+    for (int i = 0; i < 3; ++i) gap = std::max(gap, std::abs(t[i]) - ha[i] - abs_m.row(i).dot(hb));
+    for (int j = 0; j < 3; ++j) gap = std::max(gap, std::abs(t.dot(m.col(j))) - abs_m.col(j).dot(ha) - hb[j]);
+    // One branch: most pairs a traversal tests are separated by a face axis, so skip the 9 edge axes.
+    if (gap > slack) return false;
+    for (int i = 0; i < 3; ++i) {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+      for (int j = 0; j < 3; ++j) {
+        const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+        // L = a_i x b_j in A's frame.
+        const double distance = std::abs(t[i2] * m(i1, j) - t[i1] * m(i2, j));
+        const double radius_a = ha[i1] * abs_m(i2, j) + ha[i2] * abs_m(i1, j);
+        const double radius_b = hb[j1] * abs_m(i, j2) + hb[j2] * abs_m(i, j1);
+        gap = std::max(gap, distance - radius_a - radius_b);
+      }
+    }
+    return gap <= slack;
+  }
+
   // One expression for fit and contains, so a fitted point always tests as contained.
   static Vec3 local_coordinates(const Mat3& axes, const Vec3& center, const Vec3& p) {
     return axes.transpose() * (p - center);

@@ -279,6 +279,38 @@ TYPED_TEST(VolumeConformance, IdenticalVolumesOverlapAtIdentityAndSeparateWhenSh
   }
 }
 
+// The OBB's test hands on the boxes' placement (FramePlacingVolume, read by the ADB estimate in the nodes'
+// frames): it answers as the plain test and places both boxes as the pair lies, each one's half-extents and
+// B's axes and centre in A's box frame.
+static_assert(FramePlacingVolume<Obb>);
+TEST(ObbPlacement, ThePlacingTestAnswersAsThePlainOneAndPlacesBothBoxes) {
+  std::mt19937_64 rng(37);
+  const auto sets = sample_point_sets(7);
+  int overlapping = 0, apart = 0;
+  for (std::size_t k = 0; k < sets.size(); ++k) {
+    const Obb a = Obb::fit(sets[k].points), b = Obb::fit(sets[(k + 2) % sets.size()].points);
+    const OrientedBox oa = a.oriented_box(), ob = b.oriented_box();
+    for (int j = 0; j < 20; ++j) {
+      RigidTransform pose;
+      pose.rotation = random_rotation(rng);
+      pose.translation = (0.1 * j) * gaussian_vec(rng) * (1 + oa.half.norm() + ob.half.norm());
+      const auto context = Obb::make_context(pose);
+      PlacedBoxes placed;
+      const bool answer = Obb::overlap(a, b, context, placed);
+      ASSERT_EQ(answer, Obb::overlap(a, b, context)) << sets[k].label << ", pose " << j;
+      (answer ? overlapping : apart) += 1;
+      EXPECT_EQ(placed.half_a, oa.half) << sets[k].label;
+      EXPECT_EQ(placed.half_b, ob.half) << sets[k].label;
+      const Mat3 rotation = oa.axes.transpose() * pose.rotation * ob.axes;
+      const Vec3 centre = oa.local(pose.apply(ob.center));
+      EXPECT_LT((placed.b_in_a.rotation - rotation).cwiseAbs().maxCoeff(), 1e-12) << sets[k].label;
+      EXPECT_LT((placed.b_in_a.translation - centre).norm(), 1e-12 * (1 + centre.norm())) << sets[k].label;
+    }
+  }
+  EXPECT_GT(overlapping, 10);
+  EXPECT_GT(apart, 10);
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Bounding box and volume against Monte Carlo sampling of contains().
 
