@@ -136,16 +136,16 @@ std::string_view frame_order_name(FrameOrder order);
 FrameOrder frame_order(std::string_view name);
 
 struct FrameOptions {
-  std::string policy = "adb_probability";  ///< a name of frame_policies()
-  FrameOrder order = FrameOrder::best_first;
-  double p_min = 0.9;  ///< a pair is decided colliding once its estimate exceeds this
+  std::string policy = "adb_probability";     ///< a name of frame_policies()
+  FrameOrder order = FrameOrder::best_first;  ///< each pair's traversal order (header comment, 3.)
+  double p_min = 0.9;                         ///< a pair is decided colliding once its estimate exceeds this
   /// ADB's options for every pair (leaf evidence, confirmation, best_effort_threshold, exact leaves). Its
   /// p_min is not read (the frame's is), and its budget must be empty: the budget is the frame's.
   AdbOptions adb;
   Budget budget;  ///< for the whole frame; unlimited when empty
 
   /// Throws std::invalid_argument naming the first bad value (p_min outside (0, 1], a negative or NaN
-  /// deadline, a budget in adb, an unknown policy, bad ADB options).
+  /// deadline, a budget in adb, an unknown policy or order, bad ADB options).
   void validate() const;
   /// The ADB options each pair runs with: adb, with the frame's p_min and no budget of its own.
   [[nodiscard]] AdbOptions pair_options() const;
