@@ -320,5 +320,34 @@ TEST(AdbTraversal, ASmallBoxInsideASlantedTrianglesObbIsFoundOnObbTrees) {
   }
 }
 
+// On OBB trees the estimate reads the placement the OBB test computed (Obb::overlap with a PlacedBoxes):
+// the root's estimate, what a query stopped after its first test reports, is the model's on the two root
+// boxes placed from their own frames and the pose.
+TEST(AdbTraversal, OnObbTreesTheEstimateReadsTheRootBoxesAsThePairLies) {
+  const auto a = annotate_adb(Bvh<Obb>::build(testing::make_torus(0.7, 0.25, 40, 20)), 2, kDefaultAdbTau);
+  const auto b = annotate_adb(Bvh<Obb>::build(testing::make_random_soup(400, 0.1, 5)), 2, kDefaultAdbTau);
+  const auto estimate = AdbDensity::estimator(a.density, b.density);
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> offset(-0.6, 0.6), angle(0, 3);
+  int compared = 0;
+  for (int k = 0; k < 20; ++k) {
+    RigidTransform pose;
+    pose.rotation =
+        Eigen::AngleAxisd(angle(rng), Vec3(offset(rng), 1, offset(rng)).normalized()).toRotationMatrix();
+    pose.translation = Vec3(offset(rng), offset(rng), offset(rng));
+    const PairGeometry g =
+        node_frame_geometry(a.bvh.volume(0).oriented_box(), b.bvh.volume(0).oriented_box(), pose);
+    AdbOptions options;
+    options.p_min = 1;  // nothing decides: the first test's estimate is what the stopped query reports
+    options.budget.max_bv_tests = 1;
+    const Result r = query_adb(a, b, pose, options);
+    if (!r.budget_exhausted) continue;  // the root volumes apart: an exact no
+    EXPECT_NEAR(r.probability, estimate(0, g.a, 0, g.b, g.overlap), 1e-12) << "pose " << k;
+    EXPECT_GT(r.probability, 0.0) << "pose " << k;
+    ++compared;
+  }
+  EXPECT_GT(compared, 10);
+}
+
 }  // namespace
 }  // namespace bvhlab
