@@ -167,46 +167,30 @@ TEST_F(WorldTest, OptionsThatDoNotApplyAreRefusedByName) {
   expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
       "motion": {"type": "random_walk", "frames": 2}, "broad_phases": ["octree"]})"),
          "/world/broad_phases/0: expected one of brute_force, sweep_and_prune, dynamic_aabb_tree");
-  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
+  // A world with one frame_budgets entry (equal_split at 100 BV tests) and `fields` added to it.
+  const auto budget_entry = [](const std::string& fields, const std::string& hierarchies) {
+    return world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
       "motion": {"type": "random_walk", "frames": 2},
-      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}]}]})",
-                     "", kPlain),
-         "/world/frame_budgets/0: no hierarchy carries a probability density");
-  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
-      "motion": {"type": "random_walk", "frames": 2},
-      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "hierarchies": ["obb"]}]})",
-                     "", kAnnotated),
+      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}])" +
+                           fields + "}]}",
+                       "", hierarchies);
+  };
+  expect(budget_entry("", kPlain), "/world/frame_budgets/0: no hierarchy carries a probability density");
+  expect(budget_entry(R"(, "hierarchies": ["obb"])", kAnnotated),
          "/world/frame_budgets/0/hierarchies/0: hierarchy \"obb\" carries no probability density");
   expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
       "motion": {"type": "random_walk", "frames": 2},
       "frame_budgets": [{"schedules": ["greedy"], "budgets": [{"bv_tests": 100}], "hierarchies": ["aabb"]}]})",
                      "", kAnnotated),
          "/world/frame_budgets/0/schedules/0: expected one of adb_probability");
-  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
-      "motion": {"type": "random_walk", "frames": 2},
-      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "confirm_levels": 256}]})",
-                     "", kAnnotated),
-         "/world/frame_budgets/0/confirm_levels: ");
-  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
-      "motion": {"type": "random_walk", "frames": 2},
-      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "confirm_levels": 1.5}]})",
-                     "", kAnnotated),
+  expect(budget_entry(R"(, "confirm_levels": 256)", kAnnotated), "/world/frame_budgets/0/confirm_levels: ");
+  expect(budget_entry(R"(, "confirm_levels": 1.5)", kAnnotated),
          "/world/frame_budgets/0/confirm_levels: expected an integer");
-  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
-      "motion": {"type": "random_walk", "frames": 2},
-      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "memory": "yes"}]})",
-                     "", kAnnotated),
+  expect(budget_entry(R"(, "memory": "yes")", kAnnotated),
          "/world/frame_budgets/0/memory: expected true or false");
-  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
-      "motion": {"type": "random_walk", "frames": 2},
-      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "confirm_levels": 1,
-                         "memory": true}]})",
-                     "", kAnnotated),
+  expect(budget_entry(R"(, "confirm_levels": 1, "memory": true)", kAnnotated),
          "/world/frame_budgets/0/memory: recalls decisions made by one node pair");
-  expect(world_scene(R"({"instances": [{"object": "torus"}], "region": {"min": [0,0,0], "max": [1,1,1]},
-      "motion": {"type": "random_walk", "frames": 2},
-      "frame_budgets": [{"schedules": ["equal_split"], "budgets": [{"bv_tests": 100}], "order": "sideways"}]})",
-                     "", kAnnotated),
+  expect(budget_entry(R"(, "order": "sideways")", kAnnotated),
          "/world/frame_budgets/0/order: expected one of best_first, depth_first");
 }
 
