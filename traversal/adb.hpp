@@ -245,6 +245,16 @@ class AdbHooks {
     return decided_at_;
   }
 
+  /// A node pair remembered from the previous frame's decision (FrameMemory) decides "collision" again iff
+  /// its estimate still exceeds p_min. Under confirm_levels it was the last pair of a confirmed chain, so
+  /// it is not asked to confirm again.
+  bool decides_again(const Pair& p) {
+    const double probability = evaluate(p);
+    if (!(probability > options_.p_min)) return false;
+    decide(probability, p);
+    return true;
+  }
+
  private:
   [[gnu::always_inline]] PairGeometry geometry(const Pair& p) const {
     if constexpr (kNodeFrames)

@@ -95,12 +95,15 @@ struct FramePair {
 /// next frame, when the pair is a candidate again on the same trees and its root test leaves it open, that
 /// node pair is tested next and decides "collision" at once if its estimate still exceeds p_min: one BV test
 /// where the descent from the root took many, since contacts persist over the frames of a continuous
-/// motion. Otherwise the pair goes on from its root, one test later. A pair the budget leaves without a
-/// root test answers the remembered estimate as its best effort (flagged), not 0. Such a decision applies
-/// ADB's rule to one node pair without its ancestors: where a child's volume is not inside its parent's
-/// (OBBs), the descent from the root might have proved the pair apart first; the errors are measured as
-/// any schedule's. Identities must be unique within a frame: two remembered pairs with one identity are
-/// refused. Keep one object per motion and schedule; a copy keeps a state to return to (a warm-up run).
+/// motion. Otherwise the pair goes on from its root, one test later. Under confirm_levels the node pair kept
+/// is the last of the confirmed chain; recalled, it decides on its own estimate and is not asked to confirm
+/// again (a new chain below it cost about as much as the descent it saves). A pair decided by combined leaf
+/// evidence leaves nothing. A pair the budget leaves without a root test answers the remembered estimate as
+/// its best effort (flagged), not 0. Such a decision applies ADB's rule to one node pair without its
+/// ancestors: where a child's volume is not inside its parent's (OBBs), the descent from the root might
+/// have proved the pair apart first; the errors are measured as any schedule's. Identities must be unique
+/// within a frame: two remembered pairs with one identity are refused. Keep one object per motion and
+/// schedule; a copy keeps a state to return to (a warm-up run).
 class FrameMemory {
  public:
   struct Entry {
@@ -240,7 +243,6 @@ class PairRun {
         trees_(pair.a->bvh, pair.b->bvh, pair.b_to_a, context_, result_.counters),
         estimate_{density_estimator(*pair.a, *pair.b, pair.b_to_a)},
         hooks_(trees_, result_, options, estimate_),
-        p_min_(options.p_min),
         state_(pair.a->bvh.empty() || pair.b->bvh.empty() ? TraversalState::Done : TraversalState::Stopped) {}
   PairRun(const PairRun&) = delete;
   PairRun& operator=(const PairRun&) = delete;
@@ -304,8 +306,7 @@ class PairRun {
     } else {
       if (i >= trees_.a.nodes().size() || j >= trees_.b.nodes().size()) return false;
       typename Hooks::Pair pair{{}, i, j, {}, {}, {}};
-      const double probability = hooks_.evaluate(pair);
-      return probability > p_min_ && hooks_.admit(pair, probability) == Admission::Decide;
+      return hooks_.decides_again(pair);
     }
   }
 
@@ -316,7 +317,6 @@ class PairRun {
   Hooks hooks_;
   typename Steps::Queue queue_;
   typename Steps::Staged staged_;
-  double p_min_;
   TraversalState state_;  ///< Stopped until begun; Done at once for an empty tree
 };
 
@@ -378,12 +378,12 @@ class TestBudget {
   bool equal_shares_;
 };
 
-/// A memory recalls decisions made by one node pair's own estimate (FrameMemory).
+/// A memory recalls decisions made by one node pair's estimate (FrameMemory).
 inline void validate_memory(const AdbOptions& options) {
-  if (options.confirm_levels > 0 || options.confirm_with_children || options.exact_leaves)
+  if (options.confirm_with_children || options.exact_leaves)
     throw std::invalid_argument(
-        "frame memory: recalls decisions made by one node pair's estimate; not with confirm_levels, "
-        "confirm_with_children or exact leaves");
+        "frame memory: recalls decisions made by one node pair's estimate; not with confirm_with_children "
+        "or exact leaves");
 }
 
 /// The previous frame's decision for pair k, if any (FrameMemory::recall).

@@ -151,11 +151,7 @@ FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
   if (node.has("order"))
     spec.order = node.child("order").choice({std::string(frame_order_name(FrameOrder::best_first)),
                                              std::string(frame_order_name(FrameOrder::depth_first))});
-  if (node.has("memory")) {
-    spec.memory = node.child("memory").boolean();
-    if (spec.memory && spec.confirm_levels > 0)
-      node.child("memory").fail("recalls decisions made by one node pair; not with \"confirm_levels\"");
-  }
+  if (node.has("memory")) spec.memory = node.child("memory").boolean();
   std::vector<std::string> hierarchy_names;
   for (const auto& h : scene.hierarchies) hierarchy_names.push_back(h.name);
   auto probability = [&](const HierarchySpec& h) {

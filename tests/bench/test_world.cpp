@@ -188,8 +188,6 @@ TEST_F(WorldTest, OptionsThatDoNotApplyAreRefusedByName) {
          "/world/frame_budgets/0/confirm_levels: expected an integer");
   expect(budget_entry(R"(, "memory": "yes")", kAnnotated),
          "/world/frame_budgets/0/memory: expected true or false");
-  expect(budget_entry(R"(, "confirm_levels": 1, "memory": true)", kAnnotated),
-         "/world/frame_budgets/0/memory: recalls decisions made by one node pair");
   expect(budget_entry(R"(, "order": "sideways")", kAnnotated),
          "/world/frame_budgets/0/order: expected one of best_first, depth_first");
 }
@@ -371,8 +369,8 @@ TEST_F(WorldTest, ADepthFirstScheduleAnswersAsAdbDfsTestForTest) {
 }
 
 // A schedule with frame-to-frame fronts is a series of its own; its memory carries one frame to the next and
-// saves tests on a slow walk, and the warm-up run does not feed it (the timed run would recall the very
-// frame it answers, and spend fewer tests with a warm-up than without).
+// saves tests on a slow walk (also under confirm_levels), and the warm-up run does not feed it (the timed run
+// would recall the very frame it answers, and spend fewer tests with a warm-up than without).
 TEST_F(WorldTest, AFrameMemoryCarriesFramesOnAndTheWarmUpDoesNotFeedIt) {
   const Scene scene = parse(R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "ring.obj"}],
       "hierarchies": [{"bv": "aabb", "annotation": {"type": "adb"}}], "strategies": [{"type": "exact"}],
@@ -381,15 +379,21 @@ TEST_F(WorldTest, AFrameMemoryCarriesFramesOnAndTheWarmUpDoesNotFeedIt) {
         "motion": {"type": "random_walk", "frames": 8, "seed": 11, "step": 0.02, "turn_deg": 1},
         "frame_budgets": [{"schedules": ["adb_probability"], "budgets": [{"bv_tests": 10000000}], "p_min": 0.99},
                           {"schedules": ["adb_probability"], "budgets": [{"bv_tests": 10000000}], "p_min": 0.99,
-                           "memory": true}]}})");
+                           "memory": true},
+                          {"schedules": ["adb_probability"], "budgets": [{"bv_tests": 10000000}], "p_min": 0.9,
+                           "confirm_levels": 2, "order": "depth_first"},
+                          {"schedules": ["adb_probability"], "budgets": [{"bv_tests": 10000000}], "p_min": 0.9,
+                           "confirm_levels": 2, "order": "depth_first", "memory": true}]}})");
   RunOptions warm = quiet_options();
   warm.warmup_queries = 1;
   const WorldOutput cold = run_world(scene, quiet_options()), warmed = run_world(scene, warm);
   std::map<std::string, std::uint64_t> tests;
   for (const WorldSeriesRow& row : cold.series)
     if (!row.schedule.empty()) tests[row.schedule] += row.bv_tests;
-  ASSERT_EQ(tests.size(), 2u);
+  ASSERT_EQ(tests.size(), 4u);
   EXPECT_LT(tests.at("adb_probability memory"), tests.at("adb_probability"));
+  EXPECT_LT(tests.at("adb_probability depth_first confirm_levels=2 memory"),
+            tests.at("adb_probability depth_first confirm_levels=2"));
   for (std::size_t k = 0; k < cold.series.size(); ++k) {
     if (cold.series[k].schedule.empty()) continue;
     EXPECT_EQ(warmed.series[k].bv_tests, cold.series[k].bv_tests)

@@ -449,6 +449,33 @@ TEST(FrameMemory, TheSameFrameAgainDecidesItsCollisionsAfterTheRootAndOneTest) {
   }
 }
 
+// Under confirm_levels a collision is decided by the last pair of a confirmed chain; the memory keeps that
+// pair, which decides again on its own estimate, without a second chain. Collisions decided by the leaf
+// pairs' combined evidence leave nothing and run as before.
+TEST(FrameMemory, UnderConfirmLevelsTheChainsLastPairDecidesAgainAlone) {
+  const Frame<Aabb> frame = named_close_frame(15);
+  for (const FrameOrder order : {FrameOrder::best_first, FrameOrder::depth_first}) {
+    FrameOptions options;
+    options.order = order;
+    options.adb.confirm_levels = 2;
+    const std::string name(frame_order_name(order));
+    FrameMemory memory;
+    const auto first = schedule_frame<Aabb, AdbDensity>(frame, options, &memory);
+    std::size_t chains = 0;  // collisions remembered below the root, where a chain of three pairs decided
+    const auto again = schedule_frame<Aabb, AdbDensity>(frame, options, &memory);
+    for (std::size_t k = 0; k < frame.size(); ++k) {
+      const std::string where = name + ", pair " + std::to_string(k);
+      EXPECT_EQ(again[k].collides, first[k].collides) << where;
+      const bool recalled = first[k].collides && again[k].counters.bv_tests <= 2;
+      if (!recalled) {
+        EXPECT_EQ(again[k].counters.bv_tests, first[k].counters.bv_tests) << where;
+      }
+      chains += recalled && first[k].counters.bv_tests > 8;  // a chain of two generations costs more
+    }
+    EXPECT_GT(chains, 3u) << name << ": the test needs collisions decided by chains";
+  }
+}
+
 TEST(FrameMemory, APairWithoutARootTestAnswersWhatItRemembers) {
   const Frame<Aabb> frame = named_close_frame(12);
   FrameOptions options;
@@ -499,12 +526,16 @@ void expect_refused(Run&& run, const std::string& name) {
   ADD_FAILURE() << "not refused: " << name;
 }
 
-TEST(FrameMemory, ConfirmationsAndRepeatedIdentitiesAreRefused) {
+TEST(FrameMemory, ChildConfirmationExactLeavesAndRepeatedIdentitiesAreRefused) {
   Frame<Aabb> frame = named_close_frame(14);
   FrameMemory memory;
   FrameOptions confirming;
-  confirming.adb.confirm_levels = 1;
-  expect_refused([&] { schedule_frame<Aabb, AdbDensity>(frame, confirming, &memory); }, "confirm_levels");
+  confirming.adb.confirm_with_children = true;
+  expect_refused([&] { schedule_frame<Aabb, AdbDensity>(frame, confirming, &memory); },
+                 "confirm_with_children");
+  FrameOptions exact_leaves;
+  exact_leaves.adb.exact_leaves = true;
+  expect_refused([&] { schedule_frame<Aabb, AdbDensity>(frame, exact_leaves, &memory); }, "exact leaves");
   for (auto& pair : frame) pair.identity = 7;
   expect_refused([&] { schedule_frame<Aabb, AdbDensity>(frame, FrameOptions{}, &memory); }, "identity 7");
   EXPECT_EQ(memory.size(), 0u);
