@@ -66,6 +66,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <queue>
@@ -408,8 +409,9 @@ std::vector<PairOutcome> schedule_in_order(std::span<const FramePair<BV, D>> pai
   std::vector<std::optional<Run>> runs(pairs.size());
   TestBudget tests(options.budget.max_bv_tests, pairs.size(), policy.equal_shares);
   std::priority_queue<Ranked> next;
-  const auto rank = [&](std::size_t k) {
-    next.push({policy.priority(runs[k]->status(k, policy.uses_cost)), k});
+  std::vector<Ranked> open;  // the root round's pairs left running, ranked once the round is over
+  const auto ranked = [&](std::size_t k) {
+    return Ranked{policy.priority(runs[k]->status(k, policy.uses_cost)), k};
   };
   // Runs pair k's root or next step; true when the frame's budget of BV tests has run out.
   const auto advance = [&](std::size_t k, bool root) {
@@ -418,13 +420,25 @@ std::vector<PairOutcome> schedule_in_order(std::span<const FramePair<BV, D>> pai
     const TraversalState progress = root ? run.begin(tests.allowance(k, before), recalled(memory, pairs[k]))
                                          : run.step(tests.allowance(k, before));
     tests.spend(run.bv_tests() - before);
-    if (progress == TraversalState::Running) rank(k);
+    if (progress == TraversalState::Running) {
+      if (root)
+        open.push_back({0, k});
+      else
+        next.push(ranked(k));
+    }
     return progress == TraversalState::Stopped && !policy.equal_shares;
   };
 
   bool exhausted = false;
-  for (std::size_t k = 0; k < runs.size() && !exhausted; ++k)  // 2. every pair's root first
+  // 2. every pair's root first; under a tight deadline the ranking (for uncertainty_per_cost, two
+  // logarithms a pair) would take the time of root tests, so it follows the round
+  open.reserve(runs.size());
+  for (std::size_t k = 0; k < runs.size() && !exhausted; ++k)
     exhausted = !clock.allows_pop() || advance(k, true);
+  if (!exhausted && clock.allows_pop()) {
+    for (Ranked& r : open) r = ranked(r.index);
+    next = std::priority_queue<Ranked>(std::less<Ranked>{}, std::move(open));
+  }
   const bool shared_deadline = policy.equal_shares && options.budget.deadline_us > 0;
   const double share_us =
       options.budget.deadline_us / static_cast<double>(std::max<std::size_t>(runs.size(), 1));
