@@ -2,6 +2,7 @@
 #include "frame_budget.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -89,15 +90,25 @@ const FramePolicy& frame_policy(std::string_view name) {
   throw std::invalid_argument("frame: unknown policy '" + std::string(name) + "' (known: " + known + ")");
 }
 
+namespace {
+constexpr FrameOrder kOrders[] = {FrameOrder::best_first, FrameOrder::depth_first};
+}  // namespace
+
+std::span<const FrameOrder> frame_orders() {
+  return kOrders;
+}
+
 std::string_view frame_order_name(FrameOrder order) {
   return order == FrameOrder::depth_first ? "depth_first" : "best_first";
 }
 
 FrameOrder frame_order(std::string_view name) {
-  for (FrameOrder order : {FrameOrder::best_first, FrameOrder::depth_first})
+  std::string known;
+  for (FrameOrder order : frame_orders()) {
     if (frame_order_name(order) == name) return order;
-  throw std::invalid_argument("frame: unknown order '" + std::string(name) +
-                              "' (known: best_first, depth_first)");
+    known += (known.empty() ? "" : ", ") + std::string(frame_order_name(order));
+  }
+  throw std::invalid_argument("frame: unknown order '" + std::string(name) + "' (known: " + known + ")");
 }
 
 void FrameOptions::validate() const {
@@ -110,7 +121,7 @@ void FrameOptions::validate() const {
     throw std::invalid_argument(
         "frame: adb.budget must be empty; the frame's budget is FrameOptions::budget");
   frame_policy(policy);
-  if (order != FrameOrder::best_first && order != FrameOrder::depth_first)
+  if (std::find(kOrders, std::end(kOrders), order) == std::end(kOrders))
     throw std::invalid_argument("frame: order is neither best_first nor depth_first");
   pair_options().validate();
 }

@@ -134,6 +134,8 @@ enum class FrameOrder {
   best_first,   ///< the most probable queued BV pair next (AdbBestFirst, the paper's)
   depth_first,  ///< the most probable child of the last expansion next (AdbDepthFirst, as adb_dfs)
 };
+/// Every order, in a fixed order.
+std::span<const FrameOrder> frame_orders();
 /// "best_first" or "depth_first".
 std::string_view frame_order_name(FrameOrder order);
 /// The order named `name`; std::invalid_argument listing the known names otherwise.

@@ -25,6 +25,12 @@ std::vector<std::string> frame_schedule_names() {
   return names;
 }
 
+std::vector<std::string> frame_order_names() {
+  std::vector<std::string> names;
+  for (FrameOrder order : frame_orders()) names.emplace_back(frame_order_name(order));
+  return names;
+}
+
 std::vector<std::string> object_names(const Scene& scene) {
   std::vector<std::string> names;
   for (const auto& o : scene.objects) names.push_back(o.name);
@@ -148,9 +154,7 @@ FrameBudgetSpec parse_frame_budget(const Node& node, const Scene& scene) {
   }
   if (node.has("confirm_levels"))
     spec.confirm_levels = static_cast<int>(node.child("confirm_levels").integer(0, 255));
-  if (node.has("order"))
-    spec.order = node.child("order").choice({std::string(frame_order_name(FrameOrder::best_first)),
-                                             std::string(frame_order_name(FrameOrder::depth_first))});
+  if (node.has("order")) spec.order = node.child("order").choice(frame_order_names());
   if (node.has("memory")) spec.memory = node.child("memory").boolean();
   std::vector<std::string> hierarchy_names;
   for (const auto& h : scene.hierarchies) hierarchy_names.push_back(h.name);
