@@ -1,6 +1,7 @@
 #include "adb/point_density.hpp"
 
 #include "adb/annotate.hpp"
+#include "adb/pair_geometry.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -78,28 +79,75 @@ std::uint8_t count_cells(const Box& box, int grid, std::span<const double> cell_
       std::count_if(cell_areas.begin(), cell_areas.end(), [&](double a) { return a > 0 && a >= threshold; }));
 }
 
+namespace {
+
+/// The checks both count functions share; then count(i, points, areas) for every node holding points.
+template <class CountNode>
+std::vector<std::uint8_t> count_nodes(const char* what, std::size_t nodes,
+                                      std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
+                                      std::span<const Vec3> points, std::span<const double> areas, double tau,
+                                      CountNode&& count) {
+  if (nodes != node_ranges.size())
+    throw std::invalid_argument(std::string(what) + ": " + std::to_string(nodes) + " boxes for " +
+                                std::to_string(node_ranges.size()) + " nodes");
+  if (points.size() != areas.size())
+    throw std::invalid_argument(std::string(what) + ": areas and points differ in number");
+  if (!(tau > 0) || !std::isfinite(tau))
+    throw std::invalid_argument(std::string(what) + ": tau must be finite and > 0");
+  std::vector<std::uint8_t> out(nodes, 0);
+  for (std::size_t i = 0; i < nodes; ++i) {
+    const auto [first, last] = node_ranges[i];
+    if (first > last || last > points.size())
+      throw std::invalid_argument(std::string(what) + ": node " + std::to_string(i) +
+                                  " has a range past the points");
+    if (first == last) continue;
+    out[i] = count(i, points.subspan(first, last - first), areas.subspan(first, last - first));
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> point_cell_counts(
     std::span<const Box> node_boxes, std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
     std::span<const Vec3> points, std::span<const double> areas, int grid, double tau) {
-  if (node_boxes.size() != node_ranges.size())
-    throw std::invalid_argument("point_cell_counts: " + std::to_string(node_boxes.size()) + " boxes for " +
-                                std::to_string(node_ranges.size()) + " nodes");
-  if (points.size() != areas.size())
-    throw std::invalid_argument("point_cell_counts: areas and points differ in number");
-  if (!(tau > 0) || !std::isfinite(tau))
-    throw std::invalid_argument("point_cell_counts: tau must be finite and > 0");
-  std::vector<std::uint8_t> out(node_boxes.size(), 0);
-  for (std::size_t i = 0; i < node_boxes.size(); ++i) {
-    const auto [first, last] = node_ranges[i];
-    if (first > last || last > points.size())
-      throw std::invalid_argument("point_cell_counts: node " + std::to_string(i) +
-                                  " has a range past the points");
-    if (first == last) continue;
-    const auto cells = point_cell_areas(node_boxes[i], grid, points.subspan(first, last - first),
-                                        areas.subspan(first, last - first));
-    out[i] = count_cells(node_boxes[i], grid, cells, tau);
-  }
-  return out;
+  return count_nodes(
+      "point_cell_counts", node_boxes.size(), node_ranges, points, areas, tau,
+      [&](std::size_t i, std::span<const Vec3> node_points, std::span<const double> node_areas) {
+        const auto cells = point_cell_areas(node_boxes[i], grid, node_points, node_areas);
+        return count_cells(node_boxes[i], grid, cells, tau);
+      });
+}
+
+std::vector<std::uint8_t> point_cell_counts_in_frames(
+    std::span<const OrientedBox> node_frames,
+    std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges, std::span<const Vec3> points,
+    std::span<const double> areas, int grid, double tau) {
+  std::vector<Vec3> local;
+  return count_nodes(
+      "point_cell_counts_in_frames", node_frames.size(), node_ranges, points, areas, tau,
+      [&](std::size_t i, std::span<const Vec3> node_points, std::span<const double> node_areas) {
+        const OrientedBox& frame = node_frames[i];
+        Box box;
+        if (!frame.empty()) box = {-frame.half, frame.half};
+        local.clear();
+        for (const Vec3& p : node_points) {
+          local.push_back(frame.local(p));
+          if (!local.back().allFinite())  // a corrupt frame; Box::extend would skip a NaN silently
+            throw std::invalid_argument("point_cell_counts_in_frames: node " + std::to_string(i) +
+                                        " has a non-finite frame but holds points");
+          box.extend(local.back());  // rounding may put a point just outside [-half, half]
+        }
+        // As the exact annotation in frames: an axis thinner than kMinRelativeThickness of the longest is
+        // the plane 0, so the points' areas count in every layer along it.
+        const Vec3 extent = box.extent();
+        for (int axis = 0; axis < 3; ++axis) {
+          if (!(extent[axis] < kMinRelativeThickness * extent.maxCoeff())) continue;
+          box.min[axis] = box.max[axis] = 0;
+          for (Vec3& v : local) v[axis] = 0;
+        }
+        return count_cells(box, grid, point_cell_areas(box, grid, local, node_areas), tau);
+      });
 }
 
 }  // namespace bvhlab

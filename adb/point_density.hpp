@@ -38,10 +38,20 @@ std::vector<std::uint8_t> point_cell_counts(
     std::span<const Box> node_boxes, std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
     std::span<const Vec3> points, std::span<const double> areas, int grid, double tau);
 
+/// The same with each node's grid in its own frame (`node_frames[i]`, an OBB's box), as the exact
+/// annotation counts there (annotate_counts_in_frames): the node's points mapped into the frame and counted
+/// on [-half, half] (grown to hold them), an axis thinner than kMinRelativeThickness of the longest
+/// flattened to the plane 0.
+std::vector<std::uint8_t> point_cell_counts_in_frames(
+    std::span<const OrientedBox> node_frames,
+    std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges, std::span<const Vec3> points,
+    std::span<const double> areas, int grid, double tau);
+
 /// The number of cells of g^3 whose area reaches the ADB threshold of `box`.
 std::uint8_t count_cells(const Box& box, int grid, std::span<const double> cell_areas, double tau);
 
-/// A tree over `cloud` (Bvh<BV>::build(cloud)) annotated with ADB counts from its points' areas. Throws
+/// A tree over `cloud` (Bvh<BV>::build(cloud)) annotated with ADB counts from its points' areas, on the
+/// cells the estimate reads: the nodes' own frames on OBB trees, else their bounding boxes. Throws
 /// std::invalid_argument when the tree holds no points or not this cloud's, or the cloud has no areas
 /// (sample_uniform sets them; assign_knn_areas estimates them), or for bad parameters.
 template <TreeVolume BV>
@@ -60,8 +70,16 @@ Tree<BV, AdbDensity> annotate_adb_points(Bvh<BV> tree, const PointCloud& cloud, 
     areas.push_back(cloud.areas[id]);
   }
   const AdbParams params = density_params<AdbDensity>({{"grid", grid}, {"tau", tau}});
-  std::vector<std::uint8_t> counts = point_cell_counts(tree.node_boxes(), node_triangle_ranges(tree.nodes()),
-                                                       tree.points(), areas, params.grid, params.tau);
+  std::vector<std::uint8_t> counts;
+  if constexpr (estimates_in_node_frames<AdbDensity, BV>) {  // the cells the estimate reads (OBB)
+    std::vector<OrientedBox> frames(tree.nodes().size());
+    for (std::size_t i = 0; i < frames.size(); ++i) frames[i] = tree.volume(i).oriented_box();
+    counts = point_cell_counts_in_frames(frames, node_triangle_ranges(tree.nodes()), tree.points(), areas,
+                                         params.grid, params.tau);
+  } else {
+    counts = point_cell_counts(tree.node_boxes(), node_triangle_ranges(tree.nodes()), tree.points(), areas,
+                               params.grid, params.tau);
+  }
   AdbStorage storage = AdbDensity::make_storage(params, std::move(counts));
   return Tree<BV, AdbDensity>{std::move(tree), std::move(storage)};
 }

@@ -4,6 +4,7 @@
 #include "bvh/mesh_io.hpp"
 #include "support/meshes.hpp"
 #include "volumes/aabb.hpp"
+#include "volumes/obb.hpp"
 #include "volumes/restricted_box.hpp"
 
 #include <gtest/gtest.h>
@@ -113,6 +114,36 @@ TEST(PointDensity, TreesOverPointsCarryAdbCounts) {
   // Every volume: the restricted boxtree's decoded boxes too.
   const auto restricted = annotate_adb_points(Bvh<RestrictedBox>::build(cloud), cloud, 3);
   EXPECT_GT(restricted.density.possible_collision_cells[0], 0);
+}
+
+// On OBB trees the ADB estimate reads cells in the nodes' own frames (adb/pair_geometry.hpp), so the point
+// counts must be taken there too. A flat 2 x 1 rectangle tilted by 45 degrees: in its root's frame the box is
+// flat, so its area counts in both layers of a 2^3 grid (8 cells), as the exact annotation in that frame
+// counts it; the axis-aligned box of the same node would see the slanted sheet in only some cells.
+TEST(PointDensity, ObbTreesCountThePointsInTheNodesOwnFrames) {
+  const double c = std::sqrt(0.5);
+  Mesh rectangle;
+  rectangle.name = "tilted rectangle";
+  for (const auto& [u, v] : {std::pair{-1.0, -0.5}, {1.0, -0.5}, {1.0, 0.5}, {-1.0, 0.5}})
+    rectangle.vertices.push_back(Vec3(c * u, v, c * u));  // the plane x = z
+  rectangle.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const PointCloud cloud = sample_uniform(rectangle, 4000, 3);
+  const auto tree = annotate_adb_points(Bvh<Obb>::build(cloud), cloud, 2);
+  const std::array<OrientedBox, 1> root{tree.bvh.volume(0).oriented_box()};
+  const std::array<std::pair<std::uint32_t, std::uint32_t>, 1> both{std::pair{0u, 2u}};
+  const CellCounts exact =
+      annotate_counts_in_frames(root, both, triangles_of(rectangle), 2, AnnotateOptions{});
+  EXPECT_EQ(exact.counts[0], 8);
+  EXPECT_EQ(tree.density.possible_collision_cells[0], exact.counts[0]);
+  // The same points counted on the node's axis-aligned box give another count: the test tells them apart.
+  std::vector<double> areas;
+  for (std::uint32_t id : tree.bvh.point_ids()) areas.push_back(cloud.areas[id]);
+  const std::array<std::pair<std::uint32_t, std::uint32_t>, 1> all{
+      std::pair{0u, static_cast<std::uint32_t>(areas.size())}};
+  const std::vector<Box> boxes = tree.bvh.node_boxes();
+  const auto in_boxes =
+      point_cell_counts(std::span(boxes).first(1), all, tree.bvh.points(), areas, 2, kDefaultAdbTau);
+  EXPECT_NE(in_boxes[0], exact.counts[0]);
 }
 
 TEST(PointDensity, RefusesTreesAndCloudsThatDoNotFit) {
