@@ -1,12 +1,15 @@
 #include "python/any_tree.hpp"
 
+#include "adb/point_density.hpp"
 #include "adb/saved_tree.hpp"
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
 #include "bench/core/tree_cache.hpp"
 #include "bench/prepare.hpp"
+#include "traversal/point_leaves.hpp"
 #include "traversal/strategies.hpp"
 
+#include <chrono>
 #include <cstdio>
 #include <stdexcept>
 
@@ -28,13 +31,13 @@ struct AnyTree::Model {
 namespace {
 
 template <class BV, class D>
-struct TypedModel;
+struct TypedBase;
 
 /// Strategy S on two trees of one type, configured once.
 template <class S, class BV, class D>
 class TypedQuery final : public PreparedQuery {
  public:
-  TypedQuery(std::shared_ptr<const TypedModel<BV, D>> a, std::shared_ptr<const TypedModel<BV, D>> b,
+  TypedQuery(std::shared_ptr<const TypedBase<BV, D>> a, std::shared_ptr<const TypedBase<BV, D>> b,
              typename S::Options options)
       : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)) {}
 
@@ -43,20 +46,43 @@ class TypedQuery final : public PreparedQuery {
   }
 
  private:
-  std::shared_ptr<const TypedModel<BV, D>> a_, b_;
+  std::shared_ptr<const TypedBase<BV, D>> a_, b_;
   typename S::Options options_;
 };
 
+/// The same with the clouds' surface test at the leaves (traversal/point_leaves.hpp), made per pose as
+/// query_exact_points and query_adb_points make it.
+template <class S, class BV, class D>
+class PointQuery final : public PreparedQuery {
+ public:
+  PointQuery(std::shared_ptr<const TypedBase<BV, D>> a, std::shared_ptr<const TypedBase<BV, D>> b,
+             typename S::Options options)
+      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)) {}
+
+  void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), poses[i]);
+      sink(i, S::query(a_->tree, b_->tree, poses[i], options_, leaves));
+    }
+  }
+
+ private:
+  std::shared_ptr<const TypedBase<BV, D>> a_, b_;
+  typename S::Options options_;
+};
+
+/// A typed tree, of a mesh or of a point cloud (then with its surface): what a query needs of either.
 template <class BV, class D>
-struct TypedModel final : AnyTree::Model {
-  TypedModel(Tree<BV, D> built, const MeshUnits& units, double build_seconds, double annotate_seconds)
+struct TypedBase : AnyTree::Model {
+  TypedBase(Tree<BV, D> built, const MeshUnits& units, double build_seconds, double annotate_seconds)
       : tree(std::move(built)) {
     ModelInfo size;  // the runner's and `bvhlab info`'s one account of a tree's size
     describe_tree_size(size, tree);
     info.bv = BV::name();
     info.density = D::name();
     info.annotation = D::describe(tree.density);
-    info.triangles = size.triangles;
+    info.triangles = tree.bvh.has_points() ? 0 : size.triangles;
+    info.points = tree.bvh.point_ids().size();
     info.nodes = size.nodes;
     info.depth = size.depth;
     info.model_bytes = size.model_bytes;
@@ -66,32 +92,34 @@ struct TypedModel final : AnyTree::Model {
     info.units = units;
   }
 
-  [[nodiscard]] std::vector<std::byte> save_bytes(const std::string& source) const override {
-    SaveOptions options;
-    options.units = info.units.file;
-    return save_tree_to_buffer(tree, options, source);
-  }
+  /// A mesh's side of a point query; a cloud's tree gives its surface.
+  [[nodiscard]] virtual SurfaceSide side() const { return mesh_side(); }
 
   [[nodiscard]] std::unique_ptr<PreparedQuery> prepare(std::shared_ptr<const Model> self,
                                                        std::shared_ptr<const Model> b,
                                                        const StrategyVariant& variant) const override {
-    auto other = std::dynamic_pointer_cast<const TypedModel>(b);
+    auto other = std::dynamic_pointer_cast<const TypedBase>(b);
     if (!other)
       throw std::invalid_argument("the two trees differ in BV or density (" + info.bv + ", " +
                                   info.annotation + " vs " + b->info.bv + ", " + b->info.annotation + ")");
-    auto a = std::static_pointer_cast<const TypedModel>(std::move(self));
+    auto a = std::static_pointer_cast<const TypedBase>(std::move(self));
+    const bool points = side().is_cloud() || other->side().is_cloud();
     std::unique_ptr<PreparedQuery> out;
     with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
       if constexpr (S::template accepts<D>) {
+        if constexpr (ProbabilityDensity<D>)  // refuses trees annotated with other parameters, before any
+                                              // pose
+          (void)D::estimator(tree.density, other->tree.density);
+        auto options = strategy_options<S>(variant.values, variant.budget);
+        if (points) {
+          out = prepare_points<S>(std::move(a), std::move(other), std::move(options), variant.strategy);
+          return;
+        }
         if (S::needs_polygons && !(info.polygons && other->info.polygons))
           throw std::invalid_argument("strategy " + variant.strategy +
                                       " tests triangles, and a tree was loaded without polygons (load it "
                                       "with its mesh)");
-        if constexpr (ProbabilityDensity<D>)  // refuses trees annotated with other parameters, before any
-                                              // pose
-          (void)D::estimator(tree.density, other->tree.density);
-        out = std::make_unique<TypedQuery<S, BV, D>>(a, other,
-                                                     strategy_options<S>(variant.values, variant.budget));
+        out = std::make_unique<TypedQuery<S, BV, D>>(std::move(a), std::move(other), std::move(options));
       } else {
         throw std::invalid_argument("strategy " + variant.strategy + " does not run on trees with density '" +
                                     std::string(D::name()) + "' (it runs on: " +
@@ -102,7 +130,77 @@ struct TypedModel final : AnyTree::Model {
   }
 
   Tree<BV, D> tree;
+
+ private:
+  /// S with the surface test, after SurfaceLeaves' checks of the two sides (so running cannot fail).
+  template <class S>
+  static std::unique_ptr<PreparedQuery> prepare_points(std::shared_ptr<const TypedBase> a,
+                                                       std::shared_ptr<const TypedBase> b,
+                                                       typename S::Options options, const std::string& name) {
+    const RigidTransform identity;
+    const SurfaceLeaves<BV> check(a->tree.bvh, a->side(), b->tree.bvh, b->side(), identity);
+    if constexpr (std::is_same_v<typename S::Options, ContactMode>)
+      if (options == ContactMode::All)
+        throw std::invalid_argument(
+            "strategy " + name +
+            " lists intersecting triangle pairs, and a point cloud has none (use exact)");
+    if constexpr (requires { S::query(a->tree, b->tree, identity, options, check); })
+      return std::make_unique<PointQuery<S, BV, D>>(std::move(a), std::move(b), std::move(options));
+    else
+      throw std::invalid_argument("strategy " + name +
+                                  " takes no leaf test, so it cannot query point clouds");
+  }
 };
+
+/// A mesh's tree.
+template <class BV, class D>
+struct TypedModel final : TypedBase<BV, D> {
+  using TypedBase<BV, D>::TypedBase;
+
+  [[nodiscard]] std::vector<std::byte> save_bytes(const std::string& source) const override {
+    SaveOptions options;
+    options.units = this->info.units.file;
+    return save_tree_to_buffer(this->tree, options, source);
+  }
+};
+
+/// A point cloud's tree, its surface and the tree's sphere coverings (the cloud's side of a point query).
+template <class BV, class D>
+struct PointModel final : TypedBase<BV, D> {
+  PointModel(const PointCloud& cloud, Tree<BV, D> built, const MeshUnits& units, double build_seconds,
+             double annotate_seconds)
+      : TypedBase<BV, D>(std::move(built), units, build_seconds, annotate_seconds),
+        surface(cloud),
+        coverings(sphere_coverings(this->tree.bvh, surface)) {}
+
+  [[nodiscard]] SurfaceSide side() const override { return cloud_side(surface, coverings); }
+  [[nodiscard]] std::vector<std::byte> save_bytes(const std::string& source) const override {
+    throw std::invalid_argument("cannot save '" + source +
+                                "': a tree over a point cloud; the saved-tree format records no points or "
+                                "surface (build it again from its cloud)");
+  }
+
+  PointSurface surface;
+  std::vector<SphereCovering> coverings;
+};
+
+/// The tree of a cloud: `D` is NoDensity or AdbDensity (counts from the points' areas).
+template <class BV, class D>
+std::shared_ptr<const AnyTree::Model> build_point_typed(const UnitCloud& cloud, const DensitySpec& density,
+                                                        const BuildOptions& options) {
+  Bvh<BV> bvh = Bvh<BV>::build(cloud, options);
+  const double build_seconds = bvh.stats().build_seconds;
+  if constexpr (std::is_same_v<D, NoDensity>) {
+    return std::make_shared<PointModel<BV, D>>(cloud, Tree<BV, D>{std::move(bvh), {}}, cloud.units,
+                                               build_seconds, 0.0);
+  } else {
+    const AdbParams params = density_params<D>(density.values);
+    const auto start = std::chrono::steady_clock::now();
+    Tree<BV, D> tree = annotate_adb_points(std::move(bvh), cloud, params.grid, params.tau);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return std::make_shared<PointModel<BV, D>>(cloud, std::move(tree), cloud.units, build_seconds, seconds);
+  }
+}
 
 template <class BV, class D>
 std::shared_ptr<const AnyTree::Model> build_typed(const UnitMesh& mesh, const DensitySpec& density,
@@ -168,6 +266,26 @@ AnyTree AnyTree::build(const UnitMesh& mesh, const std::string& bv, const Densit
       else
         throw std::invalid_argument("density " + density.name + " cannot annotate " + bv + " trees");
     });
+  });
+  return AnyTree(std::move(model));
+}
+
+AnyTree AnyTree::build_points(const UnitCloud& cloud, const std::string& bv, const DensitySpec& density,
+                              const BuildOptions& options) {
+  std::shared_ptr<const Model> model;
+  with_volume(bv, [&]<class BV>(std::type_identity<BV>) {
+    if (density.name == NoDensity::name()) {
+      model = build_point_typed<BV, NoDensity>(cloud, density, options);
+    } else if (density.name == AdbDensity::name()) {
+      if constexpr (DensityFor<AdbDensity, BV>)
+        model = build_point_typed<BV, AdbDensity>(cloud, density, options);
+      else
+        throw std::invalid_argument("density adb cannot annotate " + bv + " trees");
+    } else {
+      throw std::invalid_argument("density " + density.name +
+                                  " does not annotate trees over points; they take 'none' or 'adb' (cell "
+                                  "counts from the points' areas)");
+    }
   });
   return AnyTree(std::move(model));
 }

@@ -1,7 +1,7 @@
-// The bvhlab Python module: one bind_* function per concern (meshes.cpp, trees.cpp, queries.cpp,
-// scenes.cpp), and the checks of Python input they share (arrays.cpp). Bad input raises a Python exception
-// naming the argument and the problem: TypeError for a wrong type or dtype, ValueError for a wrong shape or
-// value, FileNotFoundError for a missing file.
+// The bvhlab Python module: one bind_* function per concern (meshes.cpp, points.cpp, trees.cpp,
+// queries.cpp, scenes.cpp), and the checks of Python input they share (arrays.cpp). Bad input raises a Python
+// exception naming the argument and the problem: TypeError for a wrong type or dtype, ValueError for a wrong
+// shape or value, FileNotFoundError for a missing file.
 #pragma once
 
 #include "adb/parameters.hpp"
@@ -20,6 +20,7 @@ namespace bvhlab::python {
 namespace py = pybind11;
 
 void bind_meshes(py::module_& m);
+void bind_points(py::module_& m);
 void bind_trees(py::module_& m);
 void bind_queries(py::module_& m);
 void bind_scenes(py::module_& m);

@@ -21,6 +21,20 @@ AnyTree build(const UnitMesh& mesh, const std::string& bv, const std::string& de
   return AnyTree::build(mesh, bv, spec, options);
 }
 
+AnyTree build_from_points(const UnitCloud& cloud, const std::string& bv, const std::string& density,
+                          const std::string& split, int leaf, int threads, const py::kwargs& parameters) {
+  if (leaf < 1 || leaf > 255) throw py::value_error("leaf: points per leaf must lie in [1, 255]");
+  if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
+  (void)with_volume(bv, [](auto) { return 0; });  // an unknown name fails before the density's checks
+  const DensitySpec spec = density_spec(density, parameter_values(parameters));
+  BuildOptions options;
+  options.split = split_method_from_string(split);
+  options.max_leaf_points = static_cast<std::uint32_t>(leaf);
+  options.threads = static_cast<unsigned>(threads);
+  py::gil_scoped_release release;
+  return AnyTree::build_points(cloud, bv, spec, options);
+}
+
 AnyTree load(const py::object& file, const UnitMesh* mesh) {
   const std::filesystem::path path = path_argument(file, "Tree.load");
   require_file(path, "Tree.load");
@@ -42,6 +56,9 @@ void save(const AnyTree& tree, const py::object& file) {
 
 std::string repr(const AnyTree& tree) {
   const TreeInfo& i = tree.info();
+  if (i.points > 0)
+    return "<bvhlab.Tree " + i.bv + ", " + i.annotation + ": " + std::to_string(i.points) + " points, " +
+           std::to_string(i.nodes) + " nodes>";
   return "<bvhlab.Tree " + i.bv + ", " + i.annotation + ": " + std::to_string(i.triangles) + " triangles, " +
          std::to_string(i.nodes) + " nodes" + (i.polygons ? "" : ", without polygons") + ">";
 }
@@ -51,13 +68,20 @@ std::string repr(const AnyTree& tree) {
 void bind_trees(py::module_& m) {
   auto info = [](auto member) { return [member](const AnyTree& t) { return t.info().*member; }; };
   py::class_<AnyTree>(m, "Tree",
-                      "A bounding-volume hierarchy of one mesh, of any registered bounding volume, with or "
-                      "without a density annotation.")
+                      "A bounding-volume hierarchy of one mesh or point cloud, of any registered bounding "
+                      "volume, with or without a density annotation.")
       .def(py::init(&build), py::arg("mesh"), py::arg("bv") = "aabb", py::arg("density") = "none",
            py::kw_only(), py::arg("split") = "sah", py::arg("leaf") = 1, py::arg("threads") = 0,
            "Builds the tree of `mesh` with bounding volume `bv` (bvhlab.volumes()) and annotates it with "
            "`density` (bvhlab.policies()), whose parameters are keyword arguments (grid=2, tau=0.25). split: "
            "'sah' or 'median'; leaf: triangles per leaf at most; threads: 0 for all cores.")
+      .def(py::init(&build_from_points), py::arg("cloud"), py::arg("bv") = "aabb",
+           py::arg("density") = "none", py::kw_only(), py::arg("split") = "sah", py::arg("leaf") = 16,
+           py::arg("threads") = 0,
+           "Builds the tree of a bvhlab.PointCloud, with the cloud's implicit surface and the nodes' sphere "
+           "coverings that queries test: density 'none' or 'adb' (cell counts from the points' areas; "
+           "grid=, tau=); leaf: points per leaf at most (8 to 32 keeps leaf tests cheap). Such a tree "
+           "queries a cloud's tree or a mesh's of the same volume and density; it cannot be saved.")
       .def_static(
           "load", &load, py::arg("path"), py::arg("mesh") = nullptr,
           "Reads a saved tree, in the units it records. Saved trees carry no polygons: give the mesh it was "
@@ -75,6 +99,7 @@ void bind_trees(py::module_& m) {
       .def_property_readonly("density", info(&TreeInfo::density))
       .def_property_readonly("annotation", info(&TreeInfo::annotation), "the density and its parameters")
       .def_property_readonly("triangles", info(&TreeInfo::triangles))
+      .def_property_readonly("points", info(&TreeInfo::points), "a point cloud's tree: its points (else 0)")
       .def_property_readonly("nodes", info(&TreeInfo::nodes))
       .def_property_readonly("depth", info(&TreeInfo::depth))
       .def_property_readonly("model_bytes", info(&TreeInfo::model_bytes),

@@ -61,9 +61,10 @@ struct ExactStrategy {
   static constexpr bool accepts = true;
   static std::span<const ParamSpec> parameters() { return {}; }
   static Options configure(const ParamValues&, const Budget&) { return ContactMode::First; }
-  template <class TreeA, class TreeB>
-  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options mode) {
-    return query_exact(a.bvh, b.bvh, b_to_a, mode);
+  template <class TreeA, class TreeB, class Leaves = TriangleLeaves>
+  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options mode,
+                      const Leaves& leaves = kTriangleLeaves) {
+    return query_exact(a.bvh, b.bvh, b_to_a, mode, leaves);
   }
 };
 
@@ -93,9 +94,10 @@ struct GuidedExactStrategy {
     options.exact_leaves = true;
     return options;
   }
-  template <class TreeA, class TreeB>
-  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options) {
-    return query_adb(a, b, b_to_a, options);
+  template <class TreeA, class TreeB, class Leaves = TriangleLeaves>
+  static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options,
+                      const Leaves& leaves = kTriangleLeaves) {
+    return query_adb(a, b, b_to_a, options, leaves);
   }
 };
 
@@ -124,10 +126,10 @@ template <class Base, class Order>
 struct InOrder : Base {
   template <class D>
   static constexpr bool accepts = ProbabilityDensity<D>&& D::name() == std::string_view("adb");
-  template <class TreeA, class TreeB>
+  template <class TreeA, class TreeB, class Leaves = TriangleLeaves>
   static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a,
-                      const typename Base::Options& options) {
-    return query_adb<Order>(a, b, b_to_a, options);
+                      const typename Base::Options& options, const Leaves& leaves = kTriangleLeaves) {
+    return query_adb<Order>(a, b, b_to_a, options, leaves);
   }
 };
 /// The depth-first order: the most probable child of the pair just expanded next.

@@ -22,6 +22,9 @@
 //   S::configure(values, budget)    Options from resolved values and a budget (unlimited when S::budget is
 //                                   None); throws std::invalid_argument for a bad combination.
 //   S::query(a, b, b_to_a, options) Result for two Tree<BV, D> with accepts<D>; const and thread-safe.
+//   S::query(..., options, leaves)  The same with another leaf test (traversal/driver.hpp): the shipped
+//                                   strategies take SurfaceLeaves for point clouds
+//                                   (traversal/point_leaves.hpp); optional for a new strategy.
 #pragma once
 
 #include "../adb/parameters.hpp"
