@@ -33,8 +33,9 @@ namespace {
 template <class BV, class D>
 struct TypedBase;
 
-/// Strategy S on two trees of one type, configured once.
-template <class S, class BV, class D>
+/// Strategy S on two trees of one type, configured once; with kSurfaces, with the clouds' surface test at
+/// the leaves (traversal/point_leaves.hpp), made per pose as query_exact_points and query_adb_points make it.
+template <class S, class BV, class D, bool kSurfaces>
 class TypedQuery final : public PreparedQuery {
  public:
   TypedQuery(std::shared_ptr<const TypedBase<BV, D>> a, std::shared_ptr<const TypedBase<BV, D>> b,
@@ -42,27 +43,13 @@ class TypedQuery final : public PreparedQuery {
       : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)) {}
 
   void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
-    for (std::size_t i = 0; i < poses.size(); ++i) sink(i, S::query(a_->tree, b_->tree, poses[i], options_));
-  }
-
- private:
-  std::shared_ptr<const TypedBase<BV, D>> a_, b_;
-  typename S::Options options_;
-};
-
-/// The same with the clouds' surface test at the leaves (traversal/point_leaves.hpp), made per pose as
-/// query_exact_points and query_adb_points make it.
-template <class S, class BV, class D>
-class PointQuery final : public PreparedQuery {
- public:
-  PointQuery(std::shared_ptr<const TypedBase<BV, D>> a, std::shared_ptr<const TypedBase<BV, D>> b,
-             typename S::Options options)
-      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)) {}
-
-  void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
     for (std::size_t i = 0; i < poses.size(); ++i) {
-      const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), poses[i]);
-      sink(i, S::query(a_->tree, b_->tree, poses[i], options_, leaves));
+      if constexpr (kSurfaces) {
+        const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), poses[i]);
+        sink(i, S::query(a_->tree, b_->tree, poses[i], options_, leaves));
+      } else {
+        sink(i, S::query(a_->tree, b_->tree, poses[i], options_));
+      }
     }
   }
 
@@ -119,7 +106,8 @@ struct TypedBase : AnyTree::Model {
           throw std::invalid_argument("strategy " + variant.strategy +
                                       " tests triangles, and a tree was loaded without polygons (load it "
                                       "with its mesh)");
-        out = std::make_unique<TypedQuery<S, BV, D>>(std::move(a), std::move(other), std::move(options));
+        out =
+            std::make_unique<TypedQuery<S, BV, D, false>>(std::move(a), std::move(other), std::move(options));
       } else {
         throw std::invalid_argument("strategy " + variant.strategy + " does not run on trees with density '" +
                                     std::string(D::name()) + "' (it runs on: " +
@@ -145,7 +133,7 @@ struct TypedBase : AnyTree::Model {
             "strategy " + name +
             " lists intersecting triangle pairs, and a point cloud has none (use exact)");
     if constexpr (requires { S::query(a->tree, b->tree, identity, options, check); })
-      return std::make_unique<PointQuery<S, BV, D>>(std::move(a), std::move(b), std::move(options));
+      return std::make_unique<TypedQuery<S, BV, D, true>>(std::move(a), std::move(b), std::move(options));
     else
       throw std::invalid_argument("strategy " + name +
                                   " takes no leaf test, so it cannot query point clouds");

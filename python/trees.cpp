@@ -1,4 +1,5 @@
-// bvhlab.Tree: a tree of any registered bounding volume and density, built from a mesh, saved and loaded.
+// bvhlab.Tree: a tree of any registered bounding volume and density, built from a mesh (saved and loaded)
+// or from a point cloud.
 #include "bench/core/registry.hpp"
 #include "python/any_tree.hpp"
 #include "python/bindings.hpp"
@@ -7,32 +8,38 @@ namespace bvhlab::python {
 
 namespace {
 
-AnyTree build(const UnitMesh& mesh, const std::string& bv, const std::string& density,
-              const std::string& split, int leaf, int threads, const py::kwargs& parameters) {
-  if (leaf < 1 || leaf > 255) throw py::value_error("leaf: triangles per leaf must lie in [1, 255]");
+/// The checked arguments of a build: the density's parameters and the build options, `leaf` counting
+/// triangles (a mesh) or points (a cloud).
+struct BuildArguments {
+  DensitySpec density;
+  BuildOptions options;
+};
+
+BuildArguments build_arguments(const std::string& bv, const std::string& density, const std::string& split,
+                               int leaf, const char* leaf_items, int threads, const py::kwargs& parameters) {
+  if (leaf < 1 || leaf > 255)
+    throw py::value_error(std::string("leaf: ") + leaf_items + " per leaf must lie in [1, 255]");
   if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
   (void)with_volume(bv, [](auto) { return 0; });  // an unknown name fails before the density's checks
-  const DensitySpec spec = density_spec(density, parameter_values(parameters));
-  BuildOptions options;
-  options.split = split_method_from_string(split);
-  options.max_leaf_triangles = static_cast<std::uint32_t>(leaf);
-  options.threads = static_cast<unsigned>(threads);
+  BuildArguments out{density_spec(density, parameter_values(parameters)), {}};
+  out.options.split = split_method_from_string(split);
+  out.options.max_leaf_triangles = out.options.max_leaf_points = static_cast<std::uint32_t>(leaf);
+  out.options.threads = static_cast<unsigned>(threads);
+  return out;
+}
+
+AnyTree build(const UnitMesh& mesh, const std::string& bv, const std::string& density,
+              const std::string& split, int leaf, int threads, const py::kwargs& parameters) {
+  const BuildArguments args = build_arguments(bv, density, split, leaf, "triangles", threads, parameters);
   py::gil_scoped_release release;
-  return AnyTree::build(mesh, bv, spec, options);
+  return AnyTree::build(mesh, bv, args.density, args.options);
 }
 
 AnyTree build_from_points(const UnitCloud& cloud, const std::string& bv, const std::string& density,
                           const std::string& split, int leaf, int threads, const py::kwargs& parameters) {
-  if (leaf < 1 || leaf > 255) throw py::value_error("leaf: points per leaf must lie in [1, 255]");
-  if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
-  (void)with_volume(bv, [](auto) { return 0; });  // an unknown name fails before the density's checks
-  const DensitySpec spec = density_spec(density, parameter_values(parameters));
-  BuildOptions options;
-  options.split = split_method_from_string(split);
-  options.max_leaf_points = static_cast<std::uint32_t>(leaf);
-  options.threads = static_cast<unsigned>(threads);
+  const BuildArguments args = build_arguments(bv, density, split, leaf, "points", threads, parameters);
   py::gil_scoped_release release;
-  return AnyTree::build_points(cloud, bv, spec, options);
+  return AnyTree::build_points(cloud, bv, args.density, args.options);
 }
 
 AnyTree load(const py::object& file, const UnitMesh* mesh) {
