@@ -1,5 +1,7 @@
 #include "bvh/point_cloud.hpp"
 
+#include "bvh/mesh_io.hpp"
+
 #include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Search_traits_3.h>
 #include <CGAL/Simple_cartesian.h>
@@ -348,6 +350,10 @@ void validate(const PointCloud& cloud, std::size_t min_points) {
     fail(name, "has " + std::to_string(cloud.size()) + " points, the kernel needs at least " +
                    std::to_string(min_points));
   check_finite(name, cloud.positions, "point");
+  for (std::size_t i = 0; i < cloud.size(); ++i)  // the meshes' limit: beyond it a double spaces by 0.1
+    if (cloud.positions[i].cwiseAbs().maxCoeff() > MeshPrecisionLimits::max_abs_coordinate)
+      fail(name, "point " + std::to_string(i) +
+                     " has a coordinate beyond 1e15 (the queries' precision ends there)");
   if (cloud.has_normals()) {
     if (cloud.normals.size() != cloud.size())
       fail(name,

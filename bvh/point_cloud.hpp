@@ -40,7 +40,8 @@ class PointCloudError : public std::runtime_error {
 
 /// Throws PointCloudError naming the cloud and the first problem: no points; fewer than `min_points` points
 /// (a kernel over k neighbours needs k + 1); a non-finite position, normal or area, or a negative area (with
-/// its index); normals or areas whose count differs from the points'; all points at one position.
+/// its index); a coordinate beyond 1e15 (MeshPrecisionLimits, as for meshes); normals or areas whose count
+/// differs from the points'; all points at one position.
 void validate(const PointCloud& cloud, std::size_t min_points = 1);
 
 /// Loads a cloud by extension:

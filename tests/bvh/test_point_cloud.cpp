@@ -42,6 +42,8 @@ TEST(PointCloudValidate, RefusesBadCloudsByName) {
   EXPECT_NE(error_of([&] { validate(c); }).find("has no points"), std::string::npos);
   c.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, std::nan(""), 0)};
   EXPECT_NE(error_of([&] { validate(c); }).find("point 2 is not finite"), std::string::npos);
+  c.positions[2] = Vec3(0, 2e15, 0);  // where a double's spacing is 0.25: refused as for meshes
+  EXPECT_NE(error_of([&] { validate(c); }).find("point 2 has a coordinate beyond 1e15"), std::string::npos);
   c.positions[2] = Vec3(0, 1, 0);
   EXPECT_NO_THROW(validate(c, 3));
   EXPECT_NE(error_of([&] { validate(c, 11); }).find("has 3 points, the kernel needs at least 11"),

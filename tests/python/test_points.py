@@ -53,6 +53,10 @@ def test_arrays_round_trip_and_bad_arrays_are_refused():
         bvhlab.PointCloud(points, areas=areas[:10])
     with pytest.raises(ValueError, match="area"):
         bvhlab.PointCloud(points, areas=-areas)
+    far = points.copy()
+    far[3, 0] = 1e200  # the box sums of the density would overflow: refused where the cloud is made
+    with pytest.raises(bvhlab.PointCloudError, match="point 3 has a coordinate beyond 1e15"):
+        bvhlab.PointCloud(far)
     with pytest.raises(ValueError, match="coincident"):
         bvhlab.PointCloud(np.ones((5, 3)))
     with pytest.raises(TypeError):
