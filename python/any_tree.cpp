@@ -1,7 +1,7 @@
 #include "python/any_tree.hpp"
 
-#include "adb/point_density.hpp"
 #include "adb/saved_tree.hpp"
+#include "bench/cloud_query.hpp"
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
 #include "bench/core/tree_cache.hpp"
@@ -176,18 +176,12 @@ struct PointModel final : TypedBase<BV, D> {
 template <class BV, class D>
 std::shared_ptr<const AnyTree::Model> build_point_typed(const UnitCloud& cloud, const DensitySpec& density,
                                                         const BuildOptions& options) {
-  Bvh<BV> bvh = Bvh<BV>::build(cloud, options);
-  const double build_seconds = bvh.stats().build_seconds;
-  if constexpr (std::is_same_v<D, NoDensity>) {
-    return std::make_shared<PointModel<BV, D>>(cloud, Tree<BV, D>{std::move(bvh), {}}, cloud.units,
-                                               build_seconds, 0.0);
-  } else {
-    const AdbParams params = density_params<D>(density.values);
-    const auto start = std::chrono::steady_clock::now();
-    Tree<BV, D> tree = annotate_adb_points(std::move(bvh), cloud, params.grid, params.tau);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return std::make_shared<PointModel<BV, D>>(cloud, std::move(tree), cloud.units, build_seconds, seconds);
-  }
+  double annotate_seconds = 0;
+  const auto start = std::chrono::steady_clock::now();
+  Tree<BV, D> tree = cloud_tree<BV, D>(cloud, density.values, options, annotate_seconds);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return std::make_shared<PointModel<BV, D>>(cloud, std::move(tree), cloud.units, seconds - annotate_seconds,
+                                             annotate_seconds);
 }
 
 template <class BV, class D>

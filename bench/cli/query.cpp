@@ -1,6 +1,7 @@
 // bvhlab query: queries between two meshes, or two saved trees, at one pose or a list of poses; prints the
 // full result.
 #include "bench/cli/cli.hpp"
+#include "bench/cloud_query.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
 
@@ -21,7 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct QueryArgs {
-  std::string a, b, pose, protocol, poses_file, bv = "aabb", strategy = "exact", cache, density;
+  std::string a, b, pose, protocol, poses_file, bv = "aabb", strategy = "exact", cache, density, cloud;
   double deadline = 0, bv_tests = 0;
   int repeat = 0;
   bool all = false, json = false, normalize = false, no_cache = false;
@@ -81,6 +82,20 @@ std::vector<ListedPose> poses_of(const QueryArgs& args) {
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("--pose", e.what());
   }
+}
+
+/// Options that do not apply to point clouds: they are read in their files' own units and not cached.
+void refuse_cloud_options(const QueryArgs& args) {
+  for (const std::string& file : {args.a, args.b})
+    if (fs::is_regular_file(file) && is_saved_tree(file))
+      throw CLI::ValidationError("--cloud", "'" + file + "' is a saved tree; give mesh and cloud files");
+  if (args.normalize)
+    throw CLI::ValidationError("--normalize",
+                               "applies to meshes; with --cloud both files keep their own units");
+  if (args.cache_option->count() || args.no_cache)
+    throw CLI::ValidationError("--cache/--no-cache", "trees over clouds are not cached; it does not apply");
+  if (args.bv.rfind("fcl_", 0) == 0)
+    throw CLI::ValidationError("--bv", "FCL hierarchies hold no point clouds; give a bvhlab volume");
 }
 
 /// Whether A and B are saved trees (else meshes); refuses one of each.
@@ -190,7 +205,13 @@ QueryRun execute_query(const QueryArgs& args, bool trees, const QueryRequest& re
   out.poses = std::move(listed);
   std::vector<RigidTransform> poses;
   for (const ListedPose& p : out.poses) poses.push_back(p.pose);
-  if (trees) {  // saved trees: ADB without polygons; BV, grid, tau and units come from the files
+  if (!args.cloud.empty()) {  // a cloud on one side or both, in the files' own units
+    const QueryObject a{args.a, args.cloud != "b"}, b{args.b, args.cloud != "a"};
+    out.outcome = run_cloud_query(a, b, args.bv, request.density, request.strategy, poses, request.repeat);
+    out.name_a = out.outcome.model_a.object;
+    out.name_b = out.outcome.model_b.object;
+    out.bv = args.bv;
+  } else if (trees) {  // saved trees: ADB without polygons; BV, grid, tau and units come from the files
     out.outcome = run_query_on_trees(args.a, args.b, request.strategy, poses, request.repeat);
     out.name_a = args.a;
     out.name_b = args.b;
@@ -322,7 +343,8 @@ int query_command(const QueryArgs& args) {
   const int sources = int(!args.pose.empty()) + int(!args.protocol.empty()) + int(!args.poses_file.empty());
   if (sources != 1)
     throw CLI::ValidationError("query", "give B's pose with one of --pose, --protocol, --poses");
-  const bool trees = saved_trees(args);
+  if (!args.cloud.empty()) refuse_cloud_options(args);
+  const bool trees = args.cloud.empty() && saved_trees(args);
   const QueryRequest request = query_request(args, trees);
   std::vector<ListedPose> poses = poses_of(args);
   const QueryRun run = execute_query(args, trees, request, std::move(poses));
@@ -384,6 +406,11 @@ Command add_query_command(CLI::App& app) {
                   "default: the mesh files' own units");
   query->add_option("--repeat", args->repeat, "Also time N warm queries at each pose: median, min and max")
       ->check(CLI::Range(1, 10'000'000));
+  query
+      ->add_option("--cloud", args->cloud,
+                   "Read A, B or both as point clouds (PLY: the vertices; XYZ), queried through their "
+                   "implicit surfaces; density none or adb (areas from each point's 10th neighbour)")
+      ->check(CLI::IsMember({"a", "b", "both"}));
   query->add_flag("--json", args->json, "Print JSON");
   args->cache_option =
       query->add_option("--cache", args->cache, "Tree cache directory (default: <build>/cache)");
@@ -394,7 +421,8 @@ Command add_query_command(CLI::App& app) {
       "  bvhlab query jeep1.ms3d jeep1.ms3d --pose 12,0,0,0,0,1,30\n"
       "  bvhlab query injector_pipes.stl injector_pipes.stl --normalize --protocol 1.6,42,5000 "
       "--strategy time_critical --bv-tests 200 --repeat 100\n"
-      "  bvhlab query pinion.off pinion.off --normalize --poses bench/scenes/example_poses.txt --json");
+      "  bvhlab query pinion.off pinion.off --normalize --poses bench/scenes/example_poses.txt --json\n"
+      "  bvhlab query scan.xyz pinion.off --cloud a --pose 0.5,0,0 --strategy adb --p-min 0.99");
   return {query, [args] { return query_command(*args); }};
 }
 

@@ -140,6 +140,50 @@ TEST_F(Cli, OptionsThatDoNotApplyAreRefused) {
                    "does not apply");
 }
 
+// Point clouds (--cloud): a cloud of the small cube's surface against the cube's mesh or itself, queried
+// through the implicit surfaces; what does not apply to clouds is refused by name.
+TEST_F(Cli, PointCloudsAreQueriedThroughTheirSurfaces) {
+  std::string xyz;
+  for (int face = 0; face < 6; ++face)
+    for (int i = 0; i < 15; ++i)
+      for (int j = 0; j < 15; ++j) {
+        double p[3];
+        p[face % 3] = face < 3 ? -0.5 : 0.5;
+        p[(face + 1) % 3] = -0.5 + (i + 0.5) / 15;
+        p[(face + 2) % 3] = -0.5 + (j + 0.5) / 15;
+        xyz += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
+      }
+  testing::write_text(dir / "cube.xyz", xyz);
+  const auto collides = [&](const std::string& args) {
+    return nlohmann::json::parse(ok("query " + args + " --json").out)["collides"].get<bool>();
+  };
+  // Turned a little: no face of one cube lies in a face's plane of the other (touching there has overlap
+  // volume 0, which ADB drops as no contact).
+  const std::string near = " --pose 0.5,0.2,0.1,1,2,3,20", far = " --pose 1.5,0.2,0.1,1,2,3,20";
+  for (const std::string sides :
+       {"cube.xyz small.obj --cloud a", "small.obj cube.xyz --cloud b", "cube.xyz cube.xyz --cloud both"}) {
+    EXPECT_TRUE(collides(sides + near)) << sides;
+    EXPECT_FALSE(collides(sides + far)) << sides;
+    EXPECT_TRUE(collides(sides + near + " --strategy adb --p-min 0.999 --confirm-levels 4")) << sides;
+    EXPECT_FALSE(collides(sides + far + " --strategy adb")) << sides;
+  }
+  const Outcome text = ok("query cube.xyz small.obj --cloud a --pose 0.5,0,0 --bv obb");
+  EXPECT_NE(text.out.find("cube.xyz vs small.obj, exact on obb"), std::string::npos) << text.out;
+
+  ok("build small.obj --adb -o small.tree");
+  expect_refused("query cube.xyz small.tree --cloud a --pose 0.5,0,0", "'small.tree' is a saved tree");
+  expect_refused("query cube.xyz small.obj --cloud a --pose 0.5,0,0 --normalize", "applies to meshes");
+  expect_refused("query cube.xyz small.obj --cloud a --pose 0.5,0,0 --no-cache", "not cached");
+  expect_refused("query cube.xyz small.obj --cloud a --pose 0.5,0,0 --bv fcl_obb", "hold no point clouds");
+  expect_refused("query cube.xyz small.obj --cloud a --pose 0.5,0,0 --all-contacts",
+                 "lists intersecting triangle pairs, and a point cloud has none");
+  expect_refused("query cube.xyz small.obj --cloud a --pose 0.5,0,0 --strategy adb --density adb_paper",
+                 "does not annotate trees over points");
+  expect_refused("query cube.xyz small.obj --cloud c --pose 0.5,0,0", "--cloud");
+  testing::write_text(dir / "bad.xyz", "0 0 0\n1 1\n");
+  expect_refused("query bad.xyz small.obj --cloud a --pose 0.5,0,0", "bad.xyz");
+}
+
 TEST_F(Cli, InfoOfASavedTreePrintsJson) {
   ok("build small.obj --adb -o small.tree");
   const nlohmann::json j = nlohmann::json::parse(ok("info small.tree --json").out);

@@ -163,3 +163,25 @@ def test_point_trees_refuse_what_does_not_apply(tmp_path, gear, gear_cloud):
     normalised = bvhlab.Tree(bvhlab.PointCloud.sample(gear.normalized(), 500), "aabb", "adb")
     with pytest.raises(ValueError, match="different units"):
         bvhlab.query(normalised, cloud_tree, np.eye(4))
+
+
+def test_the_cli_queries_clouds_as_the_module_does(tmp_path, cli, gear_file, gear, gear_cloud):
+    """`bvhlab query --cloud` and the module build the same trees from the same files (k-NN areas: a cloud
+    file has none) and answer alike, with the same work."""
+    path = tmp_path / "gear.ply"
+    gear_cloud.save(path)
+    loaded = bvhlab.PointCloud.load(path)
+    loaded.assign_knn_areas(10)
+    cloud_tree = bvhlab.Tree(loaded, "aabb", "adb")
+    mesh_tree = bvhlab.Tree(gear, "aabb", "adb")
+    answers = set()
+    for x in (0.3, 1.0, 1.9, 2.5):
+        for strategy, params in (("exact", {}), ("adb", {"p_min": 0.99})):
+            options = ["--p-min", "0.99"] if params else []
+            for b_file, b_tree, sides in ((path, cloud_tree, "both"), (gear_file, mesh_tree, "a")):
+                expected = cli("query", path, b_file, "--cloud", sides, "--pose", f"{x},0.1,0",
+                               "--strategy", strategy, *options, "--json")
+                got = bvhlab.query(cloud_tree, b_tree, translation=[x, 0.1, 0], strategy=strategy, **params)
+                assert (expected["collides"], expected["bv_tests"]) == (got.collides, got.counters["bv_tests"])
+                answers.add(got.collides)
+    assert answers == {True, False}

@@ -1,0 +1,51 @@
+// Queries with a point cloud on one side or both (`bvhlab query --cloud`, and the Python module's trees over
+// clouds): the tree of a cloud, and a run over poses with the clouds' surface test at the leaves
+// (traversal/point_leaves.hpp), timed as run_query times meshes.
+#pragma once
+
+#include "adb/point_density.hpp"
+#include "bench/run.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <span>
+#include <type_traits>
+
+namespace bvhlab {
+
+/// The tree of `cloud` (options.max_leaf_points per leaf) with density D: NoDensity, or AdbDensity from
+/// the points' areas (`density`: its grid and tau). `annotate_seconds` receives the annotation's time.
+/// Throws std::invalid_argument for a cloud without areas under AdbDensity (annotate_adb_points).
+template <TreeVolume BV, class D>
+Tree<BV, D> cloud_tree(const PointCloud& cloud, const ParamValues& density, const BuildOptions& options,
+                       double& annotate_seconds) {
+  Bvh<BV> bvh = Bvh<BV>::build(cloud, options);
+  annotate_seconds = 0;
+  if constexpr (std::is_same_v<D, NoDensity>) {
+    return Tree<BV, D>{std::move(bvh), {}};
+  } else {
+    static_assert(std::is_same_v<D, AdbDensity>, "trees over points carry no density or adb's");
+    const AdbParams params = density_params<D>(density);
+    const auto start = std::chrono::steady_clock::now();
+    Tree<BV, D> tree = annotate_adb_points(std::move(bvh), cloud, params.grid, params.tau);
+    annotate_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return tree;
+  }
+}
+
+/// One side of a query: a mesh file, or a point-cloud file (PLY: its vertices; XYZ).
+struct QueryObject {
+  std::filesystem::path file;
+  bool cloud = false;
+};
+
+/// A query with a point cloud on one side or both, in the files' own units: trees of `bv` (a bvhlab volume)
+/// with `density` "none" or "adb" (a cloud from a file gets k-NN areas, k = 10: files carry none), clouds
+/// with leaves of 16 points, meshes of one triangle; `strategy` runs with the surface test at the leaves.
+/// Throws std::invalid_argument for no pose, no cloud, another density, a volume or strategy that cannot
+/// run (all_contacts lists triangle pairs), PointCloudError and MeshError for files they refuse.
+QueryOutcome run_cloud_query(const QueryObject& a, const QueryObject& b, const std::string& bv,
+                             const DensitySpec& density, const StrategyVariant& strategy,
+                             std::span<const RigidTransform> poses, int repeat = 0);
+
+}  // namespace bvhlab
