@@ -4,7 +4,6 @@
 #include "bench/measure.hpp"
 #include "bench/prepare.hpp"
 #include "bvh/mesh_io.hpp"
-#include "traversal/point_leaves.hpp"
 #include "traversal/strategies.hpp"
 
 #include <memory>
@@ -59,14 +58,10 @@ void run_on(const QueryObject& a, const QueryObject& b, const DensitySpec& densi
       const auto options = strategy_options<S>(strategy.values, strategy.budget);
       const RigidTransform identity;
       const SurfaceLeaves<BV> check(side_a.tree.bvh, side_a.side(), side_b.tree.bvh, side_b.side(), identity);
-      if constexpr (std::is_same_v<typename S::Options, ContactMode>)
-        if (options == ContactMode::All)
-          throw std::invalid_argument("strategy " + strategy.strategy +
-                                      " lists intersecting triangle pairs, and a point cloud has none");
-      if constexpr (!requires { S::query(side_a.tree, side_b.tree, identity, options, check); }) {
-        throw std::invalid_argument("strategy " + strategy.strategy +
-                                    " takes no leaf test, so it cannot query point clouds");
-      } else {
+      if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, strategy.strategy);
+          !refusal.empty())
+        throw std::invalid_argument(refusal);
+      if constexpr (requires { S::query(side_a.tree, side_b.tree, identity, options, check); }) {
         const auto query = [&](const RigidTransform& pose) {
           const SurfaceLeaves<BV> leaves(side_a.tree.bvh, side_a.side(), side_b.tree.bvh, side_b.side(),
                                          pose);
@@ -79,6 +74,9 @@ void run_on(const QueryObject& a, const QueryObject& b, const DensitySpec& densi
                           [&](const std::vector<RigidTransform>& copies, std::vector<QueryRecord>& records) {
                             timed_series(copies, 0, records, query);
                           }));
+      } else {
+        throw std::logic_error("cloud_query_refusal let strategy " + strategy.strategy +
+                               " through without a leaf test");
       }
     }
   });

@@ -5,10 +5,13 @@
 
 #include "adb/point_density.hpp"
 #include "bench/run.hpp"
+#include "traversal/point_leaves.hpp"
 
 #include <chrono>
 #include <filesystem>
 #include <span>
+#include <string>
+#include <string_view>
 #include <type_traits>
 
 namespace bvhlab {
@@ -31,6 +34,21 @@ Tree<BV, D> cloud_tree(const PointCloud& cloud, const ParamValues& density, cons
     annotate_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return tree;
   }
+}
+
+/// Why strategy S, configured with `options`, cannot query point clouds on trees of BV and D; empty when it
+/// can: it takes the leaf test as a last argument (S::query(a, b, pose, options, leaves)) and answers
+/// something other than triangle pairs (all_contacts).
+template <class S, TreeVolume BV, class D>
+std::string cloud_query_refusal(const typename S::Options& options, std::string_view name) {
+  if constexpr (std::is_same_v<typename S::Options, ContactMode>)
+    if (options == ContactMode::All)
+      return "strategy " + std::string(name) +
+             " lists intersecting triangle pairs, and a point cloud has none";
+  if constexpr (!requires(const Tree<BV, D>& tree, const RigidTransform& pose,
+                          const SurfaceLeaves<BV>& leaves) { S::query(tree, tree, pose, options, leaves); })
+    return "strategy " + std::string(name) + " takes no leaf test, so it cannot query point clouds";
+  return {};
 }
 
 /// One side of a query: a mesh file, or a point-cloud file (PLY: its vertices; XYZ).

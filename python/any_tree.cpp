@@ -127,16 +127,12 @@ struct TypedBase : AnyTree::Model {
                                                        typename S::Options options, const std::string& name) {
     const RigidTransform identity;
     const SurfaceLeaves<BV> check(a->tree.bvh, a->side(), b->tree.bvh, b->side(), identity);
-    if constexpr (std::is_same_v<typename S::Options, ContactMode>)
-      if (options == ContactMode::All)
-        throw std::invalid_argument(
-            "strategy " + name +
-            " lists intersecting triangle pairs, and a point cloud has none (use exact)");
+    if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, name); !refusal.empty())
+      throw std::invalid_argument(refusal);
     if constexpr (requires { S::query(a->tree, b->tree, identity, options, check); })
       return std::make_unique<TypedQuery<S, BV, D, true>>(std::move(a), std::move(b), std::move(options));
     else
-      throw std::invalid_argument("strategy " + name +
-                                  " takes no leaf test, so it cannot query point clouds");
+      throw std::logic_error("cloud_query_refusal let strategy " + name + " through without a leaf test");
   }
 };
 
