@@ -22,16 +22,13 @@ struct Side {
     const auto start = std::chrono::steady_clock::now();
     if (object.cloud) {
       PointCloud cloud = load_point_cloud(object.file);
-      if (!std::is_same_v<D, NoDensity>) assign_knn_areas(cloud, 10);
+      if constexpr (!std::is_same_v<D, NoDensity>) assign_knn_areas(cloud, 10);
       tree = cloud_tree<BV, D>(cloud, density.values, BuildOptions{}, model.annotate_seconds);
       surface.emplace(cloud);
       coverings = sphere_coverings(tree.bvh, *surface);
     } else {
-      Bvh<BV> bvh = Bvh<BV>::build(load_mesh(object.file).mesh, BuildOptions{});
-      if constexpr (std::is_same_v<D, NoDensity>)
-        tree = {std::move(bvh), {}};
-      else
-        tree = annotate_tree<D>(std::move(bvh), density_params<D>(density.values));
+      tree = annotate_tree<D>(Bvh<BV>::build(load_mesh(object.file).mesh, BuildOptions{}),
+                              density_params<D>(density.values));
     }
     model.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     describe_tree_size(model, tree);
@@ -56,12 +53,13 @@ void run_on(const QueryObject& a, const QueryObject& b, const DensitySpec& densi
                                   std::string(D::name()) + "'");
     } else {
       const auto options = strategy_options<S>(strategy.values, strategy.budget);
-      const RigidTransform identity;
-      const SurfaceLeaves<BV> check(side_a.tree.bvh, side_a.side(), side_b.tree.bvh, side_b.side(), identity);
+      // SurfaceLeaves checks the two sides once here, so the timed queries cannot fail on them.
+      (void)SurfaceLeaves<BV>(side_a.tree.bvh, side_a.side(), side_b.tree.bvh, side_b.side(),
+                              RigidTransform{});
       if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, strategy.strategy);
           !refusal.empty())
         throw std::invalid_argument(refusal);
-      if constexpr (requires { S::query(side_a.tree, side_b.tree, identity, options, check); }) {
+      if constexpr (takes_leaf_test<S, BV, D>) {
         const auto query = [&](const RigidTransform& pose) {
           const SurfaceLeaves<BV> leaves(side_a.tree.bvh, side_a.side(), side_b.tree.bvh, side_b.side(),
                                          pose);
@@ -93,17 +91,8 @@ QueryOutcome run_cloud_query(const QueryObject& a, const QueryObject& b, const s
   if (!a.cloud && !b.cloud) throw std::invalid_argument("a point-cloud query needs a cloud on one side");
   QueryOutcome outcome;
   with_volume(bv, [&]<class BV>(std::type_identity<BV>) {
-    if (density.name == NoDensity::name()) {
-      run_on<BV, NoDensity>(a, b, density, strategy, poses, repeat, outcome);
-    } else if (density.name != AdbDensity::name()) {
-      throw std::invalid_argument("density " + density.name +
-                                  " does not annotate trees over points; they take 'none' or 'adb' (cell "
-                                  "counts from the points' areas)");
-    } else if constexpr (DensityFor<AdbDensity, BV>) {
-      run_on<BV, AdbDensity>(a, b, density, strategy, poses, repeat, outcome);
-    } else {
-      throw std::invalid_argument("density adb cannot annotate " + bv + " trees");
-    }
+    with_cloud_density<BV>(
+        density.name, bv, [&]<class D>() { run_on<BV, D>(a, b, density, strategy, poses, repeat, outcome); });
   });
   return outcome;
 }

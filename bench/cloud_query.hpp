@@ -10,6 +10,7 @@
 #include <chrono>
 #include <filesystem>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -36,19 +37,45 @@ Tree<BV, D> cloud_tree(const PointCloud& cloud, const ParamValues& density, cons
   }
 }
 
+/// Strategy S runs on point clouds of BV and D: it takes the leaf test as a last argument
+/// (S::query(a, b, pose, options, leaves)).
+template <class S, class BV, class D>
+inline constexpr bool takes_leaf_test = requires(const Tree<BV, D>& tree, const RigidTransform& pose,
+                                                 const typename S::Options& options,
+                                                 const SurfaceLeaves<BV>& leaves) {
+  S::query(tree, tree, pose, options, leaves);
+};
+
 /// Why strategy S, configured with `options`, cannot query point clouds on trees of BV and D; empty when it
-/// can: it takes the leaf test as a last argument (S::query(a, b, pose, options, leaves)) and answers
-/// something other than triangle pairs (all_contacts).
+/// can: it takes a leaf test (takes_leaf_test) and answers something other than triangle pairs
+/// (all_contacts).
 template <class S, TreeVolume BV, class D>
 std::string cloud_query_refusal(const typename S::Options& options, std::string_view name) {
   if constexpr (std::is_same_v<typename S::Options, ContactMode>)
     if (options == ContactMode::All)
       return "strategy " + std::string(name) +
              " lists intersecting triangle pairs, and a point cloud has none";
-  if constexpr (!requires(const Tree<BV, D>& tree, const RigidTransform& pose,
-                          const SurfaceLeaves<BV>& leaves) { S::query(tree, tree, pose, options, leaves); })
+  if constexpr (!takes_leaf_test<S, BV, D>)
     return "strategy " + std::string(name) + " takes no leaf test, so it cannot query point clouds";
   return {};
+}
+
+/// Calls f.template operator()<D>() with the density a tree over points of BV takes under `density`:
+/// NoDensity for "none", AdbDensity for "adb". Throws std::invalid_argument naming any other density, or
+/// adb on a volume it cannot annotate (`bv` names the volume).
+template <TreeVolume BV, class F>
+void with_cloud_density(const std::string& density, const std::string& bv, F&& f) {
+  if (density == NoDensity::name()) {
+    f.template operator()<NoDensity>();
+  } else if (density != AdbDensity::name()) {
+    throw std::invalid_argument("density " + density +
+                                " does not annotate trees over points; they take 'none' or 'adb' (cell "
+                                "counts from the points' areas)");
+  } else if constexpr (DensityFor<AdbDensity, BV>) {
+    f.template operator()<AdbDensity>();
+  } else {
+    throw std::invalid_argument("density adb cannot annotate " + bv + " trees");
+  }
 }
 
 /// One side of a query: a mesh file, or a point-cloud file (PLY: its vertices; XYZ).

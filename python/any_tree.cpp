@@ -125,11 +125,10 @@ struct TypedBase : AnyTree::Model {
   static std::unique_ptr<PreparedQuery> prepare_points(std::shared_ptr<const TypedBase> a,
                                                        std::shared_ptr<const TypedBase> b,
                                                        typename S::Options options, const std::string& name) {
-    const RigidTransform identity;
-    const SurfaceLeaves<BV> check(a->tree.bvh, a->side(), b->tree.bvh, b->side(), identity);
+    (void)SurfaceLeaves<BV>(a->tree.bvh, a->side(), b->tree.bvh, b->side(), RigidTransform{});
     if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, name); !refusal.empty())
       throw std::invalid_argument(refusal);
-    if constexpr (requires { S::query(a->tree, b->tree, identity, options, check); })
+    if constexpr (takes_leaf_test<S, BV, D>)
       return std::make_unique<TypedQuery<S, BV, D, true>>(std::move(a), std::move(b), std::move(options));
     else
       throw std::logic_error("cloud_query_refusal let strategy " + name + " through without a leaf test");
@@ -252,18 +251,8 @@ AnyTree AnyTree::build_points(const UnitCloud& cloud, const std::string& bv, con
                               const BuildOptions& options) {
   std::shared_ptr<const Model> model;
   with_volume(bv, [&]<class BV>(std::type_identity<BV>) {
-    if (density.name == NoDensity::name()) {
-      model = build_point_typed<BV, NoDensity>(cloud, density, options);
-    } else if (density.name == AdbDensity::name()) {
-      if constexpr (DensityFor<AdbDensity, BV>)
-        model = build_point_typed<BV, AdbDensity>(cloud, density, options);
-      else
-        throw std::invalid_argument("density adb cannot annotate " + bv + " trees");
-    } else {
-      throw std::invalid_argument("density " + density.name +
-                                  " does not annotate trees over points; they take 'none' or 'adb' (cell "
-                                  "counts from the points' areas)");
-    }
+    with_cloud_density<BV>(density.name, bv,
+                           [&]<class D>() { model = build_point_typed<BV, D>(cloud, density, options); });
   });
   return AnyTree(std::move(model));
 }

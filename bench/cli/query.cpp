@@ -84,10 +84,14 @@ std::vector<ListedPose> poses_of(const QueryArgs& args) {
   }
 }
 
+bool is_saved_tree_file(const std::string& file) {
+  return fs::is_regular_file(file) && is_saved_tree(file);
+}
+
 /// Options that do not apply to point clouds: they are read in their files' own units and not cached.
 void refuse_cloud_options(const QueryArgs& args) {
   for (const std::string& file : {args.a, args.b})
-    if (fs::is_regular_file(file) && is_saved_tree(file))
+    if (is_saved_tree_file(file))
       throw CLI::ValidationError("--cloud", "'" + file + "' is a saved tree; give mesh and cloud files");
   if (args.normalize)
     throw CLI::ValidationError("--normalize",
@@ -100,8 +104,8 @@ void refuse_cloud_options(const QueryArgs& args) {
 
 /// Whether A and B are saved trees (else meshes); refuses one of each.
 bool saved_trees(const QueryArgs& args) {
-  const bool tree_a = fs::is_regular_file(args.a) && is_saved_tree(args.a);
-  const bool tree_b = fs::is_regular_file(args.b) && is_saved_tree(args.b);
+  const bool tree_a = is_saved_tree_file(args.a);
+  const bool tree_b = is_saved_tree_file(args.b);
   if (tree_a != tree_b)
     throw CLI::ValidationError("query", "give two meshes or two saved trees, not one of each");
   return tree_a;
