@@ -40,6 +40,22 @@ py::array_t<double, py::array::c_style> real_array(const py::handle& value, cons
   return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(array);
 }
 
+std::vector<Vec3> vec3_rows(const py::handle& value, const std::string& what) {
+  const auto array = real_array(value, what, {-1, 3}, "(N, 3)");
+  const double* xyz = array.data();
+  std::vector<Vec3> out(static_cast<std::size_t>(array.shape(0)));
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  return out;
+}
+
+py::array_t<double> vec3_array(const std::vector<Vec3>& vectors) {
+  py::array_t<double> out({static_cast<py::ssize_t>(vectors.size()), py::ssize_t{3}});
+  double* data = out.mutable_data();
+  for (std::size_t i = 0; i < vectors.size(); ++i)
+    for (int k = 0; k < 3; ++k) data[3 * i + k] = vectors[i](k);
+  return out;
+}
+
 RigidTransform rigid_from_parts(const double* rotation, const double* translation, const std::string& what) {
   Mat3 r;
   for (int i = 0; i < 3; ++i)

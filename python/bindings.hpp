@@ -32,6 +32,11 @@ py::array_t<double, py::array::c_style> real_array(const py::handle& value, cons
                                                    const std::vector<py::ssize_t>& shape,
                                                    const std::string& shape_text);
 
+/// An (N, 3) array of real numbers as N vectors (real_array's checks, `what` naming it); values unchecked.
+std::vector<Vec3> vec3_rows(const py::handle& value, const std::string& what);
+/// N vectors as an (N, 3) float64 array (a copy).
+py::array_t<double> vec3_array(const std::vector<Vec3>& vectors);
+
 /// The rigid motion a 4 x 4 homogeneous matrix (row-major, as numpy stores it) describes. Throws ValueError
 /// naming `what` for a NaN or infinite entry, a last row other than 0 0 0 1, or a matrix that is not a
 /// rotation (not orthonormal, or a reflection).

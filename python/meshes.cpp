@@ -118,14 +118,6 @@ UnitMesh normalized(UnitMesh mesh) {
   return mesh;
 }
 
-py::array_t<double> vertex_array(const UnitMesh& mesh) {
-  py::array_t<double> out({static_cast<py::ssize_t>(mesh.vertices.size()), py::ssize_t{3}});
-  double* data = out.mutable_data();
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-    for (int k = 0; k < 3; ++k) data[3 * i + k] = mesh.vertices[i](k);
-  return out;
-}
-
 py::array_t<std::int64_t> triangle_array(const UnitMesh& mesh) {
   py::array_t<std::int64_t> out({static_cast<py::ssize_t>(mesh.triangles.size()), py::ssize_t{3}});
   std::int64_t* data = out.mutable_data();
@@ -154,7 +146,9 @@ void bind_meshes(py::module_& m) {
       .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("triangles"), py::arg("name") = "",
            "Checks the arrays: an (N, 3) array of finite real numbers and an (M, 3) integer array of indices "
            "below N, M >= 1, the triangles not all in one point.")
-      .def_property_readonly("vertices", &vertex_array, "(N, 3) float64 array (a copy)")
+      .def_property_readonly(
+          "vertices", [](const UnitMesh& mesh) { return vec3_array(mesh.vertices); },
+          "(N, 3) float64 array (a copy)")
       .def_property_readonly("triangles", &triangle_array, "(M, 3) int64 array (a copy)")
       .def_readwrite("name", &Mesh::name)
       .def_property_readonly("vertex_count", [](const UnitMesh& mesh) { return mesh.vertices.size(); })

@@ -9,21 +9,13 @@ namespace bvhlab::python {
 
 namespace {
 
-std::vector<Vec3> vectors_from(const py::handle& value, const std::string& what) {
-  const auto array = real_array(value, what, {-1, 3}, "(N, 3)");
-  const double* xyz = array.data();
-  std::vector<Vec3> out(static_cast<std::size_t>(array.shape(0)));
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-  return out;
-}
-
 /// The arrays as a cloud, checked by the library (validate: finite, counts, areas >= 0, not one position).
 UnitCloud cloud_from_arrays(const py::object& points, const py::object& normals, const py::object& areas,
                             const std::string& name) {
   UnitCloud cloud;  // in its own units
   cloud.name = name.empty() ? "points" : name;
-  cloud.positions = vectors_from(points, "points");
-  if (!normals.is_none()) cloud.normals = vectors_from(normals, "normals");
+  cloud.positions = vec3_rows(points, "points");
+  if (!normals.is_none()) cloud.normals = vec3_rows(normals, "normals");
   if (!areas.is_none()) {
     const auto a = real_array(areas, "areas", {-1}, "(N,)");
     cloud.areas.assign(a.data(), a.data() + a.shape(0));
@@ -63,14 +55,6 @@ UnitCloud sample(const UnitMesh& mesh, long long count, long long seed, const py
   return cloud;
 }
 
-py::array_t<double> vector_array(const std::vector<Vec3>& vectors) {
-  py::array_t<double> out({static_cast<py::ssize_t>(vectors.size()), py::ssize_t{3}});
-  double* data = out.mutable_data();
-  for (std::size_t i = 0; i < vectors.size(); ++i)
-    for (int k = 0; k < 3; ++k) data[3 * i + k] = vectors[i](k);
-  return out;
-}
-
 void save(const UnitCloud& cloud, const py::object& file) {
   const std::filesystem::path path = path_argument(file, "PointCloud.save");
   py::gil_scoped_release release;
@@ -99,13 +83,13 @@ void bind_points(py::module_& m) {
                   "(>= 1) denser along the longest axis, from 1 to ratio, areas from each point's k-th "
                   "nearest neighbour. The cloud is in the mesh's units.")
       .def_property_readonly(
-          "points", [](const UnitCloud& c) { return vector_array(c.positions); },
+          "points", [](const UnitCloud& c) { return vec3_array(c.positions); },
           "(N, 3) float64 array (a copy)")
       .def_property_readonly(
           "normals",
           [](const UnitCloud& c) -> py::object {
             if (!c.has_normals()) return py::none();
-            return vector_array(c.normals);
+            return vec3_array(c.normals);
           },
           "(N, 3) float64 array (a copy), or None")
       .def_property_readonly(
