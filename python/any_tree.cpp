@@ -184,16 +184,11 @@ std::shared_ptr<const AnyTree::Model> build_typed(const UnitMesh& mesh, const De
                                                   const BuildOptions& options) {
   Bvh<BV> bvh = Bvh<BV>::build(mesh, options);
   const double build_seconds = bvh.stats().build_seconds;
-  if constexpr (std::is_same_v<D, NoDensity>) {
-    return std::make_shared<TypedModel<BV, D>>(Tree<BV, D>{std::move(bvh), {}}, mesh.units, build_seconds,
-                                               0.0);
-  } else {
-    AnnotationContext context;
-    context.threads = options.threads;
-    AnnotateStats stats;
-    Tree<BV, D> tree = annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &stats);
-    return std::make_shared<TypedModel<BV, D>>(std::move(tree), mesh.units, build_seconds, stats.seconds);
-  }
+  AnnotationContext context;
+  context.threads = options.threads;
+  AnnotateStats stats;  // NoDensity annotates nothing: 0 seconds
+  Tree<BV, D> tree = annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &stats);
+  return std::make_shared<TypedModel<BV, D>>(std::move(tree), mesh.units, build_seconds, stats.seconds);
 }
 
 /// The saved tree with `mesh`'s polygons, checked as the tree cache checks its entries.
