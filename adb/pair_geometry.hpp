@@ -28,13 +28,18 @@ inline constexpr double kMinRelativeThickness = 1e-3;
   return {box.min - grow, box.max + grow};
 }
 
-/// Volume of `box` ∩ (`other` re-boxed through rotation/translation): an upper bound of the overlap.
+/// Volume of `box` ∩ (`other` re-boxed through rotation/translation): an upper bound of the overlap; 0 when
+/// they are apart. Boxes that touch meet in a face, an edge or a corner, of volume 0, although polygons in
+/// them may touch there (a resting contact): each side of the intersection counts as at least
+/// kMinRelativeThickness of the smaller box's longest side, as flat boxes are thickened.
 inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rotation,
                               const Mat3& abs_rotation, const Vec3& translation) {
   const Vec3 center = rotation * other.center() + translation;
   const Vec3 half = abs_rotation * (other.extent() * 0.5);
   const Vec3 lo = box.min.cwiseMax(center - half), hi = box.max.cwiseMin(center + half);
-  return (hi - lo).cwiseMax(0.0).prod();
+  if (!(hi.array() >= lo.array()).all()) return 0;
+  const double thinnest = kMinRelativeThickness * std::min(box.extent().maxCoeff(), 2 * half.maxCoeff());
+  return (hi - lo).cwiseMax(thinnest).prod();
 }
 
 /// An upper bound of Vol(A ∩ B) for boxes a and b whose frames b_to_a relates (abs_rotation = |R|):

@@ -22,7 +22,8 @@
 //   * Flat boxes: a node of polygons in one axis-aligned plane has a box of thickness 0, hence volume 0 and
 //     an overlap of 0 with anything: its estimate would be 0 while the volumes overlap. Each box is thickened
 //     to at least kMinRelativeThickness of its longest side before the overlap and the estimate see it; the
-//     overlap's share of the box, all the estimate uses of it, then stays that of the plane.
+//     overlap's share of the box, all the estimate uses of it, then stays that of the plane. Boxes that only
+//     touch intersect in a face, an edge or a corner; that intersection is thickened the same way.
 //   * Which boxes: the nodes' bounding boxes in the trees' frames, or, for a density that counts its cells
 //     in the nodes' own frames on a volume that has one (the OBB under "adb"), the nodes' own boxes and
 //     their overlap in those frames (adb/pair_geometry.hpp). The density decides; the loop is the same.

@@ -157,8 +157,8 @@ TEST_F(Cli, PointCloudsAreQueriedThroughTheirSurfaces) {
   const auto collides = [&](const std::string& args) {
     return nlohmann::json::parse(ok("query " + args + " --json").out)["collides"].get<bool>();
   };
-  // Turned a little: no face of one cube lies in a face's plane of the other (touching there has overlap
-  // volume 0, which ADB drops as no contact).
+  // Turned a little: no face of one cube lies in a face's plane of the other, where only coplanar points
+  // would touch.
   const std::string near = " --pose 0.5,0.2,0.1,1,2,3,20", far = " --pose 1.5,0.2,0.1,1,2,3,20";
   for (const std::string sides :
        {"cube.xyz small.obj --cloud a", "small.obj cube.xyz --cloud b", "cube.xyz cube.xyz --cloud both"}) {

@@ -293,6 +293,34 @@ TEST(AdbTraversal, FlatBoxesThatCrossGetAPositiveProbability) {
   EXPECT_FALSE(r.exact);
 }
 
+// Boxes that only touch meet in a face of volume 0; the polygons in that face touch, which exact counts as a
+// collision. ADB must not read such a pair as certainly apart: before, it dropped the root pair (overlap 0)
+// and answered "no" with the probability 0. Two cubes face to face (also turned about the face's normal) and
+// edge to edge, on AABB and OBB trees.
+template <class BV>
+void expect_touching_cubes_not_apart() {
+  const auto tree = annotate_adb(Bvh<BV>::build(generators::make_box(1, 1, 1)), 2, 0.25);
+  RigidTransform turned = RigidTransform::translate(Vec3(1, 0, 0));
+  turned.rotation = Eigen::AngleAxisd(0.4, Vec3::UnitX()).toRotationMatrix();
+  for (const RigidTransform& pose : {RigidTransform::translate(Vec3(1, 0, 0)), turned}) {
+    ASSERT_TRUE(query_exact(tree.bvh, tree.bvh, pose).collides);
+    const Result r = query_adb(tree, tree, pose, AdbOptions{});
+    // The faces' triangles lie in one plane: their flat boxes overlap whole, so the estimate finds them.
+    EXPECT_TRUE(r.collides) << BV::name() << ", p " << r.probability;
+    EXPECT_FALSE(r.exact);
+  }
+  const RigidTransform edge = RigidTransform::translate(Vec3(1, 1, 0));
+  ASSERT_TRUE(query_exact(tree.bvh, tree.bvh, edge).collides);
+  const Result r = query_adb(tree, tree, edge, AdbOptions{});
+  EXPECT_GT(r.probability, 0.0) << BV::name();  // an edge has no area: "no" stays possible, never certain
+  EXPECT_FALSE(r.exact);
+}
+
+TEST(AdbTraversal, BoxesThatOnlyTouchAreNotReadAsApart) {
+  expect_touching_cubes_not_apart<Aabb>();
+  expect_touching_cubes_not_apart<Obb>();
+}
+
 // A small closed box straddling a large slanted triangle (the size pair's case: the jeep's triangles against
 // the dragon). The triangle's OBB is a thin slab, its axis-aligned box a cube that holds the small box a
 // thousand times over. On OBB trees the default density counts cells in each node's own frame, so a node
