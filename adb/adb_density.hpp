@@ -43,6 +43,15 @@ AdbStorage decode(std::span<const std::byte> bytes, std::size_t node_count, std:
 void check_combinable(const AdbStorage& a, const AdbStorage& b, std::string_view name);
 }  // namespace adb_storage
 
+/// Every node's own box (FramedVolume::oriented_box), by node index: the grids "adb" counts its cells on in
+/// trees of such a volume (estimates_in_node_frames).
+template <TreeVolume BV>
+requires FramedVolume<BV> std::vector<OrientedBox> node_frames(const Bvh<BV>& bvh) {
+  std::vector<OrientedBox> frames(bvh.nodes().size());
+  for (std::size_t i = 0; i < frames.size(); ++i) frames[i] = bvh.volume(i).oriented_box();
+  return frames;
+}
+
 /// An ADB density: the cell counts, read through `Variant::rule`. `Variant` names it: a struct with
 /// `static constexpr std::string_view name`, `static constexpr AdbRule rule` and
 /// `static constexpr bool cells_in_node_frames`.
@@ -82,10 +91,8 @@ struct BasicAdbDensity {
   template <TreeVolume BV>
   static CellCounts count_cells(const Bvh<BV>& bvh, int grid, const AnnotateOptions& options) {
     if constexpr (estimates_in_node_frames<BasicAdbDensity, BV>) {
-      std::vector<OrientedBox> frames(bvh.nodes().size());
-      for (std::size_t i = 0; i < frames.size(); ++i) frames[i] = bvh.volume(i).oriented_box();
-      return annotate_counts_in_frames(frames, node_triangle_ranges(bvh.nodes()), bvh.triangles(), grid,
-                                       options);
+      return annotate_counts_in_frames(node_frames(bvh), node_triangle_ranges(bvh.nodes()), bvh.triangles(),
+                                       grid, options);
     } else {
       return annotate_counts(bvh.node_boxes(), node_triangle_ranges(bvh.nodes()), bvh.triangles(), grid,
                              options);

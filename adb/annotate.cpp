@@ -277,13 +277,10 @@ std::uint8_t count_node_in_frame(const FrameJob& job, std::uint32_t node, Worker
     worker.local.push_back(local);
   }
   check_grid_box(box, node);
-  const Vec3 extent = box.extent();
-  for (int axis = 0; axis < 3; ++axis) {
-    if (!(extent[axis] < kMinRelativeThickness * extent.maxCoeff())) continue;
-    box.min[axis] = box.max[axis] = 0;
+  flatten_thin_axes(box, [&](auto&& set) {
     for (TrianglePoints& t : worker.local)
-      for (Vec3& v : t) v[axis] = 0;
-  }
+      for (Vec3& v : t) set(v);
+  });
   worker.infos.clear();
   for (const TrianglePoints& t : worker.local) worker.infos.push_back(make_info(t));
   return count_cells(box, worker.local, worker.infos, job.g, job.tau, worker);

@@ -28,6 +28,20 @@ inline constexpr double kMinRelativeThickness = 1e-3;
   return {box.min - grow, box.max + grow};
 }
 
+/// The annotation's side of the same rule, for a node's grid box in its own frame: every axis of `box`
+/// thinner than kMinRelativeThickness of its longest becomes the plane 0, and so does that coordinate of each
+/// point `for_each_point(set)` hands to `set(Vec3&)`, so a flat node's polygons count in every layer along
+/// it.
+template <class ForEachPoint>
+void flatten_thin_axes(Box& box, ForEachPoint&& for_each_point) {
+  const Vec3 extent = box.extent();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(extent[axis] < kMinRelativeThickness * extent.maxCoeff())) continue;
+    box.min[axis] = box.max[axis] = 0;
+    for_each_point([axis](Vec3& v) { v[axis] = 0; });
+  }
+}
+
 /// Volume of `box` ∩ (`other` re-boxed through rotation/translation): an upper bound of the overlap; 0 when
 /// they are apart. Boxes that touch meet in a face, an edge or a corner, of volume 0, although polygons in
 /// them may touch there (a resting contact): each side of the intersection counts as at least

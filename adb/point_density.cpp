@@ -138,14 +138,9 @@ std::vector<std::uint8_t> point_cell_counts_in_frames(
                                         " has a non-finite frame but holds points");
           box.extend(local.back());  // rounding may put a point just outside [-half, half]
         }
-        // As the exact annotation in frames: an axis thinner than kMinRelativeThickness of the longest is
-        // the plane 0, so the points' areas count in every layer along it.
-        const Vec3 extent = box.extent();
-        for (int axis = 0; axis < 3; ++axis) {
-          if (!(extent[axis] < kMinRelativeThickness * extent.maxCoeff())) continue;
-          box.min[axis] = box.max[axis] = 0;
-          for (Vec3& v : local) v[axis] = 0;
-        }
+        flatten_thin_axes(box, [&](auto&& set) {  // as the exact annotation in frames
+          for (Vec3& v : local) set(v);
+        });
         return count_cells(box, grid, point_cell_areas(box, grid, local, node_areas), tau);
       });
 }

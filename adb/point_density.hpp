@@ -72,10 +72,8 @@ Tree<BV, AdbDensity> annotate_adb_points(Bvh<BV> tree, const PointCloud& cloud, 
   const AdbParams params = density_params<AdbDensity>({{"grid", grid}, {"tau", tau}});
   std::vector<std::uint8_t> counts;
   if constexpr (estimates_in_node_frames<AdbDensity, BV>) {  // the cells the estimate reads (OBB)
-    std::vector<OrientedBox> frames(tree.nodes().size());
-    for (std::size_t i = 0; i < frames.size(); ++i) frames[i] = tree.volume(i).oriented_box();
-    counts = point_cell_counts_in_frames(frames, node_triangle_ranges(tree.nodes()), tree.points(), areas,
-                                         params.grid, params.tau);
+    counts = point_cell_counts_in_frames(node_frames(tree), node_triangle_ranges(tree.nodes()), tree.points(),
+                                         areas, params.grid, params.tau);
   } else {
     counts = point_cell_counts(tree.node_boxes(), node_triangle_ranges(tree.nodes()), tree.points(), areas,
                                params.grid, params.tau);

@@ -31,10 +31,10 @@ AnnotateStats recount(std::span<const Box> boxes, const NodeRanges& ranges,
 /// The nodes' own frames when "adb" counts BV's cells there (adb/pair_geometry.hpp), else none.
 template <TreeVolume BV>
 std::vector<OrientedBox> count_frames(const Bvh<BV>& bvh) {
-  std::vector<OrientedBox> frames;
   if constexpr (estimates_in_node_frames<AdbDensity, BV>)
-    for (std::size_t i = 0; i < bvh.nodes().size(); ++i) frames.push_back(bvh.volume(i).oriented_box());
-  return frames;
+    return node_frames(bvh);
+  else
+    return {};
 }
 
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
