@@ -19,7 +19,7 @@ struct Side {
   Side(const QueryObject& object, const DensitySpec& density) {
     model.object = object.file.filename().string();
     model.bv = model.hierarchy = BV::name();
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     if (object.cloud) {
       PointCloud cloud = load_point_cloud(object.file);
       if constexpr (!std::is_same_v<D, NoDensity>) assign_knn_areas(cloud, 10);
@@ -30,7 +30,7 @@ struct Side {
       tree = annotate_tree<D>(Bvh<BV>::build(load_mesh(object.file).mesh, BuildOptions{}),
                               density_params<D>(density.values));
     }
-    model.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    model.build_seconds = seconds_since(start);
     describe_tree_size(model, tree);
     model.annotation = D::describe(tree.density);
   }

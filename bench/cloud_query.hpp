@@ -4,10 +4,10 @@
 #pragma once
 
 #include "adb/point_density.hpp"
+#include "bench/prepare.hpp"
 #include "bench/run.hpp"
 #include "traversal/point_leaves.hpp"
 
-#include <chrono>
 #include <filesystem>
 #include <span>
 #include <stdexcept>
@@ -30,9 +30,9 @@ Tree<BV, D> cloud_tree(const PointCloud& cloud, const ParamValues& density, cons
   } else {
     static_assert(std::is_same_v<D, AdbDensity>, "trees over points carry no density or adb's");
     const AdbParams params = density_params<D>(density);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     Tree<BV, D> tree = annotate_adb_points(std::move(bvh), cloud, params.grid, params.tau);
-    annotate_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    annotate_seconds = seconds_since(start);
     return tree;
   }
 }

@@ -9,7 +9,6 @@
 #include "traversal/point_leaves.hpp"
 #include "traversal/strategies.hpp"
 
-#include <chrono>
 #include <cstdio>
 #include <stdexcept>
 
@@ -172,9 +171,9 @@ template <class BV, class D>
 std::shared_ptr<const AnyTree::Model> build_point_typed(const UnitCloud& cloud, const DensitySpec& density,
                                                         const BuildOptions& options) {
   double annotate_seconds = 0;
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   Tree<BV, D> tree = cloud_tree<BV, D>(cloud, density.values, options, annotate_seconds);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = seconds_since(start);
   return std::make_shared<PointModel<BV, D>>(cloud, std::move(tree), cloud.units, seconds - annotate_seconds,
                                              annotate_seconds);
 }
