@@ -1,6 +1,7 @@
 #include "bench/aggregate.hpp"
 
 #include "bench/core/policies.hpp"
+#include "bench/report_tables.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -33,29 +34,28 @@ ResultRow series_row(const std::string& label, const HierarchySpec& h, const Mod
 
 }  // namespace
 
-std::vector<TruthSummary> summarize_truth(const std::string& label, const WorkloadSpec& workload,
-                                          const Truth& truth) {
-  std::vector<TruthSummary> out;
-  for (std::size_t g = 0; g < workload.groups.size(); ++g) {
-    TruthSummary summary{label, workload.groups[g].distance, truth[g].size(), 0};
-    for (auto t : truth[g]) summary.colliding += t;
-    out.push_back(summary);
-  }
-  return out;
+TruthSummary summarize_truth(const std::string& label, const PoseSlice& slice, const Truth& truth) {
+  TruthSummary summary{label, slice.distance, slice.poses.size(), 0};
+  for (const auto& [g, k] : slice.poses) summary.colliding += truth[g][k];
+  return summary;
 }
 
-void Aggregation::add_group(const PreparedPair& pair, const RunPlan& plan, std::size_t g,
-                            const std::vector<std::uint8_t>& truth, const GroupRecords& records,
-                            RunOutput& output, const SeriesMaps& maps) {
-  const PoseGroup& group = output.scene.workload.groups[g];
+void Aggregation::add_slice(const PreparedPair& pair, const RunPlan& plan, const PoseSlice& slice,
+                            const Truth& truth, const PairRecords& records, RunOutput& output,
+                            const SeriesMaps& maps) {
+  std::vector<std::uint8_t> slice_truth;
+  for (const auto& [g, k] : slice.poses) slice_truth.push_back(truth[g][k]);
+  std::vector<QueryRecord> slice_records;
   for (std::size_t i = 0; i < plan.hierarchies.size(); ++i) {
     const HierarchySpec& h = *plan.hierarchies[i].hierarchy;
     const PreparedHierarchy& hierarchy = *pair.hierarchies[i];
     for (std::size_t v = 0; v < plan.hierarchies[i].variants.size(); ++v) {
+      slice_records.clear();
+      for (const auto& [g, k] : slice.poses) slice_records.push_back(records[g][i][v][k]);
       const StrategyVariant& variant = plan.hierarchies[i].variants[v];
-      ResultRow row = series_row(pair.label, h, hierarchy.model, variant, group.distance);
+      ResultRow row = series_row(pair.label, h, hierarchy.model, variant, slice.distance);
       const std::string key = pair.label + "\x1f" + h.name + "\x1f" + variant.label();
-      tally(records[i][v], truth, key, hierarchy.has_counters(), row, output.stats);
+      tally(slice_records, slice_truth, key, hierarchy.has_counters(), row, output.stats);
       const CalibrationBin series{pair.label, h.name, row.strategy, row.budget, row.p_min};
       if (!row.exact_strategy) register_series(key, series);
       if (i < maps.size() && v < maps[i].size() && maps[i][v]) {
@@ -63,12 +63,13 @@ void Aggregation::add_group(const PreparedPair& pair, const RunPlan& plan, std::
         CalibrationBin calibrated = series;
         calibrated.calibrated = true;
         register_series(calibrated_key, calibrated);
-        for (std::size_t k = 0; k < records[i][v].size(); ++k)
-          bin(calibrated_key, (*maps[i][v])(records[i][v][k].probability), truth[k] != 0);
+        for (std::size_t k = 0; k < slice_records.size(); ++k)
+          bin(calibrated_key, (*maps[i][v])(slice_records[k].probability), slice_truth[k] != 0);
       }
       if (per_pose_ != PerPose::none)
-        keep_poses(records[i][v], truth, g, output.rows.size(), hierarchy.has_counters(), output.poses);
-      output.rows.push_back(row);
+        keep_poses(slice_records, slice_truth, slice, output.rows.size(), hierarchy.has_counters(),
+                   output.poses);
+      output.rows.push_back(std::move(row));
     }
   }
 }
@@ -77,7 +78,8 @@ void Aggregation::tally(const std::vector<QueryRecord>& records, const std::vect
                         const std::string& series_key, bool has_counters, ResultRow& row, RunStats& stats) {
   row.queries = records.size();
   std::size_t fp = 0, fn = 0, truth_yes = 0, answer_yes = 0, inexact = 0, exhausted = 0;
-  double sum_us = 0, max_us = 0;
+  double sum_us = 0;
+  row.pose_times_us.clear();
   Counters counters;
   const bool calibrate = !row.exact_strategy;
   for (std::size_t k = 0; k < records.size(); ++k) {
@@ -91,7 +93,7 @@ void Aggregation::tally(const std::vector<QueryRecord>& records, const std::vect
     exhausted += r.budget_exhausted;
     const double micros = net_micros(r.micros, clock_overhead_us_);
     sum_us += micros;
-    max_us = std::max(max_us, micros);
+    row.pose_times_us.push_back(micros);
     counters += r.counters;
     if (calibrate) bin(series_key, r.probability, truly);
   }
@@ -103,13 +105,17 @@ void Aggregation::tally(const std::vector<QueryRecord>& records, const std::vect
   row.inexact_rate = double(inexact) / n;
   row.budget_exhausted_rate = double(exhausted) / n;
   row.mean_time_us = sum_us / n;
-  row.max_time_us = max_us;
+  row.median_time_us = report_tables::median(row.pose_times_us);
+  row.p99_time_us = report_tables::quantile(row.pose_times_us, 0.99);
+  row.max_time_us = report_tables::quantile(row.pose_times_us, 1);
   if (has_counters) {
     row.bv_tests_per_query = double(counters.bv_tests) / n;
     row.triangle_tests_per_query = double(counters.triangle_tests) / n;
     row.nodes_visited_per_query = double(counters.nodes_visited) / n;
+    row.estimates_per_query = double(counters.probability_evaluations) / n;
   } else {
-    row.bv_tests_per_query = row.triangle_tests_per_query = row.nodes_visited_per_query = kNotApplicable;
+    row.bv_tests_per_query = row.triangle_tests_per_query = row.nodes_visited_per_query =
+        row.estimates_per_query = kNotApplicable;
   }
   stats.queries += records.size();
   stats.query_seconds += sum_us * 1e-6;
@@ -130,14 +136,15 @@ void Aggregation::register_series(const std::string& key, const CalibrationBin& 
 }
 
 void Aggregation::keep_poses(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,
-                             std::size_t g, std::size_t row, bool has_counters,
+                             const PoseSlice& slice, std::size_t row, bool has_counters,
                              std::vector<PoseRecord>& out) const {
   for (std::size_t k = 0; k < records.size(); ++k) {
     const QueryRecord& r = records[k];
     const bool truly = truth[k] != 0;
     if (per_pose_ == PerPose::wrong && r.collides == truly) continue;
-    out.push_back({row, g, k, truly, r.collides, r.exact, r.budget_exhausted, has_counters, r.probability,
-                   net_micros(r.micros, clock_overhead_us_), r.counters});
+    out.push_back({row, slice.poses[k].first, slice.poses[k].second, truly, r.collides, r.exact,
+                   r.budget_exhausted, has_counters, r.probability, net_micros(r.micros, clock_overhead_us_),
+                   r.counters});
   }
 }
 

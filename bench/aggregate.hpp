@@ -4,6 +4,7 @@
 #pragma once
 
 #include "bench/measure.hpp"
+#include "bench/slices.hpp"
 
 #include <array>
 #include <cstddef>
@@ -13,9 +14,11 @@
 
 namespace bvhlab {
 
-/// The ground truth's colliding fraction per distance, for one pair.
-std::vector<TruthSummary> summarize_truth(const std::string& label, const WorkloadSpec& workload,
-                                          const Truth& truth);
+/// The ground truth's colliding fraction of one slice, for one pair.
+TruthSummary summarize_truth(const std::string& label, const PoseSlice& slice, const Truth& truth);
+
+/// The timed records of every pose group of one pair, [group] (a group not timed yet: empty).
+using PairRecords = std::vector<GroupRecords>;
 
 /// The aggregate stage of one run.
 class Aggregation {
@@ -24,14 +27,13 @@ class Aggregation {
   /// also kept one by one in RunOutput::poses.
   explicit Aggregation(double clock_overhead_us, PerPose per_pose = PerPose::none)
       : clock_overhead_us_(clock_overhead_us), per_pose_(per_pose) {}
-  /// One row per planned series of the pair on pose group `g` of the scene's workload (`truth`: its ground
-  /// truth), appended to output.rows in plan order; the queries and their time are added to output.stats,
-  /// and the queries per_pose asks for to output.poses. A series with a map in `maps` is also binned a second
-  /// time, its probabilities through the map (a calibrated series: calibration bins only, since its answers,
-  /// times and counters are the raw series').
-  void add_group(const PreparedPair& pair, const RunPlan& plan, std::size_t g,
-                 const std::vector<std::uint8_t>& truth, const GroupRecords& records, RunOutput& output,
-                 const SeriesMaps& maps = {});
+  /// One row per planned series of the pair on the poses of `slice` (`truth`: the workload's ground
+  /// truth; `records`: the groups' timed records), appended to output.rows in plan order; the queries and
+  /// their time are added to output.stats, and the queries per_pose asks for to output.poses. A series with
+  /// a map in `maps` is also binned a second time, its probabilities through the map (a calibrated series:
+  /// calibration bins only, since its answers, times and counters are the raw series').
+  void add_slice(const PreparedPair& pair, const RunPlan& plan, const PoseSlice& slice, const Truth& truth,
+                 const PairRecords& records, RunOutput& output, const SeriesMaps& maps = {});
   /// Ten probability bins per inexact series, series in the order they first appeared.
   [[nodiscard]] std::vector<CalibrationBin> calibration() const;
 
@@ -53,7 +55,8 @@ class Aggregation {
 
   /// The queries of one series that per_pose_ asks for, as rows of poses.csv for output row `row`.
   void keep_poses(const std::vector<QueryRecord>& records, const std::vector<std::uint8_t>& truth,
-                  std::size_t g, std::size_t row, bool has_counters, std::vector<PoseRecord>& out) const;
+                  const PoseSlice& slice, std::size_t row, bool has_counters,
+                  std::vector<PoseRecord>& out) const;
 
   double clock_overhead_us_;
   PerPose per_pose_;

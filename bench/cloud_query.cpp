@@ -66,12 +66,11 @@ void run_on(const QueryObject& a, const QueryObject& b, const DensitySpec& densi
           return S::query(side_a.tree, side_b.tree, pose, options, leaves);
         };
         const double overhead = repeat > 0 ? clock_overhead_us() : 0;
-        for (const RigidTransform& pose : poses)
-          outcome.answers.push_back(
-              answer_pose(pose, repeat, overhead, query,
-                          [&](const std::vector<RigidTransform>& copies, std::vector<QueryRecord>& records) {
-                            timed_series(copies, 0, records, query);
-                          }));
+        outcome.answers =
+            answer_poses(poses, repeat, overhead, query,
+                         [&](std::span<const RigidTransform> all, std::vector<QueryRecord>& records) {
+                           timed_series(all, 0, records, query);
+                         });
       } else {
         throw std::logic_error("cloud_query_refusal let strategy " + strategy.strategy +
                                " through without a leaf test");

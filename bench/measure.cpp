@@ -4,6 +4,7 @@
 #include "bench/core/policies.hpp"
 #include "bench/core/tree_cache.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <thread>
@@ -31,6 +32,13 @@ struct Reader {
     return v;
   }
 };
+
+/// Context switches forced on this thread so far (another process took its core).
+long involuntary_switches() {
+  rusage usage{};
+  getrusage(RUSAGE_THREAD, &usage);
+  return usage.ru_nivcsw;
+}
 
 Truth exact_truth(const WorkloadSpec& workload, const PreparedHierarchy& exact, unsigned threads) {
   Truth truth(workload.groups.size());
@@ -179,7 +187,10 @@ Measurement::Measurement(const Scene& scene, const RunPlan& plan, const RunOptio
                    "truth"),
       calibration_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "calibration",
                          ".calib", "calibration"),
-      progress_(options.progress, plan.total_queries) {}
+      progress_(options.progress, plan.total_queries) {
+  stats_.timing_repeats = scene.timing.repeats;
+  stats_.timing_statistic = statistic_name(scene.timing.statistic);
+}
 
 Truth Measurement::ground_truth(const PreparedPair& pair, Preparation& preparation) {
   const auto truth_start = Clock::now();
@@ -248,29 +259,58 @@ void Measurement::cross_check(const PreparedPair& pair, const Truth& truth) {
   }
 }
 
-// Every hierarchy and strategy on the same poses. The poses run in blocks, each block through every
-// series in turn, so a slow spell of a shared machine (another process, frequency changes) spreads
-// over all series instead of landing on one; within a block the caches stay warm.
+// Every hierarchy and strategy on the same poses. The poses run in blocks; each block is timed in `repeats`
+// passes, and each pass runs every series over the block in turn. So a slow spell of a shared machine
+// (another process, frequency changes) spreads over all series instead of landing on one, a pose comes
+// back only after every other query of its block (the branch predictor cannot learn it), and within a block
+// the caches stay warm. Each (series, pose) keeps the query of its representative sample (the median or the
+// minimum of its passes): its time and its answer come from the same query.
 GroupRecords Measurement::time_group(const PreparedPair& pair, std::size_t g) {
   const PoseGroup& group = scene_.workload.groups[g];
   const auto& planned = plan_.hierarchies;
+  const std::size_t repeats = static_cast<std::size_t>(std::max(1, scene_.timing.repeats));
   GroupRecords series(planned.size());
   for (std::size_t i = 0; i < planned.size(); ++i) series[i].resize(planned[i].variants.size());
   const std::span<const RigidTransform> poses(group.poses);
+  const long switches_before = involuntary_switches();
   for (std::size_t begin = 0; begin < poses.size(); begin += kPoseBlock) {
     const auto block = poses.subspan(begin, std::min(kPoseBlock, poses.size() - begin));
+    // passes[series][pass]: the block's records of one pass of one series.
+    std::vector<std::vector<std::vector<QueryRecord>>> passes;
+    for (std::size_t pass = 0; pass < repeats; ++pass) {
+      std::size_t s = 0;
+      for (std::size_t i = 0; i < planned.size(); ++i)
+        for (std::size_t v = 0; v < planned[i].variants.size(); ++v, ++s) {
+          if (pass == 0) passes.emplace_back(repeats);
+          pair.hierarchies[i]->run(planned[i].variants[v], block, warmup_, passes[s][pass]);
+        }
+    }
+    std::size_t s = 0;
     for (std::size_t i = 0; i < planned.size(); ++i)
-      for (std::size_t v = 0; v < planned[i].variants.size(); ++v) {
-        pair.hierarchies[i]->run(planned[i].variants[v], block, warmup_, block_records_);
-        series[i][v].insert(series[i][v].end(), block_records_.begin(), block_records_.end());
-      }
+      for (std::size_t v = 0; v < planned[i].variants.size(); ++v, ++s)
+        keep_representatives(passes[s], series[i][v]);
     char distance[16];
     std::snprintf(distance, sizeof distance, "%g", group.distance);
     std::size_t done = 0;
     for (const auto& h : planned) done += h.variants.size() * block.size();
     progress_.advance(done, pair.label + " d=" + distance);
   }
+  stats_.involuntary_switches += involuntary_switches() - switches_before;
   return series;
+}
+
+void Measurement::keep_representatives(const std::vector<std::vector<QueryRecord>>& passes,
+                                       std::vector<QueryRecord>& out) {
+  std::vector<double> samples(passes.size());
+  for (std::size_t k = 0; k < passes.front().size(); ++k) {
+    for (std::size_t pass = 0; pass < passes.size(); ++pass) samples[pass] = passes[pass][k].micros;
+    out.push_back(passes[representative_sample(samples, scene_.timing.statistic)][k]);
+    disturbance_.add(samples);
+  }
+  stats_.timed_samples = disturbance_.samples;
+  stats_.stalled_samples = disturbance_.stalled;
+  stats_.sampled_seconds = disturbance_.timed_us * 1e-6;
+  stats_.stall_lost_seconds = disturbance_.lost_us * 1e-6;
 }
 
 SeriesMaps Measurement::calibration_maps(const PreparedPair& pair, Preparation& preparation) {

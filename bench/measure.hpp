@@ -5,6 +5,7 @@
 
 #include "adb/calibration.hpp"
 #include "bench/prepare.hpp"
+#include "bench/timing_stats.hpp"
 
 #include <algorithm>
 #include <cstddef>
@@ -47,20 +48,26 @@ inline double net_micros(double micros, double clock_overhead_us) {
   return std::max(0.0, micros - clock_overhead_us);
 }
 
-/// One pose's answer for a query with warm repeats: first(pose) once, timed (cold), with its full result;
-/// then series(poses, records) over `repeat` copies of the pose, each time net of the clock's overhead.
+/// Each pose's answer for a query with warm repeats: first(pose) once per pose, timed (cold), with its full
+/// result; then `repeat` passes of series(poses, records), each timing every pose once in order (so a pose
+/// comes back only after all the others, and the branch predictor cannot learn it), each time net of the
+/// clock's overhead.
 template <class First, class Series>
-PoseAnswer answer_pose(const RigidTransform& pose, int repeat, double clock_overhead_us, First&& first,
-                       Series&& series) {
-  PoseAnswer answer;
-  const auto start = Clock::now();
-  answer.result = first(pose);
-  answer.micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
-  if (repeat <= 0) return answer;
+std::vector<PoseAnswer> answer_poses(std::span<const RigidTransform> poses, int repeat,
+                                     double clock_overhead_us, First&& first, Series&& series) {
+  std::vector<PoseAnswer> answers(poses.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const auto start = Clock::now();
+    answers[k].result = first(poses[k]);
+    answers[k].micros = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+  }
   std::vector<QueryRecord> records;
-  series(std::vector<RigidTransform>(std::size_t(repeat), pose), records);
-  for (const QueryRecord& r : records) answer.warm_micros.push_back(net_micros(r.micros, clock_overhead_us));
-  return answer;
+  for (int pass = 0; pass < repeat; ++pass) {
+    series(poses, records);
+    for (std::size_t k = 0; k < poses.size(); ++k)
+      answers[k].warm_micros.push_back(net_micros(records[k].micros, clock_overhead_us));
+  }
+  return answers;
 }
 
 using Truth = std::vector<std::vector<std::uint8_t>>;  // [group][pose] -> 0/1
@@ -141,6 +148,10 @@ class Measurement {
   Truth compute_truth(const PreparedPair& pair, Preparation& preparation, const WorkloadSpec& workload);
   Truth cached_truth(const PreparedPair& pair, Preparation& preparation, const WorkloadSpec& workload);
   void cross_check(const PreparedPair& pair, const Truth& truth);
+  /// Per pose of a block, the record of its representative pass (passes[pass][pose]) appended to `out`; its
+  /// samples tallied for the run's disturbance.
+  void keep_representatives(const std::vector<std::vector<QueryRecord>>& passes,
+                            std::vector<QueryRecord>& out);
 
   const Scene& scene_;
   const RunPlan& plan_;
@@ -151,7 +162,7 @@ class Measurement {
   KeyedFileCache truth_cache_;        ///< payload: encode_truth
   KeyedFileCache calibration_cache_;  ///< payload: CalibrationMap::encode
   Progress progress_;
-  std::vector<QueryRecord> block_records_;
+  Disturbance disturbance_;
 };
 
 }  // namespace bvhlab

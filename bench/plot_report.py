@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
 """Draws the five figures of a bvhlab report from its results.csv and calibration.csv.
 
-    plot_report.py REPORT_DIR [--quality-min 1.2] [--quality-max 2.0] [--quality-text "distances 1.2-2"]
-                   [--distance-label "..."] [--operating-strategy adb] [--operating-hierarchy aabb]
-                   [--operating-p-min 0.9]
+    plot_report.py REPORT_DIR [--band MESH=TEXT ...] [--distance-label "..."] [--operating-strategy adb]
+                   [--operating-hierarchy aabb] [--operating-p-min 0.9]
+    plot_report.py REPORT_DIR --check-pmin-curves
 
 The labels come from the scene (`bvhlab report` passes them): the distance axis says whether distances are
-in normalised or the scene's own units, and figure 3 names the distances it summarises.
+in normalised or the scene's own units, or separations, and figure 3 names each pair's summary band (the
+rows results.csv marks "in_summary"; --quality-min/--quality-max for a results.csv without that column).
+--check-pmin-curves draws nothing and lists where figure 3's p_min curves go back in time while their BV
+tests do not (exit status 1 if anywhere).
 
 Strategies are told apart by the columns results.csv takes from bvhlab's strategy table: "exact" (1 for an
 exact strategy), "strategy" (its name) and "label" (name, labelled parameters, budget); no strategy name is
@@ -22,6 +25,7 @@ Figures (PNG, in REPORT_DIR):
 """
 import math
 import os
+import sys
 
 import matplotlib
 
@@ -70,9 +74,19 @@ def grouped(rows):
     return out
 
 
-def aggregate(rows, lo, hi):
-    """Query-weighted means over distances in [lo, hi] of one series' rows."""
-    picked = [r for r in rows if lo - 1e-12 <= num(r["distance"]) <= hi + 1e-12 and int(r["queries"]) > 0]
+def in_summary(row, lo, hi):
+    """Whether a row counts in the summary: its pair's band as results.csv marks it ("in_summary"), else the
+    distances in [lo, hi]."""
+    if row.get("in_summary", "") != "":
+        return row["in_summary"] == "1"
+    return lo - 1e-12 <= num(row["distance"]) <= hi + 1e-12
+
+
+def aggregate(rows, lo, hi, band=False):
+    """Query-weighted means of one series' rows over distances in [lo, hi], or with band=True over the rows
+    inside their pair's summary band."""
+    picked = [r for r in rows if (in_summary(r, lo, hi) if band else lo - 1e-12 <= num(r["distance"]) <= hi + 1e-12)
+              and int(r["queries"]) > 0]
     q = sum(int(r["queries"]) for r in picked)
     if q == 0:
         return None
@@ -87,6 +101,30 @@ def aggregate(rows, lo, hi):
         "bytes": num(picked[0]["bytes_per_triangle"]),
         "queries": q,
     }
+
+
+def pmin_curve_breaks(rows):
+    """Where figure 3's p_min curves go back in time although the work does not: per (mesh, hierarchy,
+    strategy, budget) swept over p_min, over the rows inside their band, each neighbouring pair of p_min whose
+    BV tests per query rise (or stay) while the mean time falls, or the other way round. A list of
+    (mesh, hierarchy, label, p_min, next p_min); empty when every curve follows its work."""
+    curves = {}
+    for r in rows:
+        if r["p_min"] != "" and not is_exact(r):
+            curves.setdefault((r["mesh"], r["hierarchy"], r["strategy"], r["budget"]), []).append(r)
+    breaks = []
+    for (mesh, hierarchy, strategy, budget), series in curves.items():
+        points = []
+        for p_min in sorted({float(r["p_min"]) for r in series}):
+            picked = [r for r in series if float(r["p_min"]) == p_min]
+            agg = aggregate(picked, -1e300, 1e300, band=True)
+            work = sum(num(r["bv_tests_per_query"]) * int(r["queries"]) for r in picked if in_summary(r, -1e300, 1e300))
+            if agg:
+                points.append((p_min, agg["time"], work / agg["queries"]))
+        for (p, t, w), (q, u, v) in zip(points, points[1:]):
+            if (v >= w and u < t) or (v <= w and u > t):
+                breaks.append((mesh, hierarchy, f"{strategy} {budget}".strip(), p, q))
+    return breaks
 
 
 def subplots(n, width=6.0, height=4.2, rows_per_mesh=1):
@@ -272,7 +310,7 @@ def figure_error_vs_time(rows, args, out):
         budget_markers = iter(["D", "P", "X", "*", "v", "<", ">"])  # one marker per time-critical budget
         for i, series in enumerate(groups.values()):
             first = series[0]
-            agg = aggregate(series, args.quality_min, args.quality_max)
+            agg = aggregate(series, args.quality_min, args.quality_max, band=True)
             if agg is None:
                 continue
             if is_sweep(first, args):
@@ -292,7 +330,8 @@ def figure_error_vs_time(rows, args, out):
             ax.plot(xs, ys, "-", marker="^", color=colour, label=f"{hierarchy}: {args.operating_strategy} over p_min")
             labels += [(x, y, f"{p:g}", hierarchy) for (p, _), x, y in zip(points, xs, ys)]
         log_axis(ax, "x")
-        ax.set_title(f"{mesh}: error vs time, {args.quality_text}")
+        bands = dict(b.split("=", 1) for b in args.band if "=" in b)
+        ax.set_title(f"{mesh}: error vs time, {bands.get(mesh, args.quality_text)}", fontsize=9)
         ax.set_xlabel(TIME_LABEL + ", log scale")
         ax.set_ylabel("wrong answers (FP + FN, % of queries)")
         floor_at_zero(ax)
@@ -479,9 +518,13 @@ def figure_time_vs_size(rows, args, out):
 
 
 def add_options(parser):
-    parser.add_argument("--quality-min", type=float, default=1.2)
-    parser.add_argument("--quality-max", type=float, default=2.0)
+    parser.add_argument("--quality-min", type=float, default=-1e300)
+    parser.add_argument("--quality-max", type=float, default=1e300)
     parser.add_argument("--quality-text", default="the quality distances")
+    parser.add_argument("--check-pmin-curves", action="store_true",
+                        help="draw nothing: list where a p_min curve's time moves against its BV tests (exit 1)")
+    parser.add_argument("--band", action="append", default=[],
+                        help="MESH=TEXT: the summary band of one mesh pair, for figure 3's title")
     parser.add_argument("--distance-label", default=DEFAULT_DISTANCE_LABEL)
     parser.add_argument("--operating-strategy", default="")
     parser.add_argument("--operating-hierarchy", default="")
@@ -489,6 +532,12 @@ def add_options(parser):
 
 
 def draw(args, rows, calibration):
+    if args.check_pmin_curves:
+        breaks = pmin_curve_breaks(rows)
+        for mesh, hierarchy, label, p, q in breaks:
+            print(f"{mesh} {hierarchy} {label}: p_min {p:g} -> {q:g}: time and BV tests move apart")
+        print(f"{len(breaks)} break(s) of figure 3's p_min curves against their work")
+        sys.exit(1 if breaks else 0)
     figure_time_vs_distance(rows, args, os.path.join(args.report_dir, "fig1_time_vs_distance.png"))
     figure_errors_vs_distance(rows, args, os.path.join(args.report_dir, "fig2_errors_vs_distance.png"))
     figure_error_vs_time(rows, args, os.path.join(args.report_dir, "fig3_error_vs_time.png"))

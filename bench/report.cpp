@@ -1,4 +1,6 @@
 #include "bench/report.hpp"
+#include "bench/slices.hpp"
+#include "bench/summary_band.hpp"
 #include "bench/write.hpp"
 
 #include <algorithm>
@@ -45,10 +47,6 @@ std::string series_name(const SeriesSummary& s) {
   return s.label;
 }
 
-std::string series_key(const ResultRow& r) {
-  return r.mesh + '\x1f' + r.hierarchy + '\x1f' + r.label;
-}
-
 std::string shell_quote(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -92,50 +90,6 @@ const std::vector<FigureSpec>& report_figures() {
   return figures;
 }
 
-std::vector<SeriesSummary> summarize(const std::vector<ResultRow>& rows, double lo, double hi) {
-  std::vector<SeriesSummary> out;
-  std::map<std::string, std::size_t> index;
-  std::map<std::string, double> bv_sum, tri_sum;
-  for (const ResultRow& r : rows) {
-    if (r.distance < lo - 1e-12 || r.distance > hi + 1e-12 || r.queries == 0) continue;
-    const std::string key = series_key(r);
-    auto it = index.find(key);
-    if (it == index.end()) {
-      it = index.emplace(key, out.size()).first;
-      SeriesSummary s;
-      s.mesh = r.mesh;
-      s.hierarchy = r.hierarchy;
-      s.bv = r.bv;
-      s.annotation = r.annotation;
-      s.strategy = r.strategy;
-      s.label = r.label;
-      s.exact_strategy = r.exact_strategy;
-      s.budget = r.budget;
-      s.p_min = r.p_min;
-      s.bytes_per_triangle = r.bytes_per_triangle;
-      out.push_back(s);
-    }
-    SeriesSummary& s = out[it->second];
-    const double q = double(r.queries);
-    s.queries += r.queries;
-    s.mean_time_us += r.mean_time_us * q;
-    s.max_time_us = std::max(s.max_time_us, r.max_time_us);
-    s.fp_rate += r.fp_rate * q;
-    s.fn_rate += r.fn_rate * q;
-    s.bv_tests_per_query += r.bv_tests_per_query * q;  // NaN (FCL: no counters) stays NaN
-    s.triangle_tests_per_query += r.triangle_tests_per_query * q;
-  }
-  for (SeriesSummary& s : out) {
-    const double q = double(s.queries);
-    s.mean_time_us /= q;
-    s.fp_rate /= q;
-    s.fn_rate /= q;
-    s.bv_tests_per_query /= q;
-    s.triangle_tests_per_query /= q;
-  }
-  return out;
-}
-
 std::vector<FrontPoint> error_time_front(const std::vector<SeriesSummary>& series, double max_error) {
   std::vector<FrontPoint> out;
   auto faster = [](const std::optional<SeriesSummary>& best, const SeriesSummary& s) {
@@ -143,7 +97,7 @@ std::vector<FrontPoint> error_time_front(const std::vector<SeriesSummary>& serie
   };
   for (const SeriesSummary& s : series) {
     auto it = std::find_if(out.begin(), out.end(), [&](const FrontPoint& f) { return f.mesh == s.mesh; });
-    if (it == out.end()) it = out.insert(out.end(), FrontPoint{s.mesh, {}, {}, 0});
+    if (it == out.end()) it = out.insert(out.end(), FrontPoint{s.mesh, {}, {}, 0, {}, false});
     if (!(s.mean_time_us >= 0)) continue;
     if (s.exact_strategy) {
       if (faster(it->fastest_exact, s)) it->fastest_exact = s;
@@ -152,8 +106,11 @@ std::vector<FrontPoint> error_time_front(const std::vector<SeriesSummary>& serie
     }
   }
   for (FrontPoint& f : out)
-    if (f.fastest_exact && f.fastest_inexact && f.fastest_inexact->mean_time_us > 0)
-      f.speedup = f.fastest_exact->mean_time_us / f.fastest_inexact->mean_time_us;
+    if (f.fastest_exact && f.fastest_inexact && f.fastest_inexact->mean_time_us > 0) {
+      f.interval = time_ratio(*f.fastest_exact, *f.fastest_inexact);
+      f.speedup = f.interval.value;
+      f.same_work = same_work(*f.fastest_exact, *f.fastest_inexact);
+    }
   return out;
 }
 
@@ -169,58 +126,11 @@ std::vector<double> row_distances(const RunOutput& run) {
   return distances;
 }
 
-/// The distances the time-versus-quality summary covers, and the words that say which.
-struct QualityRange {
-  double lo = -1e300, hi = 1e300;  ///< the smallest and largest distance of a row inside the range
-  bool all = true;                 ///< every distance of the run
-  std::string text;                ///< "distances 1.2–1.6", "all distances", ...
-};
-
-/// The poses of the workload's groups inside [lo, hi], and all of them.
-std::pair<std::size_t, std::size_t> poses_inside(const WorkloadSpec& workload, double lo, double hi) {
-  std::size_t inside = 0, total = 0;
-  for (const PoseGroup& g : workload.groups) {
-    total += g.poses.size();
-    if (g.distance >= lo && g.distance <= hi) inside += g.poses.size();
-  }
-  return {inside, total};
-}
-
-/// The scene's quality distances that the run has: the range named by the distances it holds (a scene whose
-/// distances stop at 1.6 is summarised over 1.2–1.6), or all distances when it holds none of them. A pose
-/// file's groups are the user's own: without quality distances in the scene, all its poses are used.
-QualityRange quality_range(const RunOutput& run) {
-  const ReportSpec& spec = run.scene.report;
-  const bool own_poses = run.scene.workload.kind != WorkloadSpec::Kind::Protocol;
-  QualityRange out;
-  if (own_poses && !spec.quality_given) {
-    out.text = "all poses";
-    return out;
-  }
-  std::vector<double> inside;
-  for (double d : row_distances(run))
-    if (d >= spec.quality_min - 1e-12 && d <= spec.quality_max + 1e-12) inside.push_back(d);
-  if (inside.empty()) {
-    out.text = "all distances (the workload has none in " + fmt("%g", spec.quality_min) + "–" +
-               fmt("%g", spec.quality_max) + ")";
-    return out;
-  }
-  out = {inside.front(), inside.back(), false, ""};
-  out.text = inside.size() == 1 ? "distance " + fmt("%g", out.lo)
-                                : "distances " + fmt("%g", out.lo) + "–" + fmt("%g", out.hi);
-  if (own_poses) {
-    const auto [used, total] = poses_inside(run.scene.workload, out.lo, out.hi);
-    out.text += " (" + std::to_string(used) + " of " + std::to_string(total) + " poses)";
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<OperatingPoint> operating_points(const RunOutput& run) {
   const ReportSpec& spec = run.scene.report;
-  const QualityRange range = quality_range(run);
-  const auto series = summarize(run.rows, range.lo, range.hi);
+  const auto series = summarize_band(run.rows);
   std::vector<OperatingPoint> out;
   std::vector<std::string> meshes;
   for (const auto& s : series)
@@ -235,7 +145,8 @@ std::vector<OperatingPoint> operating_points(const RunOutput& run) {
       if (s.hierarchy == spec.baseline_hierarchy && s.strategy == spec.baseline_strategy && !base) base = &s;
     }
     if (!adb || !base) continue;
-    out.push_back({mesh, *adb, *base, adb->mean_time_us > 0 ? base->mean_time_us / adb->mean_time_us : 0});
+    const Interval ratio = time_ratio(*base, *adb);
+    out.push_back({mesh, *adb, *base, ratio.value, ratio, same_work(*base, *adb)});
   }
   return out;
 }
@@ -270,6 +181,7 @@ void add_bin(CalibrationSummary& s, const CalibrationBin& b, std::size_t min_ans
                                 " of " + b.mesh + " " + b.hierarchy + " " + s.label + " holds " +
                                 std::to_string(b.count) + " answers but no finite probability or frequency");
   const double gap = std::abs(b.mean_probability - b.collision_frequency);
+  if (b.bin_low >= 0.1 - 1e-12) ++s.qualifying_above_tenth;
   if (s.qualifying_bins++ == 0 || gap > s.max_gap) {
     s.max_gap = gap;
     s.worst_reported = b.mean_probability;
@@ -302,7 +214,10 @@ std::vector<CalibrationSummary> calibration_summary(const std::vector<Calibratio
     }
     add_bin(*it, b, min_answers);
   }
-  for (CalibrationSummary& s : out) s.meets = s.qualifying_bins > 0 && s.max_gap <= tolerance;
+  for (CalibrationSummary& s : out) {
+    s.judgeable = s.qualifying_bins >= kCalibrationMinDeciles && s.qualifying_above_tenth > 0;
+    s.meets = s.judgeable && s.max_gap <= tolerance;
+  }
   return out;
 }
 
@@ -367,13 +282,41 @@ std::string workload_text(const Scene& scene) {
 }  // namespace
 
 std::string distance_label(const Scene& scene) {
-  if (scene.workload.kind == WorkloadSpec::Kind::PoseFile) return "pose group (the pose file's \"group\")";
-  if (scene.workload.kind == WorkloadSpec::Kind::Random) return "random poses (one group, filed under 0)";
+  if (scene.workload.axis == WorkloadSpec::Axis::Group) return "pose group (the pose file's \"group\")";
+  if (scene.workload.axis == WorkloadSpec::Axis::Separation)
+    return "separation: centre distance / (r_A + r_B), bins of " + fmt("%g", kSeparationBin) + " (" +
+           fmt("%g", kSeparationOpenFrom + kSeparationBin / 2) + ": " + fmt("%g", kSeparationOpenFrom) +
+           " and beyond)";
   return normalised_units(scene) ? "distance d of B's centre (each model normalised: longest side 2)"
                                  : "distance d of B's centre (scene units)";
 }
 
 namespace {
+
+/// How the times were taken, and how much the machine disturbed them.
+void readme_timing(std::ostream& md, const RunStats& stats) {
+  md << "Times: each (series, pose) is the " << stats.timing_statistic << " of " << stats.timing_repeats
+     << " warm pass" << (stats.timing_repeats == 1 ? "" : "es")
+     << " over the poses (every series runs each block of 50 poses in turn, so drift and stalls hit all "
+        "alike), timed with a steady clock less its own cost ("
+     << fmt("%.3f", stats.clock_overhead_us)
+     << " µs); a series' mean, median and p99 are over those per-pose times, on the same poses for every "
+        "series, in one process. Speed-ups carry a 95% interval (bootstrap over the poses).\n\n";
+  if (stats.timing_repeats < 2) {
+    md << "Disturbance: not measured (one pass gives no second sample of a pose).\n\n";
+    return;
+  }
+  const double share = stats.sampled_seconds > 0 ? stats.stall_lost_seconds / stats.sampled_seconds : 0;
+  md << "Disturbance: " << stats.stalled_samples << " of " << stats.timed_samples
+     << " samples were stalls (over " << fmt("%g", kStallFactor) << "× their pose's median + "
+     << fmt("%g", kStallMarginUs) << " µs), losing " << fmt("%.2f", 100 * share) << "% of the timed time; "
+     << stats.involuntary_switches << " forced context switches. "
+     << (share >= kDisturbedShare
+             ? "**This run was disturbed** (at least " + fmt("%g", 100 * kDisturbedShare) +
+                   "% lost): the per-pose " + stats.timing_statistic +
+                   " discards most stalls, but compare its ratios with care.\n\n"
+             : "Undisturbed (under " + fmt("%g", 100 * kDisturbedShare) + "% lost).\n\n");
+}
 
 /// Title, where and how the run was made, the workload, and what was skipped.
 void readme_header(std::ostream& md, const RunOutput& run) {
@@ -390,14 +333,33 @@ void readme_header(std::ostream& md, const RunOutput& run) {
        << "` (parameters in `bvhlab policies`; the ADB method in adb/README.md).\n\n";
   for (const HierarchySpec& h : scene.hierarchies)
     if (h.density) md << "Hierarchy `" << h.name << "` carries its own: `" << h.density->label() << "`.\n\n";
-  md << "Times are per query, measured one by one with a steady clock (less its own cost, "
-     << fmt("%.3f", stats.clock_overhead_us)
-     << " µs, measured at the start of the run), all strategies on the same poses in one process.\n\n";
+  readme_timing(md, stats);
   for (const auto& why : stats.skipped) md << "> **Skipped:** " << why << "\n\n";
+  for (const auto& advice : run.advice) md << "> **The right tool:** " << advice << "\n\n";
 }
 
-/// The operating point, stated plainly.
-void readme_operating_point(std::ostream& md, const RunOutput& run, const std::string& range_text) {
+/// "`hierarchy` label: 1.23 µs mean (median 1.1, p99 2.4), 12.3 BV tests, 4.0 triangle tests, 3.1 estimates".
+std::string series_text(const SeriesSummary& s) {
+  std::string text = "`" + s.hierarchy + "` " + s.label + ": " + micros(s.mean_time_us) +
+                     " µs mean (median " + micros(s.median_time_us) + ", p99 " + micros(s.p99_time_us) + ")";
+  if (!std::isfinite(s.bv_tests_per_query)) return text + ", no work counters";
+  return text + ", " + count(s.bv_tests_per_query) + " BV tests, " + count(s.triangle_tests_per_query) +
+         " triangle tests, " + count(s.estimates_per_query) + " estimates per query";
+}
+
+/// Why a band cannot compare strategies, or "" when it can.
+std::string uninformative(const SummaryBand* band) {
+  if (!band) return "it has no ground truth";
+  if (band->poses == 0) return "its band holds no pose";
+  if (band->colliding == 0)
+    return "no pose of its band collides, so every strategy answers the same trivial 'no'";
+  if (band->colliding == band->poses)
+    return "every pose of its band collides, so there is nothing to tell apart";
+  return "";
+}
+
+/// The operating point, stated plainly: both series with their work, and a verdict the interval carries.
+void readme_operating_point(std::ostream& md, const RunOutput& run, const std::vector<SummaryBand>& bands) {
   const Scene& scene = run.scene;
   md << "## Result at the operating point\n\n";
   const auto points = operating_points(run);
@@ -409,21 +371,21 @@ void readme_operating_point(std::ostream& md, const RunOutput& run, const std::s
        << "` on `" << scene.report.baseline_hierarchy << "`.\n\n";
   }
   for (const auto& p : points) {
-    md << "- **" << p.mesh << "** (" << range_text << ", " << p.adb.queries << " queries): ADB on `"
-       << p.adb.hierarchy << "` with p_min = " << fmt("%g", p.adb.p_min) << " takes "
-       << micros(p.adb.mean_time_us) << " µs per query against " << micros(p.baseline.mean_time_us)
-       << " µs for " << p.baseline.strategy << " `" << p.baseline.hierarchy << "`: "
-       << (p.speedup >= 1 ? "**" + fmt("%.2f", p.speedup) + "× faster**"
-                          : "**" + fmt("%.2f", 1 / p.speedup) + "× slower**")
-       << ", with " << percent(p.adb.fp_rate) << "% false positives and " << percent(p.adb.fn_rate)
-       << "% false negatives (" << percent(p.adb.fp_rate + p.adb.fn_rate) << "% wrong answers).\n";
+    const SummaryBand* band = band_of(bands, p.mesh);
+    md << "- **" << p.mesh << "** (" << (band ? band->text : std::string("no band")) << ", " << p.adb.queries
+       << " queries): ";
+    if (const std::string why = uninformative(band); !why.empty()) {
+      md << "no comparison: " << why << ".\n";
+      continue;
+    }
+    md << series_text(p.adb) << ", against " << series_text(p.baseline) << ": "
+       << speedup_text(p.interval, p.same_work) << ", with " << percent(p.adb.fp_rate)
+       << "% false positives and " << percent(p.adb.fn_rate) << "% false negatives ("
+       << percent(p.adb.fp_rate + p.adb.fn_rate) << "% wrong answers).\n";
   }
   if (!points.empty())
     md << "\nFor comparison, the paper reports a speed-up of about 3 to 6 over an exact DOP-tree at about 4% "
-          "errors "
-          "(ADB on AABBs, 8 cells per node, Pentium-IV). Times on a shared 2-core machine are noisy; compare "
-          "ratios "
-          "within one run.\n";
+          "errors (ADB on AABBs, 8 cells per node, Pentium-IV). Compare ratios within one run.\n";
   md << "\n";
 }
 
@@ -434,44 +396,66 @@ void readme_figures(std::ostream& md, bool figures_ok, const std::string& plot_e
     md << "![" << f.caption << "](" << f.file << ")\n\n*" << f.caption << "*\n\n";
 }
 
-/// The summary table over the time-versus-quality range.
-void readme_summary(std::ostream& md, const RunOutput& run, const QualityRange& range) {
-  md << "## Summary over " << range.text << "\n\n";
-  md << "| mesh | hierarchy | strategy | mean µs | max µs | FP % | FN % | BV tests/query | triangle "
+/// Each pair's summary band, one line each.
+void readme_bands(std::ostream& md, const std::vector<SummaryBand>& bands) {
+  for (const SummaryBand& b : bands) {
+    md << "- " << table_cell(b.mesh) << ": " << b.text << "; " << b.poses << " poses, " << b.colliding
+       << " colliding";
+    if (const std::string why = uninformative(&b); !why.empty()) md << ". No speed-up is given: " << why;
+    md << ".\n";
+  }
+  md << "\n";
+}
+
+/// The summary table over each pair's band: times beside the work.
+void readme_summary(std::ostream& md, const RunOutput& run, const std::vector<SummaryBand>& bands) {
+  md << "## Summary over each pair's band\n\n";
+  readme_bands(md, bands);
+  md << "| mesh | hierarchy | strategy | mean µs | median µs | p99 µs | max µs | FP % | FN % | BV "
         "tests/query | "
-        "bytes/triangle |\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const auto& s : summarize(run.rows, range.lo, range.hi))
+        "triangle tests/query | estimates/query | bytes/triangle |\n"
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const auto& s : summarize_band(run.rows))
     md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << series_name(s) << " | "
-       << micros(s.mean_time_us) << " | " << micros(s.max_time_us) << " | " << percent(s.fp_rate) << " | "
-       << percent(s.fn_rate) << " | " << count(s.bv_tests_per_query) << " | "
-       << count(s.triangle_tests_per_query) << " | " << fmt("%.1f", s.bytes_per_triangle) << " |\n";
-  md << "\nMaximum times include the odd preemption by the operating system (milliseconds on a shared "
-        "machine); "
-        "the mean is the robust figure. FCL exposes no work counters (n/a).\n\n";
+       << micros(s.mean_time_us) << " | " << micros(s.median_time_us) << " | " << micros(s.p99_time_us)
+       << " | " << micros(s.max_time_us) << " | " << percent(s.fp_rate) << " | " << percent(s.fn_rate)
+       << " | " << count(s.bv_tests_per_query) << " | " << count(s.triangle_tests_per_query) << " | "
+       << count(s.estimates_per_query) << " | " << fmt("%.1f", s.bytes_per_triangle) << " |\n";
+  md << "\nEach time is a per-pose " << run.stats.timing_statistic << " of " << run.stats.timing_repeats
+     << " warm passes; the maximum is the slowest pose's. FCL exposes no work counters (n/a).\n\n";
 }
 
 /// The fastest inexact series within 4% wrong answers against the fastest exact one, per mesh pair.
-void readme_front(std::ostream& md, const RunOutput& run, const QualityRange& range) {
-  const auto front = error_time_front(summarize(run.rows, range.lo, range.hi), kFrontMaxError);
+void readme_front(std::ostream& md, const RunOutput& run, const std::vector<SummaryBand>& bands) {
+  const auto front = error_time_front(summarize_band(run.rows), kFrontMaxError);
   if (std::none_of(front.begin(), front.end(),
                    [](const FrontPoint& f) { return f.fastest_exact.has_value(); }))
     return;
   const std::string bound = percent(kFrontMaxError) + "%";
-  md << "## Against the fastest exact hierarchy\n\nOver " << range.text
-     << ": the fastest exact series, and the fastest inexact one with at most " << bound
-     << " wrong answers (FP + FN).\n\n"
-     << "| mesh | fastest exact | µs | fastest inexact within " << bound
-     << " | µs | FP % | FN % | speed-up |\n|---|---|---:|---|---:|---:|---:|---:|\n";
+  md << "## Against the fastest exact hierarchy\n\nOver each pair's band (above): the fastest exact series, "
+        "and the fastest inexact one with at most "
+     << bound
+     << " wrong answers (FP + FN), each with its work per query (BV tests / triangle tests / "
+        "estimates).\n\n"
+     << "| mesh | fastest exact | µs | work | fastest inexact within " << bound
+     << " | µs | work | FP % | FN % | speed-up |\n|---|---|---:|---|---|---:|---|---:|---:|---|\n";
+  auto work = [](const SeriesSummary& s) {
+    return count(s.bv_tests_per_query) + " / " + count(s.triangle_tests_per_query) + " / " +
+           count(s.estimates_per_query);
+  };
   for (const FrontPoint& f : front) {
     if (!f.fastest_exact) continue;
     md << "| " << table_cell(f.mesh) << " | " << f.fastest_exact->hierarchy << " " << f.fastest_exact->label
-       << " | " << micros(f.fastest_exact->mean_time_us) << " | ";
-    if (f.fastest_inexact)
-      md << f.fastest_inexact->hierarchy << " " << f.fastest_inexact->label << " | "
-         << micros(f.fastest_inexact->mean_time_us) << " | " << percent(f.fastest_inexact->fp_rate) << " | "
-         << percent(f.fastest_inexact->fn_rate) << " | " << fmt("%.2f", f.speedup) << "× |\n";
-    else
-      md << "none | | | | |\n";
+       << " | " << micros(f.fastest_exact->mean_time_us) << " | " << work(*f.fastest_exact) << " | ";
+    if (!f.fastest_inexact) {
+      md << "none | | | | | |\n";
+      continue;
+    }
+    const std::string why = uninformative(band_of(bands, f.mesh));
+    md << f.fastest_inexact->hierarchy << " " << f.fastest_inexact->label << " | "
+       << micros(f.fastest_inexact->mean_time_us) << " | " << work(*f.fastest_inexact) << " | "
+       << percent(f.fastest_inexact->fp_rate) << " | " << percent(f.fastest_inexact->fn_rate) << " | "
+       << (why.empty() ? speedup_text(f.interval, f.same_work, false) : "none: " + why) << " |\n";
   }
   md << "\n";
 }
@@ -487,7 +471,9 @@ void readme_calibration(std::ostream& md, const RunOutput& run) {
         "at "
         "least "
      << kCalibrationMinAnswers << " answers, the mean reported probability within " << tolerance
-     << " of the observed collision frequency.\n\n| mesh | hierarchy | strategy | answers | deciles with ≥ "
+     << " of the observed collision frequency. A verdict needs at least " << kCalibrationMinDeciles
+     << " such deciles, one of them above 0.1; otherwise there is too little spread to judge.\n\n"
+        "| mesh | hierarchy | strategy | answers | deciles with ≥ "
      << kCalibrationMinAnswers << " answers | largest gap | worst decile: reported → observed | within "
      << tolerance << " |\n|---|---|---|---:|---:|---:|---|---|\n";
   std::vector<std::string> meeting;
@@ -495,12 +481,15 @@ void readme_calibration(std::ostream& md, const RunOutput& run) {
     md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << s.label << " | " << s.answers
        << " | " << s.qualifying_bins << " | ";
     if (s.qualifying_bins == 0) {
-      md << "n/a | | no decile to judge |\n";
+      md << "n/a | | too little spread to judge |\n";
       continue;
     }
     md << fmt("%.3f", s.max_gap) << " | " << fmt("%.1f", s.worst_low) << "–" << fmt("%.1f", s.worst_high)
        << ": " << fmt("%.3f", s.worst_reported) << " → " << fmt("%.3f", s.worst_observed) << " | "
-       << (s.meets ? "yes" : "no") << " |\n";
+       << (!s.judgeable ? "too little spread to judge"
+           : s.meets    ? "yes"
+                        : "no")
+       << " |\n";
     if (s.meets) meeting.push_back(s.mesh + " " + s.hierarchy + " " + s.label);
   }
   md << "\n";
@@ -616,14 +605,14 @@ void readme_run(std::ostream& md, const RunStats& stats) {
 }  // namespace
 
 std::string report_readme(const RunOutput& run, bool figures_ok, const std::string& plot_error) {
-  const QualityRange range = quality_range(run);
+  const std::vector<SummaryBand> bands = summary_bands(run);
   const std::vector<double> distances = row_distances(run);
   std::ostringstream md;
   readme_header(md, run);
-  readme_operating_point(md, run, range.text);
+  readme_operating_point(md, run, bands);
   readme_figures(md, figures_ok, plot_error);
-  readme_summary(md, run, range);
-  readme_front(md, run, range);
+  readme_summary(md, run, bands);
+  readme_front(md, run, bands);
 
   readme_calibration(md, run);
   readme_per_distance(md, run, distances);
@@ -635,18 +624,24 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
 
 std::string report_snippet(const RunOutput& run, const std::filesystem::path& report_dir) {
   std::ostringstream md;
-  const QualityRange range = quality_range(run);
+  const std::vector<SummaryBand> bands = summary_bands(run);
   md << "## Results\n\nScene `" << run.scene.file.filename().string() << "` (" << run.stats.queries
      << " timed queries; `make demo` runs `bench/scenes/demo.json`) writes a report folder (`"
      << report_dir.filename().string() << "/README.md`, `results.csv`, five figures). On "
      << run.environment.machine << " (" << run.environment.build_type << ", commit `"
-     << run.environment.git_commit << "`), over " << range.text << ":\n\n";
-  for (const auto& p : operating_points(run))
-    md << "- **" << p.mesh << "**: ADB on " << p.adb.hierarchy << " (p_min = " << fmt("%g", p.adb.p_min)
-       << ") " << micros(p.adb.mean_time_us) << " µs per query vs " << micros(p.baseline.mean_time_us)
-       << " µs for " << p.baseline.strategy << " " << p.baseline.hierarchy << ": " << fmt("%.2f", p.speedup)
-       << "× speed-up, " << percent(p.adb.fp_rate) << "% false positives, " << percent(p.adb.fn_rate)
-       << "% false negatives.\n";
+     << run.environment.git_commit << "`), over each pair's summary band:\n\n";
+  for (const auto& p : operating_points(run)) {
+    const SummaryBand* band = band_of(bands, p.mesh);
+    md << "- **" << p.mesh << "** (" << (band ? band->text : std::string("no band")) << "): ADB on "
+       << p.adb.hierarchy << " (p_min = " << fmt("%g", p.adb.p_min) << ") " << micros(p.adb.mean_time_us)
+       << " µs per query vs " << micros(p.baseline.mean_time_us) << " µs for " << p.baseline.strategy << " "
+       << p.baseline.hierarchy << ": ";
+    if (const std::string why = uninformative(band); !why.empty())
+      md << "no comparison (" << why << ").\n";
+    else
+      md << speedup_text(p.interval, p.same_work, false) << ", " << percent(p.adb.fp_rate)
+         << "% false positives, " << percent(p.adb.fn_rate) << "% false negatives.\n";
+  }
   md << "\nFigures: ";
   for (std::size_t i = 0; i < report_figures().size(); ++i)
     md << (i ? ", " : "") << "`" << report_figures()[i].file << "`";
@@ -697,12 +692,11 @@ ReportFiles write_report(const RunOutput& run, const std::filesystem::path& dir,
   for (const auto& f : report_figures()) std::filesystem::remove(files.dir / f.file);  // no stale figures
   if (options.figures) {
     const ReportSpec& r = run.scene.report;
-    const QualityRange range = quality_range(run);
-    // "--name=value": a range over all poses starts at -1e300, which argparse would take for an option.
-    std::string arguments = " --quality-min=" + fmt("%.17g", range.lo) +
-                            " --quality-max=" + fmt("%.17g", range.hi) + " --quality-text " +
-                            shell_quote(range.text) + " --distance-label " +
-                            shell_quote(distance_label(run.scene));
+    // results.csv marks each row inside its pair's band; the bands' words title figure 3.
+    std::string arguments = " --quality-text " + shell_quote("each pair's summary band") +
+                            " --distance-label " + shell_quote(distance_label(run.scene));
+    for (const SummaryBand& band : summary_bands(run))
+      arguments += " --band " + shell_quote(band.mesh + "=" + band.text);
     if (!r.operating_hierarchy.empty())
       arguments += " --operating-strategy " + shell_quote(r.operating_strategy) + " --operating-hierarchy " +
                    shell_quote(r.operating_hierarchy) + " --operating-p-min " +

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "bench/run.hpp"
+#include "bench/timing_stats.hpp"
 
 #include <filesystem>
 #include <optional>
@@ -24,11 +25,24 @@ struct SeriesSummary {
   bool exact_strategy = true;
   double p_min = -1;
   std::size_t queries = 0;
-  double mean_time_us = 0, max_time_us = 0, fp_rate = 0, fn_rate = 0;
-  double bv_tests_per_query = 0, triangle_tests_per_query = 0, bytes_per_triangle = 0;
+  double mean_time_us = 0, median_time_us = 0, p99_time_us = 0, max_time_us = 0, fp_rate = 0, fn_rate = 0;
+  double bv_tests_per_query = 0, triangle_tests_per_query = 0, estimates_per_query = 0,
+         bytes_per_triangle = 0;
+  std::vector<double> pose_times_us;  ///< its rows' per-pose times, in row order (bootstrap intervals)
 };
 /// Series over distances in [lo, hi], in the order the rows first appear.
 std::vector<SeriesSummary> summarize(const std::vector<ResultRow>& rows, double lo, double hi);
+/// Series over the rows inside their pair's summary band (ResultRow::in_summary).
+std::vector<SeriesSummary> summarize_band(const std::vector<ResultRow>& rows);
+
+/// Whether two series did the same work: BV tests, triangle tests and estimates per query each within 1%.
+/// Their times then differ by the machine, not by the method: the report calls it no speed-up.
+bool same_work(const SeriesSummary& a, const SeriesSummary& b);
+/// How `slow` compares with `fast` in time: the ratio of their mean times with its 95% bootstrap interval.
+Interval time_ratio(const SeriesSummary& slow, const SeriesSummary& fast);
+/// The words for that comparison: "same work", "no measurable difference" when the interval holds 1, else
+/// the speed-up (or slow-down) with its interval. `bold` marks the verdict for Markdown.
+std::string speedup_text(const Interval& ratio, bool same_work, bool bold = true);
 
 /// The error/time front of one mesh pair over the quality range: the fastest exact series, and the fastest
 /// inexact series whose wrong answers (FP + FN) are at most `max_error`. The yardstick: the second
@@ -37,6 +51,8 @@ struct FrontPoint {
   std::string mesh;
   std::optional<SeriesSummary> fastest_exact, fastest_inexact;
   double speedup = 0;  ///< exact mean time / inexact mean time; 0 when either is missing
+  Interval interval;   ///< the speed-up's 95% bootstrap interval over the poses
+  bool same_work = false;
 };
 inline constexpr double kFrontMaxError = 0.04;
 std::vector<FrontPoint> error_time_front(const std::vector<SeriesSummary>& series, double max_error);
@@ -46,6 +62,8 @@ struct OperatingPoint {
   std::string mesh;
   SeriesSummary adb, baseline;
   double speedup = 0;  ///< baseline mean time / ADB mean time
+  Interval interval;   ///< the speed-up's 95% bootstrap interval over the poses
+  bool same_work = false;
 };
 std::vector<OperatingPoint> operating_points(const RunOutput& run);
 /// How far one ADB-type series' reported probabilities are from what happens, over the deciles of
@@ -53,15 +71,19 @@ std::vector<OperatingPoint> operating_points(const RunOutput& run);
 struct CalibrationSummary {
   std::string mesh, hierarchy, strategy, label, budget;
   double p_min = -1;
-  bool calibrated = false;          ///< the series' probabilities through its calibration map
-  std::size_t answers = 0;          ///< over all deciles
-  std::size_t qualifying_bins = 0;  ///< deciles holding at least min_answers
-  double max_gap = 0;               ///< largest |mean reported - observed| over those; NaN if none
+  bool calibrated = false;                 ///< the series' probabilities through its calibration map
+  std::size_t answers = 0;                 ///< over all deciles
+  std::size_t qualifying_bins = 0;         ///< deciles holding at least min_answers
+  std::size_t qualifying_above_tenth = 0;  ///< of those, the deciles above 0.1
+  double max_gap = 0;                      ///< largest |mean reported - observed| over those; NaN if none
   double worst_reported = 0, worst_observed = 0;  ///< the decile of max_gap
   double worst_low = 0, worst_high = 0;
-  bool meets = false;  ///< some decile qualifies and every one is within the tolerance
+  /// Enough spread to judge: at least kCalibrationMinDeciles qualifying deciles, one of them above 0.1.
+  bool judgeable = false;
+  bool meets = false;  ///< judgeable, and every qualifying decile within the tolerance
 };
 constexpr std::size_t kCalibrationMinAnswers = 50;
+constexpr std::size_t kCalibrationMinDeciles = 3;
 constexpr double kCalibrationTolerance = 0.05;
 /// One summary per series, in the order the bins first appear; `rows` supplies the series' labels. Throws
 /// std::invalid_argument on a bin holding answers without a finite probability or frequency.

@@ -2,12 +2,16 @@
 // (prepare.cpp) -> measure (measure.cpp) -> aggregate (aggregate.cpp) -> write (write.cpp, after this).
 #include "bench/run.hpp"
 
+#include "bench/advice.hpp"
 #include "bench/aggregate.hpp"
 #include "bench/core/policies.hpp"
 #include "bench/measure.hpp"
 #include "bench/plan.hpp"
 #include "bench/prepare.hpp"
+#include "bench/summary_band.hpp"
 #include "traversal/strategies.hpp"
+
+#include <fmt/format.h>
 
 #include <sys/utsname.h>
 
@@ -53,6 +57,44 @@ RunOutput start_output(const Scene& scene) {
   output.scene = scene;
   output.environment = detect_environment();
   return output;
+}
+
+/// The right tool for each strategy the pair runs, once per strategy and pair.
+void advise(const PreparedPair& pair, const RunPlan& plan, RunOutput& output, const LogFn& log) {
+  for (const PlannedHierarchy& h : plan.hierarchies)
+    for (const StrategyVariant& v : h.variants) {
+      const std::string advice = size_advice(v.strategy, pair.label, pair.a->mesh, pair.b->mesh);
+      if (!advice.empty() &&
+          std::find(output.advice.begin(), output.advice.end(), advice) == output.advice.end()) {
+        output.advice.push_back(advice);
+        log("note: " + advice);
+      }
+    }
+}
+
+/// The slice's truth and rows.
+void add_slice(Aggregation& aggregation, const PreparedPair& pair, const RunPlan& plan,
+               const PoseSlice& slice, const Truth& truth, const PairRecords& records, const SeriesMaps& maps,
+               RunOutput& output) {
+  output.truth.push_back(summarize_truth(pair.label, slice, truth));
+  aggregation.add_slice(pair, plan, slice, truth, records, output, maps);
+}
+
+/// Summary distances given on a separation axis must hold some of the pair's bins: checked before any query
+/// is timed, since the bins depend on the objects' sizes.
+void check_separation_band(const Scene& scene, const std::string& label,
+                           const std::vector<PoseSlice>& slices) {
+  const ReportSpec& report = scene.report;
+  if (!report.quality_given) return;
+  for (const PoseSlice& slice : slices)
+    if (slice.distance >= report.quality_min - 1e-12 && slice.distance <= report.quality_max + 1e-12) return;
+  std::string held;
+  for (const PoseSlice& slice : slices)
+    held += (held.empty() ? "" : ", ") + fmt::format("{:g}", slice.distance);
+  throw SceneError((scene.file.empty() ? scene.name : scene.file.filename().string()) +
+                   ": /report/quality_distances: no pose of " + label + " has a separation in [" +
+                   fmt::format("{:g}", report.quality_min) + ", " + fmt::format("{:g}", report.quality_max) +
+                   "]; its separation bins are " + held);
 }
 
 }  // namespace
@@ -134,12 +176,27 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
     const PreparedPair pair = preparation.pair(scene, *scene_pair, plan);
     const Truth truth = measurement.ground_truth(pair, preparation);
     const SeriesMaps maps = measurement.calibration_maps(pair, preparation);
-    for (const TruthSummary& summary : summarize_truth(pair.label, scene.workload, truth))
-      output.truth.push_back(summary);
-    for (std::size_t g = 0; g < scene.workload.groups.size(); ++g)
-      aggregation.add_group(pair, plan, g, truth[g], measurement.time_group(pair, g), output, maps);
+    advise(pair, plan, output, log);
+    const WorkloadSpec& workload = scene.workload;
+    PairRecords records(workload.groups.size());
+    if (workload.axis == WorkloadSpec::Axis::Separation) {  // slices cut across the groups: time them all
+      const std::vector<PoseSlice> slices = separation_slices(workload, pair.a->mesh, pair.b->mesh);
+      check_separation_band(scene, pair.label, slices);
+      for (std::size_t g = 0; g < workload.groups.size(); ++g) records[g] = measurement.time_group(pair, g);
+      for (const PoseSlice& slice : slices)
+        add_slice(aggregation, pair, plan, slice, truth, records, maps, output);
+      continue;
+    }
+    for (std::size_t g = 0; g < workload.groups.size(); ++g) {
+      records[g] = measurement.time_group(pair, g);
+      add_slice(aggregation, pair, plan, group_slice(workload, g), truth, records, maps, output);
+      records[g].clear();
+    }
   }
 
+  const std::vector<SummaryBand> bands = summary_bands(output);
+  for (ResultRow& row : output.rows)
+    if (const SummaryBand* band = band_of(bands, row.mesh)) row.in_summary = band->contains(row.distance);
   output.calibration = aggregation.calibration();
   output.models = preparation.models();
   preparation.count_cache(stats);
@@ -173,14 +230,17 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
       scene.needs_density(scene.hierarchies.front()) ? scene.density : DensitySpec{},
       {request.strategy}};
   auto hierarchy = preparation.hierarchy(planned, object_a, ob);
+  if (std::string advice =
+          size_advice(request.strategy.strategy, a.name + "|" + b.name, object_a.mesh, ob.mesh);
+      !advice.empty())
+    outcome.advice.push_back(std::move(advice));
   const double overhead = request.repeat ? clock_overhead_us() : 0;
-  for (const RigidTransform& pose : poses)
-    outcome.answers.push_back(answer_pose(
-        pose, request.repeat, overhead,
-        [&](const RigidTransform& p) { return hierarchy->query(request.strategy, p); },
-        [&](const std::vector<RigidTransform>& copies, std::vector<QueryRecord>& records) {
-          hierarchy->run(request.strategy, copies, 0, records);
-        }));
+  outcome.answers = answer_poses(
+      poses, request.repeat, overhead,
+      [&](const RigidTransform& p) { return hierarchy->query(request.strategy, p); },
+      [&](std::span<const RigidTransform> all, std::vector<QueryRecord>& records) {
+        hierarchy->run(request.strategy, all, 0, records);
+      });
   const auto models = preparation.models();
   outcome.model_a = hierarchy->model;
   outcome.model_b = models.back();

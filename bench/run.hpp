@@ -53,7 +53,15 @@ struct RunStats {
   std::size_t calibration_cache_hits = 0;  ///< calibration maps loaded from the disk cache
   std::size_t cgal_checked = 0;            ///< poses cross-checked against CGAL
   std::size_t cgal_mismatches = 0;         ///< of those, where CGAL disagreed with the ground truth
-  std::size_t queries = 0;                 ///< timed queries
+  std::size_t queries = 0;                 ///< timed queries (one per series and pose, as reported)
+  /// How they were timed (the scene's "timing"): passes over the poses, and the per-pose statistic.
+  int timing_repeats = 1;
+  std::string timing_statistic = "median";
+  /// Every timed sample of every pass, and those that were stalls (bench/timing_stats.hpp), with the time
+  /// they lost beyond their pose's median; context switches forced on the timing thread meanwhile.
+  std::size_t timed_samples = 0, stalled_samples = 0;
+  double sampled_seconds = 0, stall_lost_seconds = 0;
+  long involuntary_switches = 0;
   double preprocess_seconds = 0;
   double truth_seconds = 0;
   double query_seconds = 0;  ///< sum of the timed queries only
@@ -74,10 +82,16 @@ struct ResultRow {
   double distance = 0;
   std::size_t queries = 0;
   double truth_colliding_rate = 0, answer_colliding_rate = 0;
-  double mean_time_us = 0, max_time_us = 0;
+  /// Over the per-pose times (each the representative of its warm passes, net of the clock's own cost).
+  double mean_time_us = 0, median_time_us = 0, p99_time_us = 0, max_time_us = 0;
   double fp_rate = 0, fn_rate = 0;
   double inexact_rate = 0, budget_exhausted_rate = 0;
   double bv_tests_per_query = 0, triangle_tests_per_query = 0, nodes_visited_per_query = 0;
+  double estimates_per_query = 0;  ///< probability evaluations (ADB-type strategies)
+  bool in_summary = false;         ///< inside its pair's summary band (bench/summary_band.hpp)
+  /// The per-pose times in pose order, the same poses for every series of the pair and distance: the
+  /// report's bootstrap intervals resample them (not written to results.csv).
+  std::vector<double> pose_times_us;
   double model_bytes = 0, bytes_per_triangle = 0;  ///< of one object's tree (A's)
 };
 
@@ -139,6 +153,8 @@ struct RunOutput {
   std::vector<CalibrationBin> calibration;
   std::vector<ModelInfo> models;
   std::vector<TruthSummary> truth;
+  /// Where the scene asks a strategy to work outside what it was made for: what to use instead, and why.
+  std::vector<std::string> advice;
   PerPose per_pose = PerPose::none;  ///< what `poses` holds
   std::vector<PoseRecord> poses;     ///< in results order: per row, its poses in order
 };
@@ -172,6 +188,8 @@ struct QueryOutcome {
   std::vector<PoseAnswer> answers;  ///< one per pose, in order
   ModelInfo model_a, model_b;
   RunStats stats;
+  /// Where the strategy is not the right tool for these objects: what to use instead, and why.
+  std::vector<std::string> advice;
 };
 /// Throws std::invalid_argument for an empty list of poses or a strategy that cannot run on the trees.
 QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRequest& request,

@@ -101,13 +101,15 @@ void describe_saved(ModelInfo& model, const Tree<BV, D>& tree, const std::filesy
 
 /// The first query at `pose` with its full result, then `repeat` more timed as the runner times a series.
 template <class S, class BV, class D>
-PoseAnswer answer_on_trees(const Tree<BV, D>& a, const Tree<BV, D>& b, const typename S::Options& options,
-                           const RigidTransform& pose, int repeat, double clock_overhead) {
+std::vector<PoseAnswer> answer_on_trees(const Tree<BV, D>& a, const Tree<BV, D>& b,
+                                        const typename S::Options& options,
+                                        std::span<const RigidTransform> poses, int repeat,
+                                        double clock_overhead) {
   const auto query = [&](const RigidTransform& p) { return S::query(a, b, p, options); };
-  return answer_pose(pose, repeat, clock_overhead, query,
-                     [&](const std::vector<RigidTransform>& copies, std::vector<QueryRecord>& records) {
-                       timed_series(copies, 0, records, query);
-                     });
+  return answer_poses(poses, repeat, clock_overhead, query,
+                      [&](std::span<const RigidTransform> all, std::vector<QueryRecord>& records) {
+                        timed_series(all, 0, records, query);
+                      });
 }
 
 }  // namespace
@@ -131,8 +133,7 @@ QueryOutcome run_query_on_trees(const std::filesystem::path& a, const std::files
     with_strategy(strategy.strategy, [&]<class S>(std::type_identity<S>) {
       if constexpr (S::template accepts<D>) {
         const auto options = strategy_options<S>(strategy.values, strategy.budget);
-        for (const RigidTransform& pose : poses)
-          outcome.answers.push_back(answer_on_trees<S>(tree_a, tree_b, options, pose, repeat, overhead));
+        outcome.answers = answer_on_trees<S>(tree_a, tree_b, options, poses, repeat, overhead);
       } else {
         throw std::invalid_argument("strategy " + strategy.strategy +
                                     " does not run on trees with density '" + std::string(D::name()) + "'");

@@ -74,6 +74,8 @@ const std::vector<RowField>& row_fields() {
       {"truth_colliding_rate", [](const ResultRow& r) { return json(r.truth_colliding_rate); }},
       {"answer_colliding_rate", [](const ResultRow& r) { return json(r.answer_colliding_rate); }},
       {"mean_time_us", [](const ResultRow& r) { return json(r.mean_time_us); }},
+      {"median_time_us", [](const ResultRow& r) { return json(r.median_time_us); }},
+      {"p99_time_us", [](const ResultRow& r) { return json(r.p99_time_us); }},
       {"max_time_us", [](const ResultRow& r) { return json(r.max_time_us); }},
       {"fp_rate", [](const ResultRow& r) { return json(r.fp_rate); }},
       {"fn_rate", [](const ResultRow& r) { return json(r.fn_rate); }},
@@ -84,6 +86,8 @@ const std::vector<RowField>& row_fields() {
        [](const ResultRow& r) { return optional_number(r.triangle_tests_per_query); }},
       {"nodes_visited_per_query",
        [](const ResultRow& r) { return optional_number(r.nodes_visited_per_query); }},
+      {"estimates_per_query", [](const ResultRow& r) { return optional_number(r.estimates_per_query); }},
+      {"in_summary", [](const ResultRow& r) { return json(r.in_summary); }},
       {"model_bytes", [](const ResultRow& r) { return json(r.model_bytes); }},
       {"bytes_per_triangle", [](const ResultRow& r) { return json(r.bytes_per_triangle); }},
   };
@@ -257,6 +261,13 @@ json results_document(const RunOutput& run) {
                   {"query_seconds", s.query_seconds},
                   {"wall_seconds", s.wall_seconds},
                   {"clock_overhead_us", s.clock_overhead_us},
+                  {"timing_repeats", s.timing_repeats},
+                  {"timing_statistic", s.timing_statistic},
+                  {"timed_samples", s.timed_samples},
+                  {"stalled_samples", s.stalled_samples},
+                  {"sampled_seconds", s.sampled_seconds},
+                  {"stall_lost_seconds", s.stall_lost_seconds},
+                  {"involuntary_switches", s.involuntary_switches},
                   {"skipped", s.skipped}};
   json models = json::array();
   for (const ModelInfo& m : run.models)

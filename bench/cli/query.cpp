@@ -226,6 +226,8 @@ QueryRun execute_query(const QueryArgs& args, bool trees, const QueryRequest& re
     const bool same = a.path == b_separate.path;
     const RunOptions options = run_options(args.cache, args.no_cache, true);
     out.outcome = run_query(a, same ? a : b_separate, request, poses, options);
+    for (const std::string& advice : out.outcome.advice)
+      std::fprintf(stderr, "bvhlab: note: %s\n", advice.c_str());
     out.name_a = a.name;
     out.name_b = b_separate.name;
     out.bv = args.bv;
@@ -408,7 +410,10 @@ Command add_query_command(CLI::App& app) {
   query->add_flag("--normalize", args->normalize,
                   "Apply the protocol normalisation to each mesh (centre to the origin, longest side 2); "
                   "default: the mesh files' own units");
-  query->add_option("--repeat", args->repeat, "Also time N warm queries at each pose: median, min and max")
+  query
+      ->add_option("--repeat", args->repeat,
+                   "Also time N warm passes over the poses (each pose once per pass, so no pose repeats back "
+                   "to back): per pose the median, min and max")
       ->check(CLI::Range(1, 10'000'000));
   query
       ->add_option("--cloud", args->cloud,

@@ -3,7 +3,9 @@
 #include <benchmark/benchmark.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
+#include <string_view>
 
 namespace bvhlab {
 
@@ -25,6 +27,21 @@ void add_flag(CLI::App& app, const BenchFlag& flag) {
       flag.target);
 }
 
+/// Robust timing unless the caller chose otherwise: kBenchRepetitions repetitions of each benchmark, run in a
+/// random order across benchmarks (so a slow spell of the machine lands on different benchmarks), reported as
+/// their mean, median, standard deviation and coefficient of variation. Read the median.
+void add_robust_timing_defaults(std::vector<std::string>& args) {
+  auto given = [&](std::string_view flag) {
+    return std::any_of(args.begin(), args.end(), [&](const std::string& a) { return a.rfind(flag, 0) == 0; });
+  };
+  if (!given("--benchmark_repetitions"))
+    args.push_back("--benchmark_repetitions=" + std::to_string(kBenchRepetitions));
+  if (!given("--benchmark_enable_random_interleaving"))
+    args.emplace_back("--benchmark_enable_random_interleaving=true");
+  if (!given("--benchmark_report_aggregates_only") && !given("--benchmark_display_aggregates_only"))
+    args.emplace_back("--benchmark_display_aggregates_only=true");
+}
+
 }  // namespace
 
 std::optional<int> initialize_benchmark(const char* program, std::initializer_list<BenchFlag> flags, int argc,
@@ -43,6 +60,7 @@ std::optional<int> initialize_benchmark(const char* program, std::initializer_li
     return 2;
   }
   std::vector<std::string> rest = app.remaining();
+  add_robust_timing_defaults(rest);
   rest.insert(rest.begin(), argv[0]);
   std::vector<char*> rest_argv;
   for (std::string& arg : rest) rest_argv.push_back(arg.data());

@@ -21,6 +21,10 @@ struct BenchFlag {
   const char* help;
 };
 
+/// Repetitions of each benchmark unless --benchmark_repetitions says otherwise (with random interleaving and
+/// the aggregates displayed: the median is the figure to read).
+inline constexpr int kBenchRepetitions = 5;
+
 /// Parses the program's flags, then hands the rest to benchmark::Initialize. Returns std::nullopt to go on,
 /// or the exit code: 0 after --help (these flags, then Google Benchmark's), 2 after a bad value or a flag
 /// neither knows (named on stderr). A flag not given keeps its target's value: the default.

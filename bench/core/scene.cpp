@@ -585,7 +585,7 @@ void parse_strategies(const Node& root, Scene& scene) {
 
 /// A "poses" workload: the pose file, read now, and its content as the workload's identity.
 void parse_pose_file(const Node& w, const std::filesystem::path& base_dir, WorkloadSpec& workload) {
-  w.expect_object({"type", "file"});
+  w.expect_object({"type", "file", "axis"});
   workload.kind = WorkloadSpec::Kind::PoseFile;
   const Node f = w.child("file");
   std::filesystem::path file(f.string());
@@ -603,7 +603,7 @@ void parse_pose_file(const Node& w, const std::filesystem::path& base_dir, Workl
 
 /// A "random" workload: seeded poses in a box, one group filed under distance 0.
 void parse_random(const Node& w, WorkloadSpec& workload) {
-  w.expect_object({"type", "count", "seed", "box"});
+  w.expect_object({"type", "count", "seed", "box", "axis"});
   workload.kind = WorkloadSpec::Kind::Random;
   workload.count = static_cast<int>(w.child("count").integer(1, static_cast<long long>(limits::kSteps.max)));
   workload.seed = static_cast<std::uint64_t>(w.has("seed") ? w.child("seed").integer(0, 1LL << 53) : 1);
@@ -633,7 +633,7 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
     if (type == "random") {
       parse_random(w, workload);
     } else if (type == "protocol") {
-      w.expect_object({"type", "distances", "steps"});
+      w.expect_object({"type", "distances", "steps", "axis"});  // axis: refused by parse_axis, by name
       if (w.has("distances")) {
         workload.distances = w.child("distances").numbers(0, limits::kDistance.min, limits::kDistance.max);
         if (workload.distances.empty()) w.child("distances").fail("expected at least one distance");
@@ -644,6 +644,7 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
     } else {
       parse_pose_file(w, base_dir, workload);
     }
+    parse_axis(w, workload);
   }
   if (workload.kind == WorkloadSpec::Kind::Protocol) {
     std::string identity = "protocol:steps=" + std::to_string(workload.steps) + ":d=";
@@ -728,14 +729,14 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   const json document = parse_json(json_text, source);
   const Node root(document, "", source);
   root.expect_object({"name", "description", "objects", "pairs", "hierarchies", "annotation", "strategies",
-                      "workload", "report", "calibration", "world", "deform", "points"});
+                      "workload", "report", "calibration", "timing", "world", "deform", "points"});
   Scene scene;
   scene.name = root.has("name") ? root.child("name").string() : "scene";
   parse_objects(root, base_dir, scene);
   // A points scene runs its own series on its clouds' trees: pairs and "points" only.
   if (root.has("points")) {
-    for (const char* field :
-         {"world", "deform", "hierarchies", "annotation", "strategies", "workload", "report", "calibration"})
+    for (const char* field : {"world", "deform", "hierarchies", "annotation", "strategies", "workload",
+                              "report", "calibration", "timing"})
       if (root.has(field))
         root.child(field).fail("does not apply to a points scene (its series and poses are in \"points\")");
     parse_pairs(root, scene);
@@ -750,7 +751,7 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
     parse_hierarchies(root, scene);
     parse_density(root, scene);
     parse_strategies(root, scene);
-    for (const char* field : {"report", "calibration"})
+    for (const char* field : {"report", "calibration", "timing"})
       if (root.has(field)) root.child(field).fail(std::string("does not apply to a ") + kind + " scene");
     if (root.has("world"))
       parse_world(root, base_dir, scene);
@@ -767,6 +768,8 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& base_
   parse_workload(root, base_dir, scene.workload);
   parse_calibration(root, scene);
   parse_report(root, scene, [&](const std::string& name) { return hierarchy_skipped(scene, name); });
+  check_quality_band(root, scene);
+  parse_timing(root, scene);
   return scene;
 }
 

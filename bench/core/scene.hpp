@@ -122,6 +122,10 @@ struct PoseGroup {
 
 struct WorkloadSpec {
   enum class Kind { Protocol, PoseFile, Random } kind = Kind::Protocol;
+  /// What the report's "distance" column holds: the protocol's distance, the separation of the two objects
+  /// (their centre distance over the sum of their bounding radii, binned: random and pose-file workloads by
+  /// default), or a pose file's own groups.
+  enum class Axis { Distance, Separation, Group } axis = Axis::Distance;
   std::vector<double> distances{0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0};
   int steps = 5000;
   std::filesystem::path pose_file;  ///< PoseFile only (resolved)
@@ -135,9 +139,9 @@ struct WorkloadSpec {
 };
 
 struct ReportSpec {
-  double quality_min = 1.2, quality_max = 2.0;  ///< distances the time-versus-quality summary uses
-  /// Given in the scene. When not, a pose-file workload is summarised over all its poses: its groups are
-  /// the user's own, and the protocol's quality distances mean nothing for them.
+  double quality_min = 0, quality_max = 0;  ///< distances the time-versus-quality summary uses, if given
+  /// Given in the scene. When not, each mesh pair is summarised over the band of distances where its ground
+  /// truth has between 5% and 95% colliding poses, found from the run (bench/summary_band.hpp).
   bool quality_given = false;
   int cgal_sample = 64;                     ///< poses per object pair cross-checked against CGAL
   std::string operating_hierarchy;          ///< default: the first hierarchy the operating strategy runs on
@@ -239,6 +243,14 @@ struct PointsSpec {
   int cgal_sample = 16;                           ///< poses per pair whose mesh truth is checked against CGAL
 };
 
+/// How each (series, pose) is timed ("timing" in the file): `repeats` warm passes over the poses, each pose
+/// timed once per pass, reduced to one time per pose by `statistic` (bench/timing_stats.hpp).
+struct TimingSpec {
+  enum class Statistic { Median, Min } statistic = Statistic::Median;
+  int repeats = 3;
+};
+const char* statistic_name(TimingSpec::Statistic statistic);
+
 struct Scene {
   std::string name;
   std::filesystem::path file;  ///< where it was read from (empty for a string)
@@ -249,6 +261,7 @@ struct Scene {
   std::vector<StrategySpec> strategies;
   WorkloadSpec workload;
   ReportSpec report;
+  TimingSpec timing;
   std::optional<CalibrationSpec> calibration;
   /// Set for a world scene: many instances over frames, in place of "pairs" and "workload".
   std::optional<WorldSpec> world;

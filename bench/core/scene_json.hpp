@@ -138,4 +138,15 @@ void parse_deform(const Node& root, const std::filesystem::path& base_dir, Scene
 /// parameters. `fcl`: whether this build has FCL (its octree series).
 void parse_points(const Node& root, Scene& scene, bool fcl);
 
+/// The "timing" section (bench/core/scene_timing.cpp): warm repeats per (series, pose) and their statistic.
+void parse_timing(const Node& root, Scene& scene);
+
+/// The workload's "axis" (bench/core/scene_timing.cpp): "separation" (the default of random and pose-file
+/// workloads) or "group" (a pose file's own groups); the protocol's axis is its distances.
+void parse_axis(const Node& workload, WorkloadSpec& spec);
+
+/// Refuses "report/quality_distances" that hold no pose of the workload (bench/core/scene_timing.cpp). A
+/// separation axis is binned per mesh pair, so its band is checked when the run has the objects' sizes.
+void check_quality_band(const Node& root, const Scene& scene);
+
 }  // namespace bvhlab::scene_json

@@ -260,6 +260,27 @@ TEST_F(Cli, RepeatTimesWarmQueries) {
   EXPECT_EQ(t["warm_time_us"]["queries"], 3);
 }
 
+// With a pose list, --repeat times passes over all the poses, so each pose gets its own warm times.
+TEST_F(Cli, RepeatTimesPassesOverEveryPose) {
+  testing::write_text(dir / "poses.txt", "0.5 0 0\n0.8 0 0\n3 0 0\n");
+  const nlohmann::json j =
+      nlohmann::json::parse(ok("query small.obj small.obj --poses poses.txt --repeat 4 --json").out);
+  ASSERT_EQ(j["results"].size(), 3u) << j.dump();
+  for (const auto& answer : j["results"]) EXPECT_EQ(answer["warm_time_us"]["queries"], 4) << answer.dump();
+}
+
+// ADB splits both nodes of a pair: on objects of very different size the CLI names the strategy made for it.
+TEST_F(Cli, AdbOnObjectsOfDifferentSizeNamesAdbLarger) {
+  const Outcome adb = ok("query big.obj small.obj --pose 0,0,0 --strategy adb");
+  EXPECT_NE(adb.err.find("bvhlab: note: `adb` on big|small: the objects' root volumes differ by 1000×"),
+            std::string::npos)
+      << adb.err;
+  EXPECT_NE(adb.err.find("`adb_larger` splits only the larger node"), std::string::npos) << adb.err;
+  EXPECT_EQ(ok("query big.obj small.obj --pose 0,0,0 --strategy adb_larger").err.find("note:"),
+            std::string::npos);
+  EXPECT_EQ(ok("query small.obj small.obj --pose 0,0,0 --strategy adb").err.find("note:"), std::string::npos);
+}
+
 TEST_F(Cli, AllContactsListsThePairsInTextToo) {
   const std::string args = "query small.obj small.obj --pose 0.5,0.2,0.1 --all-contacts";
   const nlohmann::json j = nlohmann::json::parse(ok(args + " --json").out);

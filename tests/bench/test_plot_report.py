@@ -136,6 +136,28 @@ class CalibratedSeries(unittest.TestCase):
         plt.close(fig)
 
 
+def curve_row(p_min, time, bv_tests, in_band="1", distance="1.2"):
+    row = result_row(p_min)
+    row.update({"mean_time_us": str(time), "bv_tests_per_query": str(bv_tests), "in_summary": in_band,
+                "distance": distance})
+    return row
+
+
+class PminCurves(unittest.TestCase):
+    def test_a_curve_that_follows_its_work_has_no_break(self):
+        rows = [curve_row("0.5", 1.0, 4), curve_row("0.9", 2.0, 10), curve_row("0.99", 3.0, 20)]
+        self.assertEqual(plot_report.pmin_curve_breaks(rows), [])
+
+    def test_time_falling_while_the_work_rises_is_a_break(self):
+        rows = [curve_row("0.8", 2.1, 8.1), curve_row("0.9", 1.2, 12.4)]
+        self.assertEqual(plot_report.pmin_curve_breaks(rows), [("m", "aabb", "adb", 0.8, 0.9)])
+
+    def test_only_the_rows_inside_the_band_count(self):
+        rows = [curve_row("0.8", 1.0, 8), curve_row("0.9", 2.0, 12),
+                curve_row("0.8", 50.0, 8, in_band="0", distance="0.4")]  # a slow row outside the band
+        self.assertEqual(plot_report.pmin_curve_breaks(rows), [])
+
+
 class Script(ReportScriptChecks, unittest.TestCase):
     """The command line; `bvhlab report`'s tests (test_bench_run) draw the five figures from a real run."""
 

@@ -52,20 +52,34 @@ class ReportTest : public ::testing::Test {
 };
 
 TEST_F(ReportTest, NamesTheDistancesTheRunHasNotTheWholeQualityRange) {
-  const RunOutput run = run_scene(protocol_scene("[0.8, 1.2, 1.6]"), options);
+  const RunOutput run =
+      run_scene(protocol_scene("[0.8, 1.2, 1.6]", R"(, "quality_distances": [1.2, 2])"), options);
   const std::string text = readme(run);
-  EXPECT_NE(text.find("Summary over distances 1.2–1.6"), std::string::npos) << text;
+  EXPECT_NE(text.find("distances 1.2–1.6 (the scene's quality_distances)"), std::string::npos) << text;
   EXPECT_EQ(text.find("1.2–2"), std::string::npos) << text;
 }
 
-TEST_F(ReportTest, SaysWhenTheRunHasNoneOfTheQualityDistances) {
-  const RunOutput run = run_scene(protocol_scene("[0.4, 0.8]"), options);
-  EXPECT_NE(readme(run).find("all distances (the workload has none in 1.2–2)"), std::string::npos);
+// Without quality distances, each pair's band is where its ground truth has 5% to 95% colliding poses; the
+// summary, the operating point and results.csv's in_summary column all use it.
+TEST_F(ReportTest, TheDefaultBandFollowsTheGroundTruth) {
+  const RunOutput run = run_scene(protocol_scene("[0.2, 0.8, 1.2, 1.4, 1.6, 2.4]"), options);
+  std::vector<double> mixed;
+  for (const TruthSummary& t : run.truth) {
+    const double share = double(t.colliding) / double(t.poses);
+    if (share >= 0.05 && share <= 0.95) mixed.push_back(t.distance);
+  }
+  ASSERT_FALSE(mixed.empty()) << "the torus at these distances should collide at some poses only";
+  std::size_t inside = 0;
+  for (const ResultRow& r : run.rows) {
+    EXPECT_EQ(r.in_summary, r.distance >= mixed.front() && r.distance <= mixed.back()) << r.distance;
+    inside += r.in_summary && r.label == "adb p_min=0.9" ? r.queries : 0;
+  }
   ASSERT_EQ(operating_points(run).size(), 1u);
-  EXPECT_EQ(operating_points(run)[0].adb.queries, 2u * 8);
+  EXPECT_EQ(operating_points(run)[0].adb.queries, inside);
+  EXPECT_NE(readme(run).find("where the ground truth has 5% to 95% colliding poses"), std::string::npos);
 }
 
-TEST_F(ReportTest, PoseFileIsSummarisedOverAllItsPosesUnlessTheSceneSaysOtherwise) {
+TEST_F(ReportTest, PoseFileGroupsAreSummarisedWhereTheSceneSays) {
   testing::write_text(dir / "poses.json", R"({"poses": [
       {"translation": [0, 0, 0], "group": 0}, {"translation": [0.3, 0, 0], "group": 0},
       {"translation": [1.5, 0, 0], "group": 1.5}, {"translation": [5, 0, 0], "group": 5}]})");
@@ -73,19 +87,15 @@ TEST_F(ReportTest, PoseFileIsSummarisedOverAllItsPosesUnlessTheSceneSaysOtherwis
     return parse_scene(R"({"objects": [{"mesh": "torus.obj", "normalize": true}],
         "hierarchies": [{"bv": "aabb"}, {"bv": "dop24"}], "annotation": {"type": "adb", "grid": 2, "tau": 0.5},
         "strategies": [{"type": "exact"}, {"type": "adb", "p_min": 0.9, "hierarchies": ["aabb"]}],
-        "workload": {"type": "poses", "file": "poses.json"}, "report": {"cgal_sample": 1)" +
+        "workload": {"type": "poses", "file": "poses.json", "axis": "group"}, "report": {"cgal_sample": 1)" +
                            report + "}}",
                        dir.path(), "p.json");
   };
-  const RunOutput all = run_scene(pose_scene(""), options);
-  ASSERT_EQ(operating_points(all).size(), 1u);
-  EXPECT_EQ(operating_points(all)[0].adb.queries, 4u);
-  EXPECT_NE(readme(all).find("Summary over all poses"), std::string::npos);
-
   const RunOutput some = run_scene(pose_scene(R"(, "quality_distances": [1, 2])"), options);
   ASSERT_EQ(operating_points(some).size(), 1u);
   EXPECT_EQ(operating_points(some)[0].adb.queries, 1u);
-  EXPECT_NE(readme(some).find("distance 1.5 (1 of 4 poses)"), std::string::npos) << readme(some);
+  EXPECT_NE(readme(some).find("pose group 1.5 (the scene's quality_distances); 1 poses"), std::string::npos)
+      << readme(some);
 }
 
 // A workload of random poses is summarised over all of them: the figures take that range too (its lower end,
@@ -224,7 +234,7 @@ TEST(CalibrationSummary, JudgesOnlyDecilesWithEnoughAnswers) {
   const std::vector<CalibrationBin> bins{
       // p_min 0.9: within 0.05 where it counts; the 10-answer decile is far off but too small to judge.
       decile(0.9, 1, 100, 0.15, 0.12), decile(0.9, 5, 10, 0.55, 0.0), decile(0.9, 9, 60, 0.95, 0.99),
-      decile(0.9, 3, 0, nan, nan),
+      decile(0.9, 0, 50, 0.02, 0.0), decile(0.9, 3, 0, nan, nan),
       // p_min 0.5: 50 answers exactly qualify (gap 0.06, too far); 49 do not (gap 0.9).
       decile(0.5, 2, 50, 0.26, 0.20), decile(0.5, 7, 49, 0.9, 0.0), decile(0.5, 8, 500, 0.85, 0.83),
       // p_min 0.7: answers, but no decile holds enough of them.
@@ -233,8 +243,9 @@ TEST(CalibrationSummary, JudgesOnlyDecilesWithEnoughAnswers) {
   ASSERT_EQ(s.size(), 3u);
 
   EXPECT_EQ(s[0].p_min, 0.9);
-  EXPECT_EQ(s[0].answers, 170u);
-  EXPECT_EQ(s[0].qualifying_bins, 2u);
+  EXPECT_EQ(s[0].answers, 220u);
+  EXPECT_EQ(s[0].qualifying_bins, 3u);
+  EXPECT_TRUE(s[0].judgeable);
   EXPECT_NEAR(s[0].max_gap, 0.04, 1e-12);
   EXPECT_DOUBLE_EQ(s[0].worst_low, 0.9);
   EXPECT_TRUE(s[0].meets);
@@ -243,6 +254,7 @@ TEST(CalibrationSummary, JudgesOnlyDecilesWithEnoughAnswers) {
   EXPECT_NEAR(s[1].max_gap, 0.06, 1e-12);
   EXPECT_DOUBLE_EQ(s[1].worst_reported, 0.26);
   EXPECT_DOUBLE_EQ(s[1].worst_observed, 0.20);
+  EXPECT_FALSE(s[1].judgeable);  // two deciles: too little spread for a verdict either way
   EXPECT_FALSE(s[1].meets);
 
   EXPECT_EQ(s[2].answers, 30u);
@@ -251,10 +263,28 @@ TEST(CalibrationSummary, JudgesOnlyDecilesWithEnoughAnswers) {
   EXPECT_FALSE(s[2].meets);  // nothing to judge is not a pass
 }
 
+// A series whose answers all sit in the lowest decile (every answer "no") cannot show calibration, however
+// close its one decile is; nor can three deciles that are all at or below 0.1.
+TEST(CalibrationSummary, NoVerdictWithoutSpread) {
+  const auto one = calibration_summary({decile(0.9, 0, 5000, 0.0, 0.0)}, {});
+  EXPECT_FALSE(one[0].judgeable);
+  EXPECT_FALSE(one[0].meets);
+  CalibrationBin low = decile(0.9, 0, 100, 0.01, 0.0);
+  const auto all_low = calibration_summary({low, low, low}, {});
+  EXPECT_EQ(all_low[0].qualifying_bins, 3u);
+  EXPECT_FALSE(all_low[0].judgeable);
+  const auto spread = calibration_summary(
+      {decile(0.9, 0, 100, 0.01, 0.0), decile(0.9, 4, 60, 0.45, 0.43), decile(0.9, 9, 70, 0.97, 0.99)}, {});
+  EXPECT_TRUE(spread[0].judgeable);
+  EXPECT_TRUE(spread[0].meets);
+}
+
 TEST(CalibrationSummary, SeriesDifferingOnlyInBudgetStayApartAndTakeTheirLabelFromTheRows) {
   CalibrationBin a = decile(0.9, 9, 80, 0.95, 0.95), b = a;
   b.budget = "bv_tests=50";
   b.collision_frequency = 0.5;
+  CalibrationBin a0 = decile(0.9, 0, 80, 0.02, 0.0), a5 = decile(0.9, 5, 80, 0.55, 0.55), b0 = a0, b5 = a5;
+  b0.budget = b5.budget = "bv_tests=50";
   ResultRow row;
   row.mesh = "m";
   row.hierarchy = "aabb";
@@ -262,7 +292,7 @@ TEST(CalibrationSummary, SeriesDifferingOnlyInBudgetStayApartAndTakeTheirLabelFr
   row.p_min = 0.9;
   row.budget = "bv_tests=50";
   row.label = "adb p_min=0.9 budget 50";
-  const auto s = calibration_summary({a, b}, {row});
+  const auto s = calibration_summary({a0, a5, a, b0, b5, b}, {row});
   ASSERT_EQ(s.size(), 2u);
   EXPECT_TRUE(s[0].meets);
   EXPECT_FALSE(s[1].meets);
@@ -278,12 +308,17 @@ TEST(CalibrationSummary, ABinWithAnswersButNoProbabilityIsAnError) {
 TEST_F(ReportTest, ReadmeSaysWhichSeriesMeetTheCalibrationTarget) {
   RunOutput run = run_scene(protocol_scene("[1.2]"), options);
   run.calibration = {decile(0.9, 1, 100, 0.15, 0.12), decile(0.9, 8, 200, 0.85, 0.2),
-                     decile(0.5, 2, 70, 0.25, 0.26)};
+                     decile(0.9, 0, 100, 0.01, 0),    decile(0.5, 2, 70, 0.25, 0.26),
+                     decile(0.5, 0, 60, 0.01, 0.0),   decile(0.5, 9, 60, 0.95, 0.95),
+                     decile(0.7, 2, 70, 0.25, 0.26)};
   for (auto& b : run.calibration) b.mesh = run.rows.front().mesh;
   const std::string text = readme(run);
   EXPECT_NE(text.find("## Calibration"), std::string::npos) << text;
-  EXPECT_NE(text.find("| 300 | 2 | 0.650 | 0.8–0.9: 0.850 → 0.200 | no |"), std::string::npos) << text;
-  EXPECT_NE(text.find("| 70 | 1 | 0.010 | 0.2–0.3: 0.250 → 0.260 | yes |"), std::string::npos) << text;
+  EXPECT_NE(text.find("| 400 | 3 | 0.650 | 0.8–0.9: 0.850 → 0.200 | no |"), std::string::npos) << text;
+  EXPECT_NE(text.find("| 190 | 3 | 0.010 | 0.2–0.3: 0.250 → 0.260 | yes |"), std::string::npos) << text;
+  EXPECT_NE(text.find("| 70 | 1 | 0.010 | 0.2–0.3: 0.250 → 0.260 | too little spread to judge |"),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("Meeting the target: " + run.rows.front().mesh + " aabb adb p_min=0.5."),
             std::string::npos)
       << text;

@@ -237,6 +237,8 @@ TEST_F(RunTest, CsvSchemaAndRates) {
                                         "truth_colliding_rate",
                                         "answer_colliding_rate",
                                         "mean_time_us",
+                                        "median_time_us",
+                                        "p99_time_us",
                                         "max_time_us",
                                         "fp_rate",
                                         "fn_rate",
@@ -245,6 +247,8 @@ TEST_F(RunTest, CsvSchemaAndRates) {
                                         "bv_tests_per_query",
                                         "triangle_tests_per_query",
                                         "nodes_visited_per_query",
+                                        "estimates_per_query",
+                                        "in_summary",
                                         "model_bytes",
                                         "bytes_per_triangle",
                                         "machine",
@@ -400,7 +404,7 @@ TEST_F(RunTest, PoseFileWorkloadAndPairsOfDifferentObjects) {
       {"translation": [5, 0, 0], "group": 5}]})");
   const Scene s = parse_scene(R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "soup.obj", "scale": 0.5}],
       "pairs": [["torus", "soup"]], "hierarchies": [{"bv": "aabb"}], "strategies": [{"type": "exact"}],
-      "workload": {"type": "poses", "file": "poses.json"}, "report": {"cgal_sample": 3}})",
+      "workload": {"type": "poses", "file": "poses.json", "axis": "group"}, "report": {"cgal_sample": 3}})",
                               dir.path(), "p.json");
   const RunOutput run = run_scene(s, options);
   ASSERT_EQ(run.rows.size(), 2u);
@@ -409,6 +413,19 @@ TEST_F(RunTest, PoseFileWorkloadAndPairsOfDifferentObjects) {
   EXPECT_EQ(run.rows[1].truth_colliding_rate, 0.0);  // 5 apart: nothing touches
   EXPECT_EQ(run.stats.trees_built, 2u);
   EXPECT_EQ(run.stats.cgal_mismatches, 0u);
+
+  // By default a pose file is filed by separation: the two poses at the origin and 0.3 share no bin with the
+  // one 5 away (beyond 1.5: the open bin), and every pose is counted once.
+  Scene by_separation = s;
+  by_separation.workload.axis = WorkloadSpec::Axis::Separation;
+  const RunOutput separated = run_scene(by_separation, options);
+  ASSERT_GE(separated.rows.size(), 2u);
+  std::size_t queries = 0;
+  for (const ResultRow& r : separated.rows) queries += r.queries;
+  EXPECT_EQ(queries, 3u);
+  EXPECT_DOUBLE_EQ(separated.rows.back().distance, 1.55);
+  EXPECT_EQ(separated.rows.back().queries, 1u);
+  EXPECT_EQ(separated.rows.back().truth_colliding_rate, 0.0);
 }
 
 TEST_F(RunTest, MissingOptionalObjectIsSkippedWithAMessage) {
@@ -435,16 +452,18 @@ TEST_F(RunTest, ReportReadmeStatesTheOperatingPoint) {
   EXPECT_DOUBLE_EQ(points[0].adb.p_min, 0.9);
   EXPECT_EQ(points[0].baseline.hierarchy, "dop24");
   EXPECT_NEAR(points[0].speedup, points[0].baseline.mean_time_us / points[0].adb.mean_time_us, 1e-12);
-  // Summaries weight distances by queries; only 1.2 and 1.6 lie in the default range [1.2, 2].
-  EXPECT_EQ(points[0].adb.queries, 2u * 24);
+  // Summaries weight distances by queries, over the rows inside the pair's band.
+  std::size_t inside = 0;
+  for (const ResultRow& r : run.rows) inside += r.in_summary && r.label == "adb p_min=0.9" ? r.queries : 0;
+  EXPECT_EQ(points[0].adb.queries, inside);
 
   ReportOptions no_figures;
   no_figures.figures = false;
   const ReportFiles files = write_report(run, dir / "report", no_figures);
   const std::string readme = testing::read_text(files.readme);
   EXPECT_NE(readme.find("## Result at the operating point"), std::string::npos);
-  EXPECT_NE(readme.find("ADB on `aabb` with p_min = 0.9"), std::string::npos) << readme;
-  EXPECT_NE(readme.find("exact `dop24`"), std::string::npos);
+  EXPECT_NE(readme.find("`aabb` adb p_min=0.9: "), std::string::npos) << readme;
+  EXPECT_NE(readme.find("against `dop24` exact: "), std::string::npos) << readme;
   for (const auto& f : report_figures()) EXPECT_NE(readme.find(f.file), std::string::npos) << f.file;
   EXPECT_TRUE(std::filesystem::is_regular_file(files.results_csv));
   EXPECT_TRUE(std::filesystem::is_regular_file(files.results_json));

@@ -80,6 +80,29 @@ def test_the_rest_of_results_json(run):
     assert np.isfinite([c["bin_low"] for c in run["calibration"]]).all()
 
 
+def test_times_are_per_pose_statistics_of_warm_passes(gear_file):
+    warm = scene(gear_file)
+    warm["timing"] = {"repeats": 3, "statistic": "min"}
+    out = bvhlab.run_scene(warm)
+    stats = out["stats"]
+    assert stats["timing_repeats"] == 3 and stats["timing_statistic"] == "min"
+    assert stats["timed_samples"] == 3 * stats["queries"]
+    assert 0 <= stats["stalled_samples"] <= stats["timed_samples"]
+    for row in out["rows"]:
+        assert 0 <= row["median_time_us"] <= row["p99_time_us"] <= row["max_time_us"], row["label"]
+    # the summary band: where the gear's ground truth has both colliding and separated poses, else all
+    mixed = {r["distance"] for r in out["rows"] if 0.05 <= r["truth_colliding_rate"] <= 0.95}
+    inside = {r["distance"] for r in out["rows"] if r["in_summary"]}
+    assert inside == ({d for d in DISTANCES if min(mixed) <= d <= max(mixed)} if mixed else set(DISTANCES))
+
+
+def test_bad_timing_is_refused_naming_the_field(gear_file):
+    bad = scene(gear_file)
+    bad["timing"] = {"repeats": 0}
+    with pytest.raises(ValueError, match="/timing/repeats: expected at least 1"):
+        bvhlab.run_scene(bad)
+
+
 def test_calibrated_series_come_back_beside_the_raw_ones(gear_file, run):
     calibrated = bvhlab.run_scene(dict(scene(gear_file), calibration={"training_seed": 3, "training_steps": 40}))
     # The answers are the raw strategy's: the same rows; the calibration bins come twice, raw then calibrated.
