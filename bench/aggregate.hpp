@@ -17,9 +17,6 @@ namespace bvhlab {
 /// The ground truth's colliding fraction of one slice, for one pair.
 TruthSummary summarize_truth(const std::string& label, const PoseSlice& slice, const Truth& truth);
 
-/// The timed records of every pose group of one pair, [group] (a group not timed yet: empty).
-using PairRecords = std::vector<GroupRecords>;
-
 /// The aggregate stage of one run.
 class Aggregation {
  public:

@@ -187,7 +187,8 @@ Measurement::Measurement(const Scene& scene, const RunPlan& plan, const RunOptio
                    "truth"),
       calibration_cache_(options.cache_dir.empty() ? options.cache_dir : options.cache_dir / "calibration",
                          ".calib", "calibration"),
-      progress_(options.progress, plan.total_queries) {
+      progress_(options.progress,
+                plan.total_queries * static_cast<std::size_t>(std::max(1, scene.timing.repeats))) {
   stats_.timing_repeats = scene.timing.repeats;
   stats_.timing_statistic = statistic_name(scene.timing.statistic);
 }
@@ -259,48 +260,66 @@ void Measurement::cross_check(const PreparedPair& pair, const Truth& truth) {
   }
 }
 
-// Every hierarchy and strategy on the same poses. The poses run in blocks; each block is timed in `repeats`
-// passes, and each pass runs every series over the block in turn. So a slow spell of a shared machine
-// (another process, frequency changes) spreads over all series instead of landing on one, a pose comes
-// back only after every other query of its block (the branch predictor cannot learn it), and within a block
-// the caches stay warm. Each (series, pose) keeps the query of its representative sample (the median or the
-// minimum of its passes): its time and its answer come from the same query.
-GroupRecords Measurement::time_group(const PreparedPair& pair, std::size_t g) {
-  const PoseGroup& group = scene_.workload.groups[g];
-  const auto& planned = plan_.hierarchies;
+// Every hierarchy and strategy on the same poses, in `repeats` passes over the whole workload. Within a
+// pass the poses run in blocks, each block through every series in turn, so a slow spell of a shared machine
+// (another process, frequency changes) spreads over all series instead of landing on one, and within a block
+// the caches stay warm. A pose comes back only a whole pass later: its samples are far apart in time, so a
+// slow spell shorter than a pass spoils at most one of them, and the branch predictor cannot learn the pose.
+// Each (series, pose) keeps the query of its representative sample (the median or the minimum of its
+// passes): its time and its answer come from the same query.
+std::vector<PairRecords> Measurement::time_workload(const std::vector<PreparedPair>& pairs) {
   const std::size_t repeats = static_cast<std::size_t>(std::max(1, scene_.timing.repeats));
-  GroupRecords series(planned.size());
-  for (std::size_t i = 0; i < planned.size(); ++i) series[i].resize(planned[i].variants.size());
-  const std::span<const RigidTransform> poses(group.poses);
+  const std::size_t groups = scene_.workload.groups.size();
+  // passes[pair][group][series][pass]: the group's records of one series in one pass.
+  std::vector<std::vector<std::vector<std::vector<std::vector<QueryRecord>>>>> passes(pairs.size());
   const long switches_before = involuntary_switches();
-  for (std::size_t begin = 0; begin < poses.size(); begin += kPoseBlock) {
-    const auto block = poses.subspan(begin, std::min(kPoseBlock, poses.size() - begin));
-    // passes[series][pass]: the block's records of one pass of one series.
-    std::vector<std::vector<std::vector<QueryRecord>>> passes;
-    for (std::size_t pass = 0; pass < repeats; ++pass) {
-      std::size_t s = 0;
-      for (std::size_t i = 0; i < planned.size(); ++i)
-        for (std::size_t v = 0; v < planned[i].variants.size(); ++v, ++s) {
-          if (pass == 0) passes.emplace_back(repeats);
-          pair.hierarchies[i]->run(planned[i].variants[v], block, warmup_, passes[s][pass]);
-        }
+  for (std::size_t pass = 0; pass < repeats; ++pass)
+    for (std::size_t p = 0; p < pairs.size(); ++p) {
+      passes[p].resize(groups);
+      for (std::size_t g = 0; g < groups; ++g) {
+        std::vector<std::vector<QueryRecord>> series;
+        time_pass(pairs[p], g, series);
+        passes[p][g].resize(series.size());
+        for (std::size_t s = 0; s < series.size(); ++s) passes[p][g][s].push_back(std::move(series[s]));
+      }
     }
-    std::size_t s = 0;
-    for (std::size_t i = 0; i < planned.size(); ++i)
-      for (std::size_t v = 0; v < planned[i].variants.size(); ++v, ++s)
-        keep_representatives(passes[s], series[i][v]);
-    char distance[16];
-    std::snprintf(distance, sizeof distance, "%g", group.distance);
-    std::size_t done = 0;
-    for (const auto& h : planned) done += h.variants.size() * block.size();
-    progress_.advance(done, pair.label + " d=" + distance);
-  }
   stats_.involuntary_switches += involuntary_switches() - switches_before;
-  return series;
+  std::vector<PairRecords> out(pairs.size(), PairRecords(groups));
+  for (std::size_t p = 0; p < pairs.size(); ++p)
+    for (std::size_t g = 0; g < groups; ++g) {
+      std::size_t s = 0;
+      out[p][g].resize(plan_.hierarchies.size());
+      for (std::size_t i = 0; i < plan_.hierarchies.size(); ++i)
+        for (std::size_t v = 0; v < plan_.hierarchies[i].variants.size(); ++v, ++s)
+          out[p][g][i].push_back(representatives(passes[p][g][s]));
+      passes[p][g].clear();
+    }
+  return out;
 }
 
-void Measurement::keep_representatives(const std::vector<std::vector<QueryRecord>>& passes,
-                                       std::vector<QueryRecord>& out) {
+void Measurement::time_pass(const PreparedPair& pair, std::size_t g,
+                            std::vector<std::vector<QueryRecord>>& series) {
+  const PoseGroup& group = scene_.workload.groups[g];
+  const auto& planned = plan_.hierarchies;
+  const std::span<const RigidTransform> poses(group.poses);
+  std::vector<QueryRecord> block_records;
+  for (std::size_t begin = 0; begin < poses.size(); begin += kPoseBlock) {
+    const auto block = poses.subspan(begin, std::min(kPoseBlock, poses.size() - begin));
+    std::size_t s = 0;
+    for (std::size_t i = 0; i < planned.size(); ++i)
+      for (std::size_t v = 0; v < planned[i].variants.size(); ++v, ++s) {
+        if (series.size() <= s) series.emplace_back();
+        pair.hierarchies[i]->run(planned[i].variants[v], block, warmup_, block_records);
+        series[s].insert(series[s].end(), block_records.begin(), block_records.end());
+      }
+    char distance[16];
+    std::snprintf(distance, sizeof distance, "%g", group.distance);
+    progress_.advance(s * block.size(), pair.label + " d=" + distance);
+  }
+}
+
+std::vector<QueryRecord> Measurement::representatives(const std::vector<std::vector<QueryRecord>>& passes) {
+  std::vector<QueryRecord> out;
   std::vector<double> samples(passes.size());
   for (std::size_t k = 0; k < passes.front().size(); ++k) {
     for (std::size_t pass = 0; pass < passes.size(); ++pass) samples[pass] = passes[pass][k].micros;
@@ -311,6 +330,7 @@ void Measurement::keep_representatives(const std::vector<std::vector<QueryRecord
   stats_.stalled_samples = disturbance_.stalled;
   stats_.sampled_seconds = disturbance_.timed_us * 1e-6;
   stats_.stall_lost_seconds = disturbance_.lost_us * 1e-6;
+  return out;
 }
 
 SeriesMaps Measurement::calibration_maps(const PreparedPair& pair, Preparation& preparation) {

@@ -125,6 +125,8 @@ class Progress {
 
 /// One pose group's timed records: [planned hierarchy][variant][pose].
 using GroupRecords = std::vector<std::vector<std::vector<QueryRecord>>>;
+/// The timed records of every pose group of one pair, [group].
+using PairRecords = std::vector<GroupRecords>;
 
 /// Per planned series, [hierarchy][variant]: its calibration map, or none (exact series, or no
 /// "calibration").
@@ -138,8 +140,9 @@ class Measurement {
   /// The pair's ground truth: from the disk cache, else the exact traversal on the first bvhlab hierarchy
   /// (plain AABB trees from `preparation` if there is none); then the CGAL cross-check.
   Truth ground_truth(const PreparedPair& pair, Preparation& preparation);
-  /// Every planned series of the pair on pose group `g`.
-  GroupRecords time_group(const PreparedPair& pair, std::size_t g);
+  /// Every planned series of every pair on every pose group, [pair][group]: the scene's `timing.repeats`
+  /// passes over the whole workload, each (series, pose) kept as the query of its representative sample.
+  std::vector<PairRecords> time_workload(const std::vector<PreparedPair>& pairs);
   /// With the scene's "calibration": every inexact series' map, from the disk cache or fitted on the training
   /// poses against their exact truth (itself cached like the workload's). Without: no maps.
   SeriesMaps calibration_maps(const PreparedPair& pair, Preparation& preparation);
@@ -148,10 +151,11 @@ class Measurement {
   Truth compute_truth(const PreparedPair& pair, Preparation& preparation, const WorkloadSpec& workload);
   Truth cached_truth(const PreparedPair& pair, Preparation& preparation, const WorkloadSpec& workload);
   void cross_check(const PreparedPair& pair, const Truth& truth);
-  /// Per pose of a block, the record of its representative pass (passes[pass][pose]) appended to `out`; its
-  /// samples tallied for the run's disturbance.
-  void keep_representatives(const std::vector<std::vector<QueryRecord>>& passes,
-                            std::vector<QueryRecord>& out);
+  /// One pass over pose group `g` of `pair`: each series' records appended to series[s] (flat index).
+  void time_pass(const PreparedPair& pair, std::size_t g, std::vector<std::vector<QueryRecord>>& series);
+  /// Per pose, the record of its representative pass (passes[pass][pose]); its samples are tallied for the
+  /// run's disturbance.
+  std::vector<QueryRecord> representatives(const std::vector<std::vector<QueryRecord>>& passes);
 
   const Scene& scene_;
   const RunPlan& plan_;

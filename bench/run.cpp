@@ -97,6 +97,20 @@ void check_separation_band(const Scene& scene, const std::string& label,
                    "]; its separation bins are " + held);
 }
 
+/// The pair's slices of the workload: its groups, or its separation bins (checked against the summary
+/// distances the scene gives).
+std::vector<PoseSlice> slices_of(const Scene& scene, const PreparedPair& pair) {
+  const WorkloadSpec& workload = scene.workload;
+  std::vector<PoseSlice> slices;
+  if (workload.axis == WorkloadSpec::Axis::Separation) {
+    slices = separation_slices(workload, pair.a->mesh, pair.b->mesh);
+    check_separation_band(scene, pair.label, slices);
+  } else {
+    for (std::size_t g = 0; g < workload.groups.size(); ++g) slices.push_back(group_slice(workload, g));
+  }
+  return slices;
+}
+
 }  // namespace
 
 PerPose parse_per_pose(std::string_view text) {
@@ -172,27 +186,23 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
   Measurement measurement(scene, plan, options, stats, log, threads);
   Aggregation aggregation(stats.clock_overhead_us, options.per_pose);
   output.per_pose = options.per_pose;
+  // Every pair is prepared, its truth known and its slices checked before any query is timed; then the
+  // timing passes sweep the whole workload, so each pose's samples lie a whole pass apart.
+  std::vector<PreparedPair> pairs;
+  std::vector<Truth> truths;
+  std::vector<SeriesMaps> maps;
+  std::vector<std::vector<PoseSlice>> slices;
   for (const ScenePair* scene_pair : plan.pairs) {
-    const PreparedPair pair = preparation.pair(scene, *scene_pair, plan);
-    const Truth truth = measurement.ground_truth(pair, preparation);
-    const SeriesMaps maps = measurement.calibration_maps(pair, preparation);
-    advise(pair, plan, output, log);
-    const WorkloadSpec& workload = scene.workload;
-    PairRecords records(workload.groups.size());
-    if (workload.axis == WorkloadSpec::Axis::Separation) {  // slices cut across the groups: time them all
-      const std::vector<PoseSlice> slices = separation_slices(workload, pair.a->mesh, pair.b->mesh);
-      check_separation_band(scene, pair.label, slices);
-      for (std::size_t g = 0; g < workload.groups.size(); ++g) records[g] = measurement.time_group(pair, g);
-      for (const PoseSlice& slice : slices)
-        add_slice(aggregation, pair, plan, slice, truth, records, maps, output);
-      continue;
-    }
-    for (std::size_t g = 0; g < workload.groups.size(); ++g) {
-      records[g] = measurement.time_group(pair, g);
-      add_slice(aggregation, pair, plan, group_slice(workload, g), truth, records, maps, output);
-      records[g].clear();
-    }
+    pairs.push_back(preparation.pair(scene, *scene_pair, plan));
+    truths.push_back(measurement.ground_truth(pairs.back(), preparation));
+    maps.push_back(measurement.calibration_maps(pairs.back(), preparation));
+    advise(pairs.back(), plan, output, log);
+    slices.push_back(slices_of(scene, pairs.back()));
   }
+  const std::vector<PairRecords> records = measurement.time_workload(pairs);
+  for (std::size_t p = 0; p < pairs.size(); ++p)
+    for (const PoseSlice& slice : slices[p])
+      add_slice(aggregation, pairs[p], plan, slice, truths[p], records[p], maps[p], output);
 
   const std::vector<SummaryBand> bands = summary_bands(output);
   for (ResultRow& row : output.rows)
