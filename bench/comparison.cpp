@@ -111,7 +111,9 @@ std::string speedup_text(const Interval& ratio, bool same, bool bold) {
   if (has_interval && ratio.contains(1))
     return b + "no measurable difference" + b + fmt::format(" ({:.2f}×, {})", ratio.value, interval);
   if (ratio.value >= 1) return b + fmt::format("{:.2f}× faster", ratio.value) + b + " (" + interval + ")";
-  return b + fmt::format("{:.2f}× slower", 1 / ratio.value) + b + " (" + interval + ")";
+  const std::string inverted =  // a slow-down is stated as its own ratio, so its interval is inverted too
+      has_interval ? fmt::format("95% interval {:.2f}–{:.2f}×", 1 / ratio.hi, 1 / ratio.lo) : interval;
+  return b + fmt::format("{:.2f}× slower", 1 / ratio.value) + b + " (" + inverted + ")";
 }
 
 }  // namespace bvhlab

@@ -140,8 +140,8 @@ std::vector<OperatingPoint> operating_points(const RunOutput& run) {
     for (const auto& s : series) {
       if (s.mesh != mesh) continue;
       if (s.hierarchy == spec.operating_hierarchy && s.strategy == spec.operating_strategy &&
-          s.p_min == spec.operating_p_min && s.budget.empty())
-        adb = &s;
+          s.p_min == spec.operating_p_min && s.budget.empty() && !adb)
+        adb = &s;  // the first such series: the plain sweep, not a variant of it listed later
       if (s.hierarchy == spec.baseline_hierarchy && s.strategy == spec.baseline_strategy && !base) base = &s;
     }
     if (!adb || !base) continue;

@@ -56,7 +56,7 @@ struct RunStats {
   std::size_t queries = 0;                 ///< timed queries (one per series and pose, as reported)
   /// How they were timed (the scene's "timing"): passes over the poses, and the per-pose statistic.
   int timing_repeats = 1;
-  std::string timing_statistic = "median";
+  std::string timing_statistic = "min";
   /// Every timed sample of every pass, and those that were stalls (bench/timing_stats.hpp), with the time
   /// they lost beyond their pose's median; context switches forced on the timing thread meanwhile.
   std::size_t timed_samples = 0, stalled_samples = 0;

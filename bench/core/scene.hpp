@@ -246,7 +246,7 @@ struct PointsSpec {
 /// How each (series, pose) is timed ("timing" in the file): `repeats` warm passes over the poses, each pose
 /// timed once per pass, reduced to one time per pose by `statistic` (bench/timing_stats.hpp).
 struct TimingSpec {
-  enum class Statistic { Median, Min } statistic = Statistic::Median;
+  enum class Statistic { Median, Min } statistic = Statistic::Min;
   int repeats = 3;
 };
 const char* statistic_name(TimingSpec::Statistic statistic);

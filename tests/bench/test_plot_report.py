@@ -150,7 +150,14 @@ class PminCurves(unittest.TestCase):
 
     def test_time_falling_while_the_work_rises_is_a_break(self):
         rows = [curve_row("0.8", 2.1, 8.1), curve_row("0.9", 1.2, 12.4)]
-        self.assertEqual(plot_report.pmin_curve_breaks(rows), [("m", "aabb", "adb", 0.8, 0.9)])
+        breaks = plot_report.pmin_curve_breaks(rows)
+        self.assertEqual([b[:5] for b in breaks], [("m", "aabb", "adb", 0.8, 0.9)])
+        self.assertAlmostEqual(breaks[0][5], 1.2 / 2.1 - 1)
+
+    def test_a_step_back_within_the_tolerance_is_not_a_break(self):
+        rows = [curve_row("0.5", 0.2546, 1.25), curve_row("0.8", 0.2422, 1.71)]  # 5 ns at a quarter µs
+        self.assertEqual(len(plot_report.pmin_curve_breaks(rows)), 1)
+        self.assertEqual(plot_report.pmin_curve_breaks(rows, tolerance=0.05), [])
 
     def test_only_the_rows_inside_the_band_count(self):
         rows = [curve_row("0.8", 1.0, 8), curve_row("0.9", 2.0, 12),

@@ -82,10 +82,10 @@ def test_the_rest_of_results_json(run):
 
 def test_times_are_per_pose_statistics_of_warm_passes(gear_file):
     warm = scene(gear_file)
-    warm["timing"] = {"repeats": 3, "statistic": "min"}
+    warm["timing"] = {"repeats": 3, "statistic": "median"}
     out = bvhlab.run_scene(warm)
     stats = out["stats"]
-    assert stats["timing_repeats"] == 3 and stats["timing_statistic"] == "min"
+    assert stats["timing_repeats"] == 3 and stats["timing_statistic"] == "median"
     assert stats["timed_samples"] == 3 * stats["queries"]
     assert 0 <= stats["stalled_samples"] <= stats["timed_samples"]
     for row in out["rows"]:
