@@ -98,13 +98,13 @@ void check_separation_band(const Scene& scene, const std::string& label,
 }
 
 /// The pair's slices of the workload: its groups, or its separation bins (checked against the summary
-/// distances the scene gives).
-std::vector<PoseSlice> slices_of(const Scene& scene, const PreparedPair& pair) {
+/// distances the scene gives, before any tree is built for the pair).
+std::vector<PoseSlice> slices_of(const Scene& scene, const std::string& label, const Mesh& a, const Mesh& b) {
   const WorkloadSpec& workload = scene.workload;
   std::vector<PoseSlice> slices;
   if (workload.axis == WorkloadSpec::Axis::Separation) {
-    slices = separation_slices(workload, pair.a->mesh, pair.b->mesh);
-    check_separation_band(scene, pair.label, slices);
+    slices = separation_slices(workload, a, b);
+    check_separation_band(scene, label, slices);
   } else {
     for (std::size_t g = 0; g < workload.groups.size(); ++g) slices.push_back(group_slice(workload, g));
   }
@@ -193,11 +193,13 @@ RunOutput run_scene(const Scene& scene, const RunOptions& options) {
   std::vector<SeriesMaps> maps;
   std::vector<std::vector<PoseSlice>> slices;
   for (const ScenePair* scene_pair : plan.pairs) {
+    slices.push_back(slices_of(scene, scene_pair->label(),
+                               preparation.object(*scene.object(scene_pair->a)).mesh,
+                               preparation.object(*scene.object(scene_pair->b)).mesh));
     pairs.push_back(preparation.pair(scene, *scene_pair, plan));
     truths.push_back(measurement.ground_truth(pairs.back(), preparation));
     maps.push_back(measurement.calibration_maps(pairs.back(), preparation));
     advise(pairs.back(), plan, output, log);
-    slices.push_back(slices_of(scene, pairs.back()));
   }
   const std::vector<PairRecords> records = measurement.time_workload(pairs);
   for (std::size_t p = 0; p < pairs.size(); ++p)

@@ -3,6 +3,7 @@
 // the ground truth, calibration verdicts only with spread, and the scene fields that set it all, refused when
 // they make no sense.
 #include "bench/report.hpp"
+#include "bench/run.hpp"
 #include "bench/slices.hpp"
 #include "bench/summary_band.hpp"
 #include "bench/timing_stats.hpp"
@@ -196,6 +197,28 @@ TEST_F(TimingSceneTest, NonsenseIsRefusedNamingTheField) {
       "strategies": [{"type": "exact"}], "world": {"instances": 2, "frames": 2}, "timing": {"repeats": 2}})";
   EXPECT_NE(error_of(world).find("/timing: does not apply to a world scene"), std::string::npos)
       << error_of(world);
+}
+
+// A separation axis is binned per pair from the objects' sizes: summary distances outside its bins are
+// refused once the meshes are loaded, before any tree is built or query timed.
+TEST_F(TimingSceneTest, SummaryDistancesOutsideTheSeparationBinsAreRefusedBeforeAnyTree) {
+  const Scene s = parse(scene(R"(, "workload": {"type": "random", "count": 8, "box": [[-0.2, -0.2, -0.2],
+      [0.2, 0.2, 0.2]]}, "report": {"quality_distances": [5, 6]})"));
+  RunOptions options;
+  options.cache_dir.clear();
+  std::vector<std::string> messages;
+  options.log = [&](const std::string& m) { messages.push_back(m); };
+  try {
+    (void)run_scene(s, options);
+    ADD_FAILURE() << "no SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("/report/quality_distances: no pose of torus has a separation in [5, 6]; "
+                                   "its separation bins are 0.05"),
+        std::string::npos)
+        << e.what();
+  }
+  for (const std::string& m : messages) EXPECT_EQ(m.find("building"), std::string::npos) << m;
 }
 
 }  // namespace
