@@ -246,16 +246,28 @@ def exact_and_operating_panels(rows, args):
 
 
 def figure_time_vs_distance(rows, args, out):
-    fig, axes, panels = exact_and_operating_panels(rows, args)
-    for ax, mesh, shown in panels:
-        for i, (series, (colour, line, marker), label) in enumerate(shown):
-            ax.plot([num(r["distance"]) for r in series], [num(r["mean_time_us"]) for r in series], line,
-                    marker=marker, color=colour, label=label, **layered(i))
-        log_axis(ax)
-        ax.set_title(f"{mesh}: time per query")
-        ax.set_xlabel(args.distance_label, fontsize=9)
-        ax.set_ylabel(TIME_LABEL)
-        ax.grid(True, which="both", alpha=0.3)
+    """Time per query against distance, and below each panel the work that explains it: BV tests per query."""
+    meshes = meshes_of(rows)
+    hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
+    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
+    fig, per_mesh, axes = subplots(len(meshes), rows_per_mesh=2, height=3.4)
+    for (time_ax, work_ax), mesh in zip(per_mesh, meshes):
+        shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
+                 if is_exact(s[0]) or is_operating(s[0], args)]
+        for i, series in enumerate(shown):
+            colour, line, marker = style_for(series[0]["hierarchy"], series[0]["strategy"], hierarchies, strategies)
+            style = dict(marker=marker, color=colour, label=f"{series[0]['hierarchy']}: {series_label(series[0])}",
+                         **layered(i))
+            d = [num(r["distance"]) for r in series]
+            time_ax.plot(d, [num(r["mean_time_us"]) for r in series], line, **style)
+            work_ax.plot(d, [num(r.get("bv_tests_per_query", "")) for r in series], line, **style)
+        time_ax.set_title(f"{mesh}: time per query")
+        work_ax.set_title(f"{mesh}: work per query (FCL counts none)")
+        for ax, label in ((time_ax, TIME_LABEL), (work_ax, "BV tests per query")):
+            log_axis(ax)
+            ax.set_xlabel(args.distance_label, fontsize=9)
+            ax.set_ylabel(label)
+            ax.grid(True, which="both", alpha=0.3)
     legend_below(fig, axes)
     fig.savefig(out, dpi=110, bbox_inches="tight")
     plt.close(fig)
