@@ -99,6 +99,7 @@ def aggregate(rows, lo, hi, band=False):
         "fp": mean("fp_rate"),
         "fn": mean("fn_rate"),
         "bytes": num(picked[0]["bytes_per_triangle"]),
+        "bv": mean("bv_tests_per_query") if "bv_tests_per_query" in picked[0] else math.nan,
         "queries": q,
     }
 
@@ -313,6 +314,12 @@ def figure_errors_vs_distance(rows, args, out):
     plt.close(fig)
 
 
+def annotate_work(ax, x, y, bv_tests, colour):
+    """BV tests per query as a small number beside a point: the work behind its time (none for FCL)."""
+    if math.isfinite(bv_tests):
+        ax.annotate(f"{bv_tests:.0f}", (x, y), textcoords="offset points", xytext=(5, 4), fontsize=7, color=colour)
+
+
 def figure_error_vs_time(rows, args, out):
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
@@ -335,6 +342,7 @@ def figure_error_vs_time(rows, args, out):
                 marker = next(budget_markers, "D")
             ax.plot([agg["time"]], [100 * (agg["fp"] + agg["fn"])], marker, color=colour, linestyle="none",
                     label=f"{first['hierarchy']}: {series_label(first)}", **layered(i))
+            annotate_work(ax, agg["time"], 100 * (agg["fp"] + agg["fn"]), agg["bv"], colour)
         labels = []
         for hierarchy, points in curves.items():
             points.sort(key=lambda p: p[0])
@@ -342,7 +350,8 @@ def figure_error_vs_time(rows, args, out):
             xs = [p[1]["time"] for p in points]
             ys = [100 * (p[1]["fp"] + p[1]["fn"]) for p in points]
             ax.plot(xs, ys, "-", marker="^", color=colour, label=f"{hierarchy}: {args.operating_strategy} over p_min")
-            labels += [(x, y, f"{p:g}", hierarchy) for (p, _), x, y in zip(points, xs, ys)]
+            labels += [(x, y, f"{p:g}" + (f" · {a['bv']:.0f}" if math.isfinite(a["bv"]) else ""), hierarchy)
+                       for (p, a), x, y in zip(points, xs, ys)]
         log_axis(ax, "x")
         bands = dict(b.split("=", 1) for b in args.band if "=" in b)
         ax.set_title(f"{mesh}: error vs time, {bands.get(mesh, args.quality_text)}", fontsize=9)
@@ -520,6 +529,7 @@ def figure_time_vs_size(rows, args, out):
             if agg is None or not math.isfinite(agg["bytes"]):
                 continue
             ax.plot([agg["bytes"]], [agg["time"]], marker, color=colour, linestyle="none", label=label, **layered(i))
+            annotate_work(ax, agg["bytes"], agg["time"], agg["bv"], colour)
         log_axis(ax)
         ax.set_title(f"{mesh}: time vs model size (all distances)")
         ax.set_xlabel("model size (bytes per triangle, without polygons)")

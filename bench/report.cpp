@@ -74,8 +74,9 @@ const std::vector<FigureSpec>& report_figures() {
        "False-positive and false-negative rates of the inexact strategies against "
        "distance."},
       {"fig3_error_vs_time.png",
-       "Error (false positives + false negatives) against mean time per query over the "
-       "time-versus-quality distances, one point per p_min: the Pareto curve."},
+       "Error (false positives + false negatives) against mean time per query over each pair's summary band, "
+       "one point per p_min (labelled p_min · BV tests per query; other points: their BV tests per query): "
+       "the Pareto curve."},
       {"fig4_calibration.png",
        "Calibration, one panel per inexact series (in its figure 2 colour): the probability its answers "
        "report (decile means) against the observed collision frequency. Filled markers: deciles holding "
@@ -85,7 +86,8 @@ const std::vector<FigureSpec>& report_figures() {
            "; hollow: fewer answers, not judged; numbers: answers per decile; the line breaks at an empty "
            "decile."},
       {"fig5_time_vs_size.png",
-       "Mean time per query against model size (bytes per triangle, without polygons)."},
+       "Mean time per query against model size (bytes per triangle, without polygons); numbers: BV tests per "
+       "query."},
   };
   return figures;
 }
