@@ -294,6 +294,10 @@ std::vector<PairRecords> Measurement::time_workload(const std::vector<PreparedPa
           out[p][g][i].push_back(representatives(passes[p][g][s]));
       passes[p][g].clear();
     }
+  stats_.timed_samples = disturbance_.samples;
+  stats_.stalled_samples = disturbance_.stalled;
+  stats_.sampled_seconds = disturbance_.timed_us * 1e-6;
+  stats_.stall_lost_seconds = disturbance_.lost_us * 1e-6;
   return out;
 }
 
@@ -326,10 +330,6 @@ std::vector<QueryRecord> Measurement::representatives(const std::vector<std::vec
     out.push_back(passes[representative_sample(samples, scene_.timing.statistic)][k]);
     disturbance_.add(samples);
   }
-  stats_.timed_samples = disturbance_.samples;
-  stats_.stalled_samples = disturbance_.stalled;
-  stats_.sampled_seconds = disturbance_.timed_us * 1e-6;
-  stats_.stall_lost_seconds = disturbance_.lost_us * 1e-6;
   return out;
 }
 
