@@ -35,4 +35,27 @@ std::string size_advice(std::string_view strategy, const std::string& pair, cons
       strategy, pair, ratio, strategy);
 }
 
+std::string root_round_advice(const RootRoundShortfall& s) {
+  if (s.untested == 0) return "";
+  auto missed = [](std::size_t n, std::size_t of) {
+    return of ? fmt::format("{:.1f}%", 100.0 * double(n) / double(of)) : std::string("none");
+  };
+  std::string text = fmt::format(
+      "`{}` on {}: in {} of {} frames the budget ended before every candidate pair had its root test: {} of "
+      "{} candidate pairs had no test at all and were answered without one ({} of them collide in truth); "
+      "the series missed {} of the colliding pairs. No schedule can rank a pair it has not tested once, and "
+      "the root round tests the pairs in the broad phase's order, so the same pairs go untested frame after "
+      "frame. A frame of n candidate pairs needs n BV tests before the first expansion; this run's frames "
+      "had up to {}: give the frame {}.",
+      s.series, s.hierarchy, s.frames_short, s.frames, s.untested, s.candidates, s.untested_colliding,
+      missed(s.missed, s.colliding), s.most_candidates,
+      s.counts_tests
+          ? fmt::format("at least {} BV tests", s.most_candidates)
+          : fmt::format("a deadline that covers {} root tests and the frame's set-up", s.most_candidates));
+  if (!s.covered_series.empty())
+    text += fmt::format(" Measured in this run: `{}`, which covered every root round, missed {}.",
+                        s.covered_series, missed(s.covered_missed, s.covered_colliding));
+  return text;
+}
+
 }  // namespace bvhlab

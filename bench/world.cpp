@@ -1,5 +1,6 @@
 #include "bench/world.hpp"
 
+#include "bench/advice.hpp"
 #include "bench/core/policies.hpp"
 #include "bench/core/registry.hpp"
 #include "bench/core/world_motion.hpp"
@@ -18,6 +19,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -264,6 +266,8 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
         if (spec.confirm_levels > 0) row.schedule += " confirm_levels=" + std::to_string(spec.confirm_levels);
         if (spec.memory) row.schedule += " memory";
         row.budget = budget_label(budget);
+        row.budget_bv_tests = budget.max_bv_tests;
+        row.budget_deadline_us = budget.deadline_us;
         row.series = "frame " + row.schedule + " " + row.budget + " p_min=" + parameter_text(spec.p_min);
         FrameMemory* memory = spec.memory ? &memories[row.series] : nullptr;
         if (warmup > 0) {
@@ -276,6 +280,10 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
         for (std::size_t k = 0; k < outcomes.size(); ++k) {
           answers[k] = outcomes[k].collides;
           flagged[k] = outcomes[k].budget_exhausted;
+          if (outcomes[k].counters.bv_tests == 0) {
+            ++row.untested;
+            row.untested_colliding += candidates[k].truth;
+          }
           row.bv_tests += outcomes[k].counters.bv_tests;
           pair_rows.add(row.series, candidates[k], answers[k], flagged[k], outcomes[k].probability, -1,
                         outcomes[k].counters.bv_tests);
@@ -285,6 +293,61 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
       }
   }
   return rows;
+}
+
+/// Each frame-budget series summed over the run's frames, in first-seen order.
+std::vector<RootRoundShortfall> frame_budget_totals(const std::vector<WorldSeriesRow>& rows) {
+  std::vector<RootRoundShortfall> out;
+  std::map<std::pair<std::string, std::string>, std::size_t> index;
+  for (const WorldSeriesRow& row : rows) {
+    if (row.schedule.empty()) continue;
+    auto [it, fresh] = index.try_emplace({row.hierarchy, row.series}, out.size());
+    if (fresh) {
+      out.emplace_back();
+      out.back().series = row.series;
+      out.back().hierarchy = row.hierarchy;
+      out.back().counts_tests = row.budget_bv_tests > 0;
+    }
+    RootRoundShortfall& s = out[it->second];
+    ++s.frames;
+    s.frames_short += row.untested > 0;
+    s.candidates += row.candidates;
+    s.most_candidates = std::max(s.most_candidates, row.candidates);
+    s.untested += row.untested;
+    s.untested_colliding += row.untested_colliding;
+    s.colliding += row.colliding;
+    s.missed += row.missed;
+  }
+  return out;
+}
+
+/// "The right tool" for every frame-budget series that left a pair without its root test in some frame,
+/// with the same schedule's smallest budget of the same kind that covered every round, when the run has one.
+std::vector<std::string> root_round_advice(const std::vector<WorldSeriesRow>& rows) {
+  std::map<std::string, const WorldSeriesRow*> row_of;
+  for (const WorldSeriesRow& row : rows) row_of.try_emplace(row.series, &row);
+  // The budget's size in its own kind: tests or microseconds (a budget of both kinds is compared by tests).
+  auto amount = [&](const RootRoundShortfall& s) {
+    const WorldSeriesRow& row = *row_of.at(s.series);
+    return s.counts_tests ? double(row.budget_bv_tests) : row.budget_deadline_us;
+  };
+  const std::vector<RootRoundShortfall> totals = frame_budget_totals(rows);
+  std::vector<std::string> advice;
+  for (RootRoundShortfall s : totals) {
+    if (s.untested == 0) continue;
+    double smallest = std::numeric_limits<double>::infinity();
+    for (const RootRoundShortfall& other : totals) {
+      if (other.untested > 0 || other.hierarchy != s.hierarchy || other.counts_tests != s.counts_tests ||
+          row_of.at(other.series)->schedule != row_of.at(s.series)->schedule || !(amount(other) < smallest))
+        continue;
+      smallest = amount(other);
+      s.covered_series = other.series;
+      s.covered_colliding = other.colliding;
+      s.covered_missed = other.missed;
+    }
+    advice.push_back(root_round_advice(s));
+  }
+  return advice;
 }
 
 /// The candidate pairs of a frame with their exact answers (memoised per frame across hierarchies: any
@@ -487,6 +550,8 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
 #endif
   }
   output.pairs = std::move(pair_rows.rows);
+  output.advice = root_round_advice(output.series);
+  for (const std::string& advice : output.advice) log("note: " + advice);
   output.models = preparation.models();
   output.stats.wall_seconds = std::chrono::duration<double>(Clock::now() - wall).count();
   return output;

@@ -28,9 +28,11 @@ inline constexpr std::string_view kFclWorldHierarchy = "fcl_obbrss";
 struct WorldSeriesRow {
   int frame = 0;
   std::string hierarchy;
-  std::string series;    ///< "exact", "adb p_min=0.9", "frame adb_probability bv_tests=2000"
-  std::string schedule;  ///< the frame-budget policy; empty for a per-pair strategy
-  std::string budget;    ///< the frame's budget ("bv_tests=2000"); empty for a per-pair strategy
+  std::string series;                 ///< "exact", "adb p_min=0.9", "frame adb_probability bv_tests=2000"
+  std::string schedule;               ///< the frame-budget policy; empty for a per-pair strategy
+  std::string budget;                 ///< the frame's budget ("bv_tests=2000"); empty for a per-pair strategy
+  std::uint64_t budget_bv_tests = 0;  ///< the frame's cap of BV tests (0: none)
+  double budget_deadline_us = 0;      ///< the frame's deadline (0: none)
   bool exact_strategy = false;
   std::size_t candidates = 0;   ///< candidate pairs of the frame (the broad phase's answer)
   std::size_t colliding = 0;    ///< of those, colliding in truth
@@ -38,7 +40,9 @@ struct WorldSeriesRow {
   std::size_t missed = 0;       ///< colliding, answered apart
   std::size_t false_pairs = 0;  ///< apart, answered colliding
   std::size_t flagged = 0;      ///< answered as a best effort (budget ran out)
-  double micros = 0;            ///< narrow phase of the frame: every candidate pair
+  std::size_t untested = 0;     ///< under a frame budget: pairs the budget left without their root test
+  std::size_t untested_colliding = 0;  ///< of those, colliding in truth
+  double micros = 0;                   ///< narrow phase of the frame: every candidate pair
   std::uint64_t bv_tests = 0;
 };
 
@@ -87,6 +91,8 @@ struct WorldOutput {
   std::vector<ScalingRow> scaling;
   std::vector<ModelInfo> models;
   RunStats stats;
+  /// "The right tool" (bench/advice.hpp): frame budgets too small to give every candidate pair its root test.
+  std::vector<std::string> advice;
 };
 
 /// Runs a world scene (scene.world set). Throws std::invalid_argument for a scene without one.

@@ -62,11 +62,12 @@ void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir
   std::filesystem::create_directories(dir);
   std::ofstream frames = open_csv(dir / "world_frames.csv");
   frames << "frame,hierarchy,series,schedule,budget,exact_strategy,candidates,colliding,answered,missed,"
-            "false_pairs,flagged,micros,bv_tests\n";
+            "false_pairs,flagged,untested,untested_colliding,micros,bv_tests\n";
   for (const WorldSeriesRow& r : output.series)
-    frames << fmt::format("{},{},\"{}\",{},{},{},{},{},{},{},{},{},{:.3f},{}\n", r.frame, r.hierarchy,
+    frames << fmt::format("{},{},\"{}\",{},{},{},{},{},{},{},{},{},{},{},{:.3f},{}\n", r.frame, r.hierarchy,
                           r.series, r.schedule, r.budget, r.exact_strategy ? 1 : 0, r.candidates, r.colliding,
-                          r.answered, r.missed, r.false_pairs, r.flagged, r.micros, r.bv_tests);
+                          r.answered, r.missed, r.false_pairs, r.flagged, r.untested, r.untested_colliding,
+                          r.micros, r.bv_tests);
   std::ofstream broad = open_csv(dir / "world_broad_phase.csv");
   broad << "frame,hierarchy,broad_phase,objects,candidates,boxes_micros,update_micros\n";
   for (const BroadPhaseRow& r : output.broad)
@@ -175,6 +176,7 @@ void scaling_table(std::ostream& md, const WorldOutput& output) {
 std::string world_readme(const WorldOutput& output, const std::vector<std::string>& figures) {
   std::ostringstream md;
   md << "# " << output.scene << ": " << output.instances << " instances, " << output.frames << " frames\n\n";
+  for (const std::string& advice : output.advice) md << "> **The right tool:** " << advice << "\n\n";
   series_table(md, output);
   broad_phase_table(md, output);
   scaling_table(md, output);
@@ -198,6 +200,8 @@ nlohmann::json world_document(const WorldOutput& output) {
                       {"missed", r.missed},
                       {"false_pairs", r.false_pairs},
                       {"flagged", r.flagged},
+                      {"untested", r.untested},
+                      {"untested_colliding", r.untested_colliding},
                       {"micros", r.micros},
                       {"bv_tests", r.bv_tests}});
   for (const BroadPhaseRow& r : output.broad)
@@ -217,7 +221,8 @@ nlohmann::json world_document(const WorldOutput& output) {
                        {"update_micros", r.update_micros}});
   nlohmann::json document = {{"scene", output.scene},   {"instances", output.instances},
                              {"frames", output.frames}, {"series", series},
-                             {"broad_phase", broad},    {"scaling", scaling}};
+                             {"broad_phase", broad},    {"scaling", scaling},
+                             {"advice", output.advice}};
   if (output.per_pose == PerPose::none) return document;
   nlohmann::json pairs = nlohmann::json::array();
   for (const WorldPairRow& r : output.pairs)

@@ -8,7 +8,9 @@
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <map>
@@ -304,6 +306,45 @@ TEST_F(WorldTest, AFrameBudgetOfOneTestFlagsItsPairsAndAGenerousOneDecidesThemAl
   }
   EXPECT_GT(candidates, 0u);
   EXPECT_GT(starved, 0u);
+}
+
+// "The right tool": a budget below one test per candidate pair leaves pairs untested, and the run says which
+// series, how many pairs, the budget that covers the round and the run's series that did; a budget that
+// covers it gives no advice.
+TEST_F(WorldTest, ABudgetBelowTheRootRoundIsNamedWithItsUntestedPairs) {
+  const Scene scene =
+      parse(crowded_world(R"([{"bv": "aabb", "annotation": {"type": "adb"}}])", R"([{"type": "exact"}])",
+                          R"(, "frame_budgets": [{"schedules": ["adb_probability"],
+          "budgets": [{"bv_tests": 1}, {"bv_tests": 10000000}]}])"));
+  const WorldOutput out = run_world(scene, quiet_options());
+  std::size_t untested = 0, most = 0, untested_colliding = 0, candidates = 0;
+  for (const WorldSeriesRow& row : out.series) {
+    if (row.budget != "bv_tests=1") {
+      EXPECT_EQ(row.untested, 0u) << row.series;
+      continue;
+    }
+    EXPECT_EQ(row.untested, row.candidates - std::min<std::size_t>(row.candidates, 1)) << row.frame;
+    untested += row.untested;
+    candidates += row.candidates;
+    untested_colliding += row.untested_colliding;
+    most = std::max(most, row.candidates);
+  }
+  ASSERT_GT(most, 1u) << "the crowded world needs frames with two candidate pairs or more";
+  ASSERT_EQ(out.advice.size(), 1u);
+  const std::string& advice = out.advice.front();
+  EXPECT_NE(advice.find("bv_tests=1 "), std::string::npos) << advice;
+  EXPECT_NE(advice.find(fmt::format("{} of {} candidate pairs had no test", untested, candidates)),
+            std::string::npos)
+      << advice;
+  EXPECT_NE(advice.find(fmt::format("({} of them collide in truth)", untested_colliding)), std::string::npos)
+      << advice;
+  EXPECT_NE(advice.find(fmt::format("at least {} BV tests", most)), std::string::npos) << advice;
+  EXPECT_NE(
+      advice.find("`frame adb_probability bv_tests=10000000 p_min=0.9`, which covered every root round"),
+      std::string::npos)
+      << advice;
+  EXPECT_NE(world_readme(out).find("The right tool"), std::string::npos);
+  EXPECT_EQ(world_document(out)["advice"].size(), 1u);
 }
 
 // A frame budget that never runs out answers every pair as ADB does on its own, with the same confirming
