@@ -116,4 +116,61 @@ std::string speedup_text(const Interval& ratio, bool same, bool bold) {
   return b + fmt::format("{:.2f}× slower", 1 / ratio.value) + b + " (" + inverted + ")";
 }
 
+namespace {
+
+/// A label without its "p_min=..." word: the name of the curve the series is a point of.
+std::string without_p_min(const std::string& label) {
+  const std::size_t at = label.find("p_min=");
+  if (at == std::string::npos) return label;
+  std::size_t end = label.find(' ', at);
+  end = end == std::string::npos ? label.size() : end + 1;
+  std::string out = label.substr(0, at) + label.substr(end);
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
+CurveStep curve_step(const SeriesSummary& a, const SeriesSummary& b, const std::string& curve) {
+  CurveStep step;
+  step.mesh = a.mesh;
+  step.hierarchy = a.hierarchy;
+  step.curve = curve;
+  step.p_min = a.p_min;
+  step.next_p_min = b.p_min;
+  step.bv_tests = a.bv_tests_per_query;
+  step.next_bv_tests = b.bv_tests_per_query;
+  step.time_ratio = time_ratio(b, a);
+  step.same_work = same_work(a, b);
+  const Interval& t = step.time_ratio;
+  const bool measured = std::isfinite(t.lo) && std::isfinite(t.hi);
+  const bool more_work = !within_one_percent(a.bv_tests_per_query, b.bv_tests_per_query) &&
+                         b.bv_tests_per_query > a.bv_tests_per_query;
+  const bool less_work = !within_one_percent(a.bv_tests_per_query, b.bv_tests_per_query) &&
+                         b.bv_tests_per_query < a.bv_tests_per_query;
+  step.against_work = measured && ((more_work && t.hi < 1) || (less_work && t.lo > 1));
+  return step;
+}
+
+}  // namespace
+
+std::vector<CurveStep> pmin_curve_steps(const std::vector<SeriesSummary>& series) {
+  std::map<std::string, std::vector<const SeriesSummary*>> curves;
+  std::vector<std::string> order;
+  for (const SeriesSummary& s : series) {
+    if (s.exact_strategy || s.p_min < 0) continue;
+    const std::string key = s.mesh + '\x1f' + s.hierarchy + '\x1f' + without_p_min(s.label);
+    auto& points = curves[key];
+    if (points.empty()) order.push_back(key);
+    points.push_back(&s);
+  }
+  std::vector<CurveStep> steps;
+  for (const std::string& key : order) {
+    auto& points = curves[key];
+    std::stable_sort(points.begin(), points.end(),
+                     [](const SeriesSummary* x, const SeriesSummary* y) { return x->p_min < y->p_min; });
+    for (std::size_t k = 1; k < points.size(); ++k)
+      steps.push_back(curve_step(*points[k - 1], *points[k], without_p_min(points[k]->label)));
+  }
+  return steps;
+}
+
 }  // namespace bvhlab

@@ -3,13 +3,13 @@
 
     plot_report.py REPORT_DIR [--band MESH=TEXT ...] [--distance-label "..."] [--operating-strategy adb]
                    [--operating-hierarchy aabb] [--operating-p-min 0.9]
-    plot_report.py REPORT_DIR --check-pmin-curves
 
 The labels come from the scene (`bvhlab report` passes them): the distance axis says whether distances are
 in normalised or the scene's own units, or separations, and figure 3 names each pair's summary band (the
 rows results.csv marks "in_summary"; --quality-min/--quality-max for a results.csv without that column).
---check-pmin-curves draws nothing and lists where figure 3's p_min curves go back in time while their BV
-tests do not (exit status 1 if anywhere).
+Figure 3 draws one curve over p_min per hierarchy and set of other parameters (confirm_levels=1 is a curve of
+its own, dashed); whether each curve follows its work is judged in the report's README, which has the
+per-pose times that judgement needs.
 
 Strategies are told apart by the columns results.csv takes from bvhlab's strategy table: "exact" (1 for an
 exact strategy), "strategy" (its name) and "label" (name, labelled parameters, budget); no strategy name is
@@ -25,7 +25,6 @@ Figures (PNG, in REPORT_DIR):
 """
 import math
 import os
-import sys
 
 import matplotlib
 
@@ -102,32 +101,6 @@ def aggregate(rows, lo, hi, band=False):
         "bv": mean("bv_tests_per_query") if "bv_tests_per_query" in picked[0] else math.nan,
         "queries": q,
     }
-
-
-def pmin_curve_breaks(rows, tolerance=0.0):
-    """Where figure 3's p_min curves go back in time although the work does not: per (mesh, hierarchy,
-    strategy, budget) swept over p_min, over the rows inside their band, each neighbouring pair of p_min whose
-    BV tests per query rise (or stay) while the mean time falls by more than `tolerance` (a share of the
-    time), or the other way round. A list of (mesh, hierarchy, label, p_min, next p_min, relative time
-    change); empty when every curve follows its work."""
-    curves = {}
-    for r in rows:
-        if r["p_min"] != "" and not is_exact(r):
-            curves.setdefault((r["mesh"], r["hierarchy"], r["strategy"], r["budget"]), []).append(r)
-    breaks = []
-    for (mesh, hierarchy, strategy, budget), series in curves.items():
-        points = []
-        for p_min in sorted({float(r["p_min"]) for r in series}):
-            picked = [r for r in series if float(r["p_min"]) == p_min]
-            agg = aggregate(picked, -1e300, 1e300, band=True)
-            work = sum(num(r["bv_tests_per_query"]) * int(r["queries"]) for r in picked if in_summary(r, -1e300, 1e300))
-            if agg:
-                points.append((p_min, agg["time"], work / agg["queries"]))
-        for (p, t, w), (q, u, v) in zip(points, points[1:]):
-            change = u / t - 1 if t > 0 else 0.0
-            if (v >= w and change < -tolerance) or (v <= w and change > tolerance):
-                breaks.append((mesh, hierarchy, f"{strategy} {budget}".strip(), p, q, change))
-    return breaks
 
 
 def subplots(n, width=6.0, height=4.2, rows_per_mesh=1):
@@ -223,6 +196,11 @@ def style_for(hierarchy, strategy, hierarchies, strategies):
 def is_operating(row, args):
     return (row["strategy"] == args.operating_strategy and row["hierarchy"] == args.operating_hierarchy
             and row["p_min"] and not row["budget"] and abs(float(row["p_min"]) - args.operating_p_min) < 1e-12)
+
+
+def curve_name(row):
+    """The series' label without its p_min: the curve of figure 3 it is a point of."""
+    return " ".join(word for word in row["label"].split() if not word.startswith("p_min="))
 
 
 def is_sweep(row, args):
@@ -335,7 +313,7 @@ def figure_error_vs_time(rows, args, out):
             if agg is None:
                 continue
             if is_sweep(first, args):
-                curves.setdefault(first["hierarchy"], []).append((float(first["p_min"]), agg))
+                curves.setdefault((first["hierarchy"], curve_name(first)), []).append((float(first["p_min"]), agg))
                 continue
             colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
             if first["budget"]:
@@ -344,12 +322,13 @@ def figure_error_vs_time(rows, args, out):
                     label=f"{first['hierarchy']}: {series_label(first)}", **layered(i))
             annotate_work(ax, agg["time"], 100 * (agg["fp"] + agg["fn"]), agg["bv"], colour)
         labels = []
-        for hierarchy, points in curves.items():
+        for (hierarchy, name), points in curves.items():
             points.sort(key=lambda p: p[0])
             colour, line, marker = style_for(hierarchy, args.operating_strategy, hierarchies, strategies)
             xs = [p[1]["time"] for p in points]
             ys = [100 * (p[1]["fp"] + p[1]["fn"]) for p in points]
-            ax.plot(xs, ys, "-", marker="^", color=colour, label=f"{hierarchy}: {args.operating_strategy} over p_min")
+            plain = name == args.operating_strategy  # variants (confirm_levels=...) of the same hierarchy: dashed
+            ax.plot(xs, ys, "-" if plain else "--", marker="^", color=colour, label=f"{hierarchy}: {name} over p_min")
             labels += [(x, y, f"{p:g}" + (f" · {a['bv']:.0f}" if math.isfinite(a["bv"]) else ""), hierarchy)
                        for (p, a), x, y in zip(points, xs, ys)]
         log_axis(ax, "x")
@@ -545,10 +524,6 @@ def add_options(parser):
     parser.add_argument("--quality-min", type=float, default=-1e300)
     parser.add_argument("--quality-max", type=float, default=1e300)
     parser.add_argument("--quality-text", default="the quality distances")
-    parser.add_argument("--check-pmin-curves", action="store_true",
-                        help="draw nothing: list where a p_min curve's time moves against its BV tests (exit 1)")
-    parser.add_argument("--tolerance", type=float, default=0.0,
-                        help="with --check-pmin-curves: a move against the work counts beyond this share of the time")
     parser.add_argument("--band", action="append", default=[],
                         help="MESH=TEXT: the summary band of one mesh pair, for figure 3's title")
     parser.add_argument("--distance-label", default=DEFAULT_DISTANCE_LABEL)
@@ -558,13 +533,6 @@ def add_options(parser):
 
 
 def draw(args, rows, calibration):
-    if args.check_pmin_curves:
-        breaks = pmin_curve_breaks(rows, args.tolerance)
-        for mesh, hierarchy, label, p, q, change in breaks:
-            print(f"{mesh} {hierarchy} {label}: p_min {p:g} -> {q:g}: time {100 * change:+.1f}% against its BV tests")
-        print(f"{len(breaks)} break(s) of figure 3's p_min curves against their work (tolerance "
-              f"{100 * args.tolerance:g}% of the time)")
-        sys.exit(1 if breaks else 0)
     figure_time_vs_distance(rows, args, os.path.join(args.report_dir, "fig1_time_vs_distance.png"))
     figure_errors_vs_distance(rows, args, os.path.join(args.report_dir, "fig2_errors_vs_distance.png"))
     figure_error_vs_time(rows, args, os.path.join(args.report_dir, "fig3_error_vs_time.png"))

@@ -398,6 +398,37 @@ void readme_figures(std::ostream& md, bool figures_ok, const std::string& plot_e
     md << "![" << f.caption << "](" << f.file << ")\n\n*" << f.caption << "*\n\n";
 }
 
+/// Whether figure 3's p_min curves follow their work, step by step, over each pair's band.
+void readme_curves(std::ostream& md, const RunOutput& run) {
+  const std::vector<CurveStep> steps = pmin_curve_steps(summarize_band(run.rows));
+  if (steps.empty()) return;
+  std::set<std::string> curves;
+  std::size_t same = 0;
+  std::vector<const CurveStep*> against;
+  for (const CurveStep& s : steps) {
+    curves.insert(s.mesh + '\x1f' + s.hierarchy + '\x1f' + s.curve);
+    same += s.same_work;
+    if (s.against_work) against.push_back(&s);
+  }
+  md << "**Figure 3's p_min curves against their work** (over each pair's band): " << steps.size()
+     << (steps.size() == 1 ? " step" : " steps") << " between neighbouring p_min on " << curves.size()
+     << (curves.size() == 1 ? " curve; " : " curves; ") << same
+     << " of them same work. A step goes against its work when the BV tests per query change by more than "
+        "1% and the time's 95% interval lies wholly on the other side of 1: ";
+  if (against.empty()) {
+    md << "none does.\n\n";
+    return;
+  }
+  md << against.size() << " do:\n\n";
+  for (const CurveStep* s : against)
+    md << "- " << table_cell(s->mesh) << ", " << s->hierarchy << " " << s->curve << ": p_min "
+       << p_min_text(s->p_min) << " → " << p_min_text(s->next_p_min) << ", BV tests " << count(s->bv_tests)
+       << " → " << count(s->next_bv_tests) << ", time ×" << fmt("%.3f", s->time_ratio.value)
+       << " (95% interval " << fmt("%.3f", s->time_ratio.lo) << "–" << fmt("%.3f", s->time_ratio.hi)
+       << ")\n";
+  md << "\n";
+}
+
 /// Each pair's summary band, one line each.
 void readme_bands(std::ostream& md, const std::vector<SummaryBand>& bands) {
   for (const SummaryBand& b : bands) {
@@ -614,6 +645,7 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
   readme_header(md, run);
   readme_operating_point(md, run, bands);
   readme_figures(md, figures_ok, plot_error);
+  readme_curves(md, run);
   readme_summary(md, run, bands);
   readme_front(md, run, bands);
 

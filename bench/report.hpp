@@ -44,6 +44,21 @@ Interval time_ratio(const SeriesSummary& slow, const SeriesSummary& fast);
 /// the speed-up (or slow-down) with its interval. `bold` marks the verdict for Markdown.
 std::string speedup_text(const Interval& ratio, bool same_work, bool bold = true);
 
+/// One step of a p_min curve (figure 3): a series at two neighbouring p_min, everything else equal, over the
+/// pairs' bands. The curve should follow its work: where the BV tests per query change by more than 1%, the
+/// time may not move measurably the other way (its ratio's 95% interval entirely on the other side of 1).
+struct CurveStep {
+  std::string mesh, hierarchy, curve;  ///< curve: the series' label without its p_min
+  double p_min = 0, next_p_min = 0;
+  double bv_tests = 0, next_bv_tests = 0;  ///< per query
+  Interval time_ratio;                     ///< next p_min's time over this one's
+  bool same_work = false;                  ///< BV tests, triangle tests and estimates within 1%
+  bool against_work = false;               ///< the time moved measurably against the BV tests
+};
+/// Every step of every p_min curve among `series` (one curve per mesh, hierarchy, and label without its
+/// p_min, of two p_min or more), in the order the curves first appear, by rising p_min.
+std::vector<CurveStep> pmin_curve_steps(const std::vector<SeriesSummary>& series);
+
 /// The error/time front of one mesh pair over the quality range: the fastest exact series, and the fastest
 /// inexact series whose wrong answers (FP + FN) are at most `max_error`. The yardstick: the second
 /// at least 3x faster than the first.

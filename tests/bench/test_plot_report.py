@@ -136,33 +136,12 @@ class CalibratedSeries(unittest.TestCase):
         plt.close(fig)
 
 
-def curve_row(p_min, time, bv_tests, in_band="1", distance="1.2"):
-    row = result_row(p_min)
-    row.update({"mean_time_us": str(time), "bv_tests_per_query": str(bv_tests), "in_summary": in_band,
-                "distance": distance})
-    return row
-
-
 class PminCurves(unittest.TestCase):
-    def test_a_curve_that_follows_its_work_has_no_break(self):
-        rows = [curve_row("0.5", 1.0, 4), curve_row("0.9", 2.0, 10), curve_row("0.99", 3.0, 20)]
-        self.assertEqual(plot_report.pmin_curve_breaks(rows), [])
-
-    def test_time_falling_while_the_work_rises_is_a_break(self):
-        rows = [curve_row("0.8", 2.1, 8.1), curve_row("0.9", 1.2, 12.4)]
-        breaks = plot_report.pmin_curve_breaks(rows)
-        self.assertEqual([b[:5] for b in breaks], [("m", "aabb", "adb", 0.8, 0.9)])
-        self.assertAlmostEqual(breaks[0][5], 1.2 / 2.1 - 1)
-
-    def test_a_step_back_within_the_tolerance_is_not_a_break(self):
-        rows = [curve_row("0.5", 0.2546, 1.25), curve_row("0.8", 0.2422, 1.71)]  # 5 ns at a quarter µs
-        self.assertEqual(len(plot_report.pmin_curve_breaks(rows)), 1)
-        self.assertEqual(plot_report.pmin_curve_breaks(rows, tolerance=0.05), [])
-
-    def test_only_the_rows_inside_the_band_count(self):
-        rows = [curve_row("0.8", 1.0, 8), curve_row("0.9", 2.0, 12),
-                curve_row("0.8", 50.0, 8, in_band="0", distance="0.4")]  # a slow row outside the band
-        self.assertEqual(plot_report.pmin_curve_breaks(rows), [])
+    def test_a_variant_of_the_same_hierarchy_is_a_curve_of_its_own(self):
+        plain, confirming = result_row("0.9"), result_row("0.9")
+        confirming["label"] = "adb p_min=0.9 confirm_levels=1"
+        self.assertEqual(plot_report.curve_name(plain), "adb")
+        self.assertEqual(plot_report.curve_name(confirming), "adb confirm_levels=1")
 
 
 class Script(ReportScriptChecks, unittest.TestCase):

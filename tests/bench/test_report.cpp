@@ -218,6 +218,45 @@ TEST(ErrorTimeFront, FastestExactAgainstFastestInexactWithinTheErrorBound) {
   EXPECT_EQ(front[1].speedup, 0.0);
 }
 
+/// A point of a p_min curve on mesh "m", hierarchy "aabb": 200 poses, each `us` within ±20%, in a pattern
+/// that `phase` shifts (so that two points' per-pose ratios vary as measured ones do).
+SeriesSummary curve_point(const std::string& label, double p_min, double bv_tests, double us, int phase) {
+  SeriesSummary s;
+  s.mesh = "m";
+  s.hierarchy = "aabb";
+  s.strategy = "adb";
+  s.label = label;
+  s.exact_strategy = false;
+  s.p_min = p_min;
+  s.bv_tests_per_query = s.estimates_per_query = bv_tests;
+  for (int k = 0; k < 200; ++k) s.pose_times_us.push_back(us * (1 + 0.2 * ((k * 7 + phase) % 5 - 2) / 2));
+  s.mean_time_us = us;
+  return s;
+}
+
+TEST(PminCurves, AStepGoesAgainstItsWorkOnlyWhenItsIntervalSaysSo) {
+  const std::vector<SeriesSummary> series = {
+      curve_point("adb p_min=0.5", 0.5, 4, 1.0, 0),
+      curve_point("adb p_min=0.8", 0.8, 8.1, 2.1, 1),
+      curve_point("adb p_min=0.9", 0.9, 12.4, 1.2, 2),     // more work, measurably less time: against
+      curve_point("adb p_min=0.95", 0.95, 12.45, 3.0, 3),  // same work (within 1%): no direction
+      curve_point("adb p_min=0.99", 0.99, 20, 2.98, 4),    // more work, less time within the noise
+      curve_point("adb p_min=0.9 confirm_levels=1", 0.9, 30, 0.5, 0)};  // a curve of its own
+  const std::vector<CurveStep> steps = pmin_curve_steps(series);
+  ASSERT_EQ(steps.size(), 4u);
+  for (const CurveStep& s : steps) EXPECT_EQ(s.curve, "adb");
+  EXPECT_FALSE(steps[0].against_work);
+  EXPECT_TRUE(steps[1].against_work);
+  EXPECT_DOUBLE_EQ(steps[1].p_min, 0.8);
+  EXPECT_NEAR(steps[1].time_ratio.value, 1.2 / 2.1, 1e-9);
+  EXPECT_LT(steps[1].time_ratio.hi, 1);
+  EXPECT_TRUE(steps[2].same_work);
+  EXPECT_FALSE(steps[2].against_work);
+  EXPECT_FALSE(steps[3].against_work);
+  EXPECT_TRUE(steps[3].time_ratio.contains(1));
+  EXPECT_TRUE(pmin_curve_steps({series.back()}).empty());
+}
+
 /// One decile of a series on mesh "m", hierarchy "aabb", strategy "adb".
 CalibrationBin decile(double p_min, int bin, std::size_t count, double reported, double observed) {
   CalibrationBin b{"m", "aabb", "adb", "", p_min};
