@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <numeric>
 #include <thread>
 
 namespace bvhlab {
@@ -261,12 +262,12 @@ void Measurement::cross_check(const PreparedPair& pair, const Truth& truth) {
 }
 
 // Every hierarchy and strategy on the same poses, in `repeats` passes over the whole workload. Within a
-// pass the poses run in blocks, each block through every series in turn, so a slow spell of a shared machine
-// (another process, frequency changes) spreads over all series instead of landing on one, and within a block
-// the caches stay warm. A pose comes back only a whole pass later: its samples are far apart in time, so a
-// slow spell shorter than a pass spoils at most one of them, and the branch predictor cannot learn the pose.
-// Each (series, pose) keeps the query of its representative sample (the median or the minimum of its
-// passes): its time and its answer come from the same query.
+// pass the poses run in blocks, each block through every series in turn (in a new order each block), so a
+// slow spell of a shared machine (another process, frequency changes) spreads over all series
+// instead of landing on one, and within a block the caches stay warm. A pose comes back only a whole pass
+// later: its samples are far apart in time, so a slow spell shorter than a pass spoils at most one of them,
+// and the branch predictor cannot learn the pose. Each (series, pose) keeps the query of its representative
+// sample (the median or the minimum of its passes): its time and its answer come from the same query.
 std::vector<PairRecords> Measurement::time_workload(const std::vector<PreparedPair>& pairs) {
   const std::size_t repeats = static_cast<std::size_t>(std::max(1, scene_.timing.repeats));
   const std::size_t groups = scene_.workload.groups.size();
@@ -305,20 +306,27 @@ void Measurement::time_pass(const PreparedPair& pair, std::size_t g,
                             std::vector<std::vector<QueryRecord>>& series) {
   const PoseGroup& group = scene_.workload.groups[g];
   const auto& planned = plan_.hierarchies;
+  std::vector<std::pair<std::size_t, std::size_t>> flat;  // (hierarchy, variant) by flat series index
+  for (std::size_t i = 0; i < planned.size(); ++i)
+    for (std::size_t v = 0; v < planned[i].variants.size(); ++v) flat.emplace_back(i, v);
+  series.resize(flat.size());
+  std::vector<std::size_t> order(flat.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
   const std::span<const RigidTransform> poses(group.poses);
   std::vector<QueryRecord> block_records;
   for (std::size_t begin = 0; begin < poses.size(); begin += kPoseBlock) {
     const auto block = poses.subspan(begin, std::min(kPoseBlock, poses.size() - begin));
-    std::size_t s = 0;
-    for (std::size_t i = 0; i < planned.size(); ++i)
-      for (std::size_t v = 0; v < planned[i].variants.size(); ++v, ++s) {
-        if (series.size() <= s) series.emplace_back();
-        pair.hierarchies[i]->run(planned[i].variants[v], block, warmup_, block_records);
-        series[s].insert(series[s].end(), block_records.begin(), block_records.end());
-      }
+    // Each block runs the series in a new order (seeded: a run repeats its orders), so no series always
+    // follows the same one and finds the caches as that neighbour left them.
+    std::shuffle(order.begin(), order.end(), block_order_);
+    for (const std::size_t s : order) {
+      const auto [i, v] = flat[s];
+      pair.hierarchies[i]->run(planned[i].variants[v], block, warmup_, block_records);
+      series[s].insert(series[s].end(), block_records.begin(), block_records.end());
+    }
     char distance[16];
     std::snprintf(distance, sizeof distance, "%g", group.distance);
-    progress_.advance(s * block.size(), pair.label + " d=" + distance);
+    progress_.advance(flat.size() * block.size(), pair.label + " d=" + distance);
   }
 }
 

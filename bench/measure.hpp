@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <random>
 #include <span>
 #include <string>
 #include <vector>
@@ -167,6 +168,7 @@ class Measurement {
   KeyedFileCache calibration_cache_;  ///< payload: CalibrationMap::encode
   Progress progress_;
   Disturbance disturbance_;
+  std::mt19937_64 block_order_{1};  ///< shuffles the series' order in each block (fixed seed)
 };
 
 }  // namespace bvhlab
