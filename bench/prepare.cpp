@@ -286,10 +286,14 @@ class TreeStore {
 
 namespace {
 
-/// The object's mesh, normalised (if asked), scaled and placed; `units` receives the normalisation.
-Mesh load_scene_mesh(const SceneObject& object, TreeUnits& units) {
+/// The object's mesh, normalised (if asked), scaled and placed; `units` receives the normalisation and
+/// `warnings` (if given) the loader's warnings.
+Mesh load_scene_mesh(const SceneObject& object, TreeUnits& units,
+                     std::vector<std::string>* warnings = nullptr) {
   if (object.path.empty()) throw MeshError(object.mesh + ": mesh not found");
-  Mesh mesh = load_mesh(object.path).mesh;
+  LoadedMesh loaded = load_mesh(object.path);
+  if (warnings) *warnings = std::move(loaded.report.warnings);
+  Mesh mesh = std::move(loaded.mesh);
   units = object.normalize ? normalize_mesh(mesh) : TreeUnits{};
   for (Vec3& v : mesh.vertices) v = object.placement.apply(v * object.scale);
   return mesh;
@@ -313,7 +317,7 @@ Mesh load_scene_object(const SceneObject& object) {
 ObjectData load_object(const SceneObject& spec) {
   ObjectData out;
   out.spec = &spec;
-  out.mesh = load_scene_mesh(spec, out.units);
+  out.mesh = load_scene_mesh(spec, out.units, &out.warnings);
   const RigidTransform& p = spec.placement;
   std::string key = "mesh=" + ContentHash::to_hex(hash_file(spec.path)) +
                     "|normalize=" + (spec.normalize ? "1" : "0") + "|scale=" + g17(spec.scale) +
@@ -341,6 +345,7 @@ const ObjectData& Preparation::object(const SceneObject& spec) {
     const auto start = Clock::now();
     it = objects_.emplace(spec.name, load_object(spec)).first;
     if (it->second.units.normalized) log_(spec.name + ": " + it->second.units.describe());
+    for (const std::string& warning : it->second.warnings) log_(spec.name + ": warning: " + warning);
     ++stats_.meshes_loaded;
     stats_.preprocess_seconds += seconds_since(start);
   }

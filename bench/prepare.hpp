@@ -40,6 +40,7 @@ struct ObjectData {
   Mesh mesh;
   TreeUnits units;  ///< the normalisation applied to the file's coordinates, if any (saved with its trees)
   std::string key;  ///< mesh checksum and every transform applied to it
+  std::vector<std::string> warnings;  ///< the loader's (bvh/mesh_io.hpp, MeshReport::warnings)
 };
 /// Loads the object's mesh and computes its key. Throws MeshError.
 ObjectData load_object(const SceneObject& spec);

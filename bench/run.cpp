@@ -237,6 +237,9 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
   const ObjectData object_a = load_object(a);
   const ObjectData object_b = &a == &b ? ObjectData{} : load_object(b);
   const ObjectData& ob = &a == &b ? object_a : object_b;
+  for (const ObjectData* object : {&object_a, &object_b})
+    for (const std::string& warning : object->warnings)
+      outcome.warnings.push_back(object->spec->name + ": " + warning);
   const PlannedHierarchy planned{
       &scene.hierarchies.front(),
       scene.needs_density(scene.hierarchies.front()) ? scene.density : DensitySpec{},

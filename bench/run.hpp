@@ -190,6 +190,8 @@ struct QueryOutcome {
   RunStats stats;
   /// Where the strategy is not the right tool for these objects: what to use instead, and why.
   std::vector<std::string> advice;
+  /// The mesh loader's warnings, each after its object's name ("gear: coordinates are far ...").
+  std::vector<std::string> warnings;
 };
 /// Throws std::invalid_argument for an empty list of poses or a strategy that cannot run on the trees.
 QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRequest& request,

@@ -49,6 +49,7 @@ void refuse_unqueryable(const std::string& density) {
 }
 
 int build_command(const BuildArgs& args) {
+  check_output_file("--output", args.output);
   const std::string density_name = args.adb ? "adb" : args.density;
   args.parameters.refuse_others({&density_info(density_name).parameters}, "density " + density_name);
   refuse_unqueryable(density_name);

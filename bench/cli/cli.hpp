@@ -16,6 +16,10 @@
 
 namespace bvhlab::cli {
 
+/// Exit statuses (the help's footer lists them all): 1 for a failure, 2 for a bad command line.
+inline constexpr int kFailed = 1;
+inline constexpr int kBadCommandLine = 2;
+
 /// A subcommand: its node in the app, and the work to do when it is the one given, returning the exit
 /// status. The work throws CLI::Error for bad arguments (main reports it as CLI11 does a parse error) and
 /// std::exception for anything else.
@@ -42,6 +46,12 @@ std::filesystem::path mesh_cache_dir();
 std::filesystem::path resolve_mesh_argument(const std::string& argument);
 /// The scene object a mesh argument names, in its file's units or normalised by the protocol.
 SceneObject object_for(const std::string& argument, bool normalize);
+/// Refuses an output file before any work: its folder missing or not writable, or the path a folder.
+/// Throws CLI::ValidationError naming `option`.
+void check_output_file(const std::string& option, const std::filesystem::path& file);
+/// Makes an output folder (and its parents) before any work; throws CLI::ValidationError naming `option` when
+/// it cannot be made or written, or names a file.
+void make_output_dir(const std::string& option, const std::filesystem::path& dir);
 /// The runner's options: the cache at `cache` (default below the build folder) or none, quiet or not.
 RunOptions run_options(const std::string& cache, bool no_cache, bool quiet);
 

@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include <unistd.h>
+
 namespace bvhlab::cli {
 
 namespace fs = std::filesystem;
@@ -26,6 +28,29 @@ fs::path default_cache_dir() {
 }
 
 }  // namespace
+
+void check_output_file(const std::string& option, const fs::path& file) {
+  std::error_code error;
+  if (fs::is_directory(file, error))
+    throw CLI::ValidationError(option, file.string() + " is a folder, not a file");
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  if (!fs::is_directory(folder, error))
+    throw CLI::ValidationError(
+        option, "cannot write " + file.string() + ": folder " + folder.string() + " does not exist");
+  if (::access(folder.c_str(), W_OK) != 0)
+    throw CLI::ValidationError(
+        option, "cannot write " + file.string() + ": folder " + folder.string() + " is not writable");
+}
+
+void make_output_dir(const std::string& option, const fs::path& dir) {
+  std::error_code error;
+  fs::create_directories(dir, error);
+  if (error || !fs::is_directory(dir))
+    throw CLI::ValidationError(option, "cannot make folder " + dir.string() +
+                                           (error ? ": " + error.message() : ": a file of that name exists"));
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw CLI::ValidationError(option, "folder " + dir.string() + " is not writable");
+}
 
 fs::path mesh_cache_dir() {
   if (const char* env = std::getenv("BVHLAB_MESH_CACHE"); env && *env) return env;

@@ -25,22 +25,28 @@ int main(int argc, char** argv) {
       "files'\n"
       "own units unless --normalize applies the protocol normalisation (centre to the origin, longest side "
       "2).\n"
-      "Run `bvhlab SUBCOMMAND --help` for a subcommand's options.");
+      "Run `bvhlab SUBCOMMAND --help` for a subcommand's options.\n"
+      "Exit status: 0 done; 1 failed (a bad file, scene or value, or the work failed); 2 a bad command line\n"
+      "(unknown or missing option, a value out of range, an output path that cannot be written); run and\n"
+      "report also 3 when the ground truth disagrees with CGAL, report 4 when the figures could not be "
+      "drawn.\n"
+      "Every message starts with \"bvhlab:\".");
   // The order here is the order of the subcommands in the help.
   const std::vector<Command> commands = {
       add_info_command(app), add_build_command(app),  add_query_command(app), add_policies_command(app),
       add_run_command(app),  add_report_command(app), add_demo_command(app)};
 
-  CLI11_PARSE(app, argc, argv);
-
   try {
+    app.parse(argc, argv);
     for (const Command& command : commands)
       if (*command.app) return command.run();
   } catch (const CLI::Error& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help: the help on stdout
+    std::fprintf(stderr, "bvhlab: %s\nRun with --help for more information.\n", e.what());
+    return kBadCommandLine;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bvhlab: %s\n", e.what());
-    return 1;
+    return kFailed;
   }
   return 0;
 }

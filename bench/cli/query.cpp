@@ -226,6 +226,8 @@ QueryRun execute_query(const QueryArgs& args, bool trees, const QueryRequest& re
     const bool same = a.path == b_separate.path;
     const RunOptions options = run_options(args.cache, args.no_cache, true);
     out.outcome = run_query(a, same ? a : b_separate, request, poses, options);
+    for (const std::string& warning : out.outcome.warnings)
+      std::fprintf(stderr, "bvhlab: warning: %s\n", warning.c_str());
     for (const std::string& advice : out.outcome.advice)
       std::fprintf(stderr, "bvhlab: note: %s\n", advice.c_str());
     out.name_a = a.name;

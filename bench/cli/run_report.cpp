@@ -142,6 +142,7 @@ int run_command(const SceneArgs& args) {
   const Scene scene = load_scene(args.scene_file);
   check_per_pose_applies(scene, options);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / scene.name : fs::path(args.out_dir);
+  make_output_dir("--output", dir);
   if (scene.world) return run_world_scene(scene, options, dir, false, args.quiet);
   if (scene.deform) return run_deform_scene(scene, options, dir, false, args.quiet);
   if (scene.points) return run_points_scene(scene, dir, false, args.quiet);
@@ -198,7 +199,9 @@ int report_command(const SceneArgs& args) {
   job.scene = load_scene(args.scene_file);
   check_per_pose_applies(job.scene, job.options);
   job.dir = args.out_dir;
+  make_output_dir("--output", job.dir);
   job.snippet_file = args.snippet_file;
+  if (!job.snippet_file.empty()) check_output_file("--snippet", job.snippet_file);
   job.figures = !args.no_figures;
   job.quiet = args.quiet;
   return run_report(job);
@@ -208,13 +211,15 @@ int demo_command(const DemoArgs& args) {
   ReportJob job;
   job.start = Clock::now();
   job.scene = load_scene(args.scene);
+  job.dir = fs::path(args.build_dir) / "report" / job.scene.name;
+  make_output_dir("--build-dir", job.dir);
+  job.snippet_file = args.snippet_file;
+  if (!job.snippet_file.empty()) check_output_file("--snippet", job.snippet_file);
   if (!args.no_fetch) {
     fetch_missing_meshes(job.scene);
     job.scene = load_scene(args.scene);  // resolve what was fetched
   }
   job.options = run_options((fs::path(args.build_dir) / "cache").string(), false, false);
-  job.dir = fs::path(args.build_dir) / "report" / job.scene.name;
-  job.snippet_file = args.snippet_file;
   return run_report(job);
 }
 

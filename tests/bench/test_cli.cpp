@@ -23,12 +23,12 @@ struct Outcome {
   std::string out, err;
 };
 
-/// An axis-aligned cube of side `side` centred at the origin, as an OBJ file.
-void write_cube(const std::filesystem::path& file, double side) {
+/// An axis-aligned cube of side `side` centred at (x, 0, 0), as an OBJ file.
+void write_cube(const std::filesystem::path& file, double side, double x = 0) {
   const double h = side / 2;
   std::string text;
   for (int k = 0; k < 8; ++k)
-    text += "v " + std::to_string(k & 1 ? h : -h) + " " + std::to_string(k & 2 ? h : -h) + " " +
+    text += "v " + std::to_string(x + (k & 1 ? h : -h)) + " " + std::to_string(k & 2 ? h : -h) + " " +
             std::to_string(k & 4 ? h : -h) + "\n";
   text +=
       "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\nf 2 4 6\n"
@@ -52,12 +52,15 @@ class Cli : public ::testing::Test {
     return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, testing::read_text(dir / "out.txt"),
             testing::read_text(dir / "err.txt")};
   }
-  /// Runs and expects a refusal (a non-zero status) whose message contains `fragment`, and no output.
-  void expect_refused(const std::string& args, const std::string& fragment) const {
+  /// Runs and expects a refusal whose message contains `fragment`, and no output: status 1 (a failure) or 2
+  /// (a bad command line), and every line of the message that is not a hint prefixed "bvhlab:".
+  Outcome expect_refused(const std::string& args, const std::string& fragment) const {
     const Outcome o = run(args);
-    EXPECT_NE(o.status, 0) << args << "\n" << o.out;
+    EXPECT_TRUE(o.status == 1 || o.status == 2) << args << "\nstatus " << o.status << "\n" << o.out;
     EXPECT_NE(o.err.find(fragment), std::string::npos) << args << "\nstderr: " << o.err;
+    EXPECT_EQ(o.err.rfind("bvhlab: ", 0), 0u) << args << "\nstderr: " << o.err;
     EXPECT_EQ(o.out, "") << args;
+    return o;
   }
   /// Runs and expects success.
   Outcome ok(const std::string& args) const {
@@ -395,6 +398,50 @@ TEST_F(Cli, PosesOfPerPoseOutputQueryBackToTheSameAnswers) {
       EXPECT_EQ(j["results"][k]["bv_tests"], std::stoull(row[col("bv_tests")])) << label << " " << k;
     }
   }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Exit statuses, output paths, warnings
+
+// The loader warns about coordinates far from the origin (precision lost in reading); `query` on the same
+// file says so as `info` does.
+TEST_F(Cli, TheLoadersWarningsReachQueryAsTheyReachInfo) {
+  write_cube(dir / "far.obj", 4, 1e7);  // |x| / diagonal = 1.4e6: past the limit of a float or double reader
+  const Outcome info = ok("info far.obj");
+  ASSERT_NE(info.out.find("far from the origin"), std::string::npos) << info.out;
+  const Outcome query = ok("query far.obj far.obj --pose 0,0,0");
+  EXPECT_NE(query.err.find("bvhlab: warning: far: coordinates are far from the origin"), std::string::npos)
+      << query.err;
+  EXPECT_EQ(ok("query big.obj small.obj --pose 0,0,0").err.find("warning"), std::string::npos);
+}
+
+// A bad command line exits 2 with the prefix, as every other refusal has it; a failure in the work exits 1.
+TEST_F(Cli, ABadCommandLineExitsTwoAndAFailureOneBothWithThePrefix) {
+  EXPECT_EQ(expect_refused("query big.obj small.obj --no-such-option", "--no-such-option").status, 2);
+  EXPECT_EQ(expect_refused("query big.obj", "required").status, 2);
+  EXPECT_EQ(expect_refused("build big.obj --leaf 0 -o x.tree", "--leaf").status, 2);
+  EXPECT_EQ(expect_refused("info missing.obj", "missing.obj").status, 1);
+  const Outcome help = ok("query --help");
+  EXPECT_NE(help.out.find("--pose"), std::string::npos) << help.out;
+}
+
+// An output path that cannot be written is refused before any tree is built or any scene runs.
+TEST_F(Cli, OutputPathsAreCheckedBeforeAnyWork) {
+  const Outcome build = expect_refused("build big.obj --adb -o missing/x.tree", "does not exist");
+  EXPECT_EQ(build.status, 2);
+  EXPECT_EQ(build.err.find("building"), std::string::npos) << build.err;
+  EXPECT_EQ(build.err.find("annotating"), std::string::npos) << build.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "missing"));
+  expect_refused("build big.obj -o .", "is a folder");
+  testing::write_text(dir / "scene.json",
+                      R"({"objects": [{"mesh": "big.obj"}], "hierarchies": [{"bv": "aabb"}],
+      "strategies": [{"type": "exact"}], "workload": {"type": "protocol", "distances": [1.2], "steps": 10}})");
+  testing::write_text(dir / "taken", "a file where the report folder should go");
+  const Outcome report =
+      expect_refused("report scene.json -o taken/report --no-figures", "cannot make folder");
+  EXPECT_EQ(report.err.find("building"), std::string::npos) << report.err;
+  expect_refused("report scene.json -o report --no-figures --snippet missing/snippet.md", "does not exist");
+  EXPECT_FALSE(std::filesystem::exists(dir / "report" / "results.csv"));
 }
 
 }  // namespace
