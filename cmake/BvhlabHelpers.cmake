@@ -14,10 +14,15 @@ endif()
 # In the build, the source tree's root is the include root: #include "volumes/aabb.hpp". Installed, the
 # headers sit under include/bvhlab and users write #include <bvhlab/volumes/aabb.hpp>, which cannot clash
 # with another project's volumes/ or adb/; the library's headers include each other by relative paths
-# ("../bvh/bvh.hpp"), which hold in both layouts.
+# ("../bvh/bvh.hpp"), which hold in both layouts. The build offers the installed spelling too (through
+# <build>/include/bvhlab, a link to the source tree), so code written against the package, such as the
+# shipped example, compiles unchanged in the build and against an install.
+file(MAKE_DIRECTORY "${PROJECT_BINARY_DIR}/include")
+file(CREATE_LINK "${PROJECT_SOURCE_DIR}" "${PROJECT_BINARY_DIR}/include/bvhlab" SYMBOLIC)
 function(bvhlab_folder_includes target scope)
   target_include_directories(${target} ${scope}
     $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+    $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/include>
     $<INSTALL_INTERFACE:include>)
 endfunction()
 

@@ -17,3 +17,8 @@ configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/bvhlabConfig.cmake.in
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/bvhlabConfigVersion.cmake COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/bvhlabConfig.cmake ${PROJECT_BINARY_DIR}/bvhlabConfigVersion.cmake
   DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bvhlab)
+# The command line beside the libraries (it reads the bundled meshes and its cache below this build's
+# source and build folders).
+if(TARGET bvhlab_cli)
+  install(TARGETS bvhlab_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()

@@ -4,10 +4,12 @@
 //   build/release/bench/examples/example_collide MESH_A MESH_B TX TY TZ [P_MIN]
 //
 // B is moved by the translation (TX, TY, TZ) into A's frame; P_MIN (default 0.9) is ADB's stopping rule.
-#include "adb/adb_density.hpp"
-#include "bvh/mesh_io.hpp"
-#include "traversal/strategies.hpp"
-#include "volumes/aabb.hpp"
+// Written against the installed package (cmake --install; find_package(bvhlab)): the headers take the
+// bvhlab/ prefix. The build offers the same spelling, so this file compiles unchanged in both.
+#include <bvhlab/adb/adb_density.hpp>
+#include <bvhlab/bvh/mesh_io.hpp>
+#include <bvhlab/traversal/strategies.hpp>
+#include <bvhlab/volumes/aabb.hpp>
 
 #include <cmath>
 #include <cstdio>
