@@ -48,20 +48,22 @@ std::vector<RigidTransform> poses_from(const py::object& poses, const py::object
   return out;
 }
 
-/// One pose: a 4 x 4 matrix, or a rotation (default: identity) and a translation (default: zero).
+/// One pose: a 4 x 4 matrix, or a translation and a rotation (default: identity). None at all is refused, as
+/// the CLI refuses a query without --pose: an identity no one asked for answers a question no one asked.
 RigidTransform pose_from(const py::object& pose, const py::object& rotation, const py::object& translation) {
   if (!pose.is_none()) {
     if (!rotation.is_none() || !translation.is_none())
       throw py::value_error("give pose, or rotation and translation, not both");
     return rigid_from_matrix(real_array(pose, "pose", {4, 4}, "(4, 4)").data(), "pose");
   }
-  const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[3] = {0, 0, 0};
+  if (translation.is_none())
+    throw py::value_error(
+        "give a pose (4, 4), or a translation (3,) and a rotation (3, 3; default identity)");
+  const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   const auto r = rotation.is_none() ? py::array_t<double, py::array::c_style>()
                                     : real_array(rotation, "rotation", {3, 3}, "(3, 3)");
-  const auto t = translation.is_none() ? py::array_t<double, py::array::c_style>()
-                                       : real_array(translation, "translation", {3}, "(3,)");
-  return rigid_from_parts(rotation.is_none() ? identity : r.data(), translation.is_none() ? zero : t.data(),
-                          "pose");
+  const auto t = real_array(translation, "translation", {3}, "(3,)");
+  return rigid_from_parts(rotation.is_none() ? identity : r.data(), t.data(), "pose");
 }
 
 struct QueryResult {
@@ -205,8 +207,8 @@ void bind_queries(py::module_& m) {
         py::arg("rotation") = py::none(), py::arg("translation") = py::none(), py::arg("strategy") = "exact",
         py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0,
         (std::string(
-             "One query between trees a and b at one pose: a 4 x 4 rigid matrix, or rotation (3 x 3) and "
-             "translation (3).") +
+             "One query between trees a and b at one pose: a 4 x 4 rigid matrix, or translation (3) and "
+             "rotation (3 x 3, default identity); a query without either is refused.") +
          strategy_help)
             .c_str());
   m.def("query_batch", &query_batch, py::arg("a"), py::arg("b"), py::arg("poses") = py::none(), py::kw_only(),

@@ -110,13 +110,21 @@ def test_non_rigid_or_malformed_poses(trees, pose, error, message):
 def test_bad_rotation_and_translation(trees):
     t = trees["plain"]
     with pytest.raises(ValueError, match="rotation is a reflection"):
-        bvhlab.query(t, t, rotation=-np.eye(3))
+        bvhlab.query(t, t, rotation=-np.eye(3), translation=[0, 0, 0])
     with pytest.raises(ValueError, match=r"translation: expected shape \(3,\)"):
         bvhlab.query(t, t, translation=[1, 2])
     with pytest.raises(ValueError, match="translation has a NaN"):
         bvhlab.query(t, t, translation=[np.nan, 0, 0])
     with pytest.raises(ValueError, match="not both"):
         bvhlab.query(t, t, np.eye(4), translation=[1, 0, 0])
+
+
+def test_a_query_without_a_pose_is_refused(trees):
+    t = trees["plain"]
+    for kwargs in ({}, {"rotation": np.eye(3)}):
+        with pytest.raises(ValueError, match=r"give a pose \(4, 4\), or a translation"):
+            bvhlab.query(t, t, **kwargs)
+    assert bvhlab.query(t, t, translation=[0, 0, 0]).collides  # the identity, when asked for
 
 
 def test_bad_batches(trees):
