@@ -381,8 +381,8 @@ class Bvh {
 };
 
 /// A degradation() past which queries on a refitted tree are measurably slower than on a rebuilt one (1.3 to
-/// 3 times on the twisted bunny: README, "Deforming objects: refit", bench_refit --crossover). Whether a
-/// rebuild pays depends on how many queries follow it.
+/// 3 times on the twisted bunny: bvh/README.md, "Deforming objects: refit", bench_refit --crossover). Whether
+/// a rebuild pays depends on how many queries follow it.
 inline constexpr double kRebuildDegradation = 2.0;
 
 }  // namespace bvhlab

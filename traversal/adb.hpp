@@ -14,7 +14,7 @@
 // Without a budget both orders give the same answers: decisions are made as pairs are filed, and the pairs
 // filed before the queue runs empty are the same in any order; only the work until a decision differs.
 //
-// Decisions (see README, "Method"):
+// Decisions (see adb/README.md, "In brief" and section 2):
 //   * Vol(A ∩ B) is bounded from above by re-boxing: A's bounding box ∩ B's box re-boxed in A's frame
 //     (centre R c + t, half-extents |R| h), and the same with the roles swapped; the smaller bound is used.
 //     It still over-estimates the true overlap of a rotated pair, which errs toward "collision" (false

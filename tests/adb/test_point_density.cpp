@@ -86,7 +86,7 @@ TEST(PointDensity, ExactCellAreasAddUpToTheMeshArea) {
   EXPECT_LE(std::accumulate(exact.begin(), exact.end(), 0.0), area * 1.01);
 }
 
-// The error table of README "Point clouds" (printed; the assertions are in the test above).
+// The error table of bvh/README.md "Point clouds" (printed; the assertions are in the test above).
 TEST(PointDensity, ReportsTheErrorAtSeveralDensities) {
   const Mesh mesh = pinion();
   const Box box = mesh.bounds();

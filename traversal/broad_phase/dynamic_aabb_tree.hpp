@@ -10,7 +10,8 @@
 // The leaves and inner nodes hold tight boxes, refitted bottom-up every frame (a pass over the nodes): the
 // pair traversal then tests no more overlaps than the objects' boxes make, where fat node boxes made about
 // twice the leaf pairs in a dense world. Refitting every frame is what a fat tree's skipped updates save,
-// but it costs less than the fat boxes' extra traversal on the scenes measured (the README's table).
+// but it costs less than the fat boxes' extra traversal on the scenes measured (the table in
+// traversal/broad_phase/README.md).
 //
 // Registration builds the tree over the leaves in Morton order. A frame in which more than a quarter of the
 // objects left their fat boxes (reinserting most leaves one by one costs more than building anew) keeps the
