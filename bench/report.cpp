@@ -419,13 +419,12 @@ void readme_curves(std::ostream& md, const RunOutput& run) {
     md << "none does.\n\n";
     return;
   }
-  md << against.size() << " do:\n\n";
+  md << against.size() << (against.size() == 1 ? " does:\n\n" : " do:\n\n");
   for (const CurveStep* s : against)
     md << "- " << table_cell(s->mesh) << ", " << s->hierarchy << " " << s->curve << ": p_min "
        << p_min_text(s->p_min) << " → " << p_min_text(s->next_p_min) << ", BV tests " << count(s->bv_tests)
        << " → " << count(s->next_bv_tests) << ", time ×" << fmt("%.3f", s->time_ratio.value)
-       << " (95% interval " << fmt("%.3f", s->time_ratio.lo) << "–" << fmt("%.3f", s->time_ratio.hi)
-       << ")\n";
+       << " (95% interval " << fmt("%.3f", s->time_ratio.lo) << "–" << fmt("%.3f", s->time_ratio.hi) << ")\n";
   md << "\n";
 }
 
