@@ -212,3 +212,27 @@ def test_batch_releases_the_gil(gear_trees):
     end = time.perf_counter()
     low, high = begin + 0.3 * (end - begin), begin + 0.7 * (end - begin)
     assert any(low < s < high for s in stamps)
+
+
+def test_ctrl_c_interrupts_a_batch_within_half_a_second(gear_trees):
+    """SIGINT (Ctrl-C) in the middle of a batch raises KeyboardInterrupt soon after, not after the batch: the
+    loop hands the signal to Python between chunks of poses. The batch is made long enough (at least 3 s) that
+    an answer after the whole batch would be far too late."""
+    import os
+    import signal
+
+    tree = gear_trees["none"]
+    poses = bvhlab.protocol_poses(0.9, 1000)
+    start = time.perf_counter()
+    bvhlab.query_batch(tree, tree, poses)
+    per_pose = max(time.perf_counter() - start, 1e-6) / len(poses)
+    repeats = min(4000, int(np.ceil(3.0 / per_pose / len(poses))))
+    long_batch = np.tile(poses, (repeats, 1, 1))
+    timer = threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGINT))
+    begin = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        bvhlab.query_batch(tree, tree, long_batch)
+    late = time.perf_counter() - begin - 0.2
+    timer.join()
+    assert late < 0.5, f"KeyboardInterrupt {late:.2f} s after Ctrl-C (a batch of {len(long_batch)} poses)"
