@@ -139,6 +139,7 @@ std::vector<std::string> words(std::string_view line) {
 struct PlyHeader {
   PlyFormat format = PlyFormat::Ascii;
   std::size_t vertices = 0;
+  std::size_t faces = 0;                ///< the face element's count (0: none declared)
   std::vector<PlyProperty> properties;  ///< of the vertex element
   std::size_t body = 0;                 ///< offset of the first body byte
 };
@@ -176,6 +177,11 @@ PlyHeader read_ply_header(std::string_view text, std::string_view name) {
         if (ec != std::errc() || ptr != w[2].data() + w[2].size())
           fail(name, where + "bad vertex count '" + w[2] + "'");
         h.vertices = count;
+      }
+      if (w[1] == "face") {
+        const auto [ptr, ec] = std::from_chars(w[2].data(), w[2].data() + w[2].size(), h.faces);
+        if (ec != std::errc() || ptr != w[2].data() + w[2].size())
+          fail(name, where + "bad face count '" + w[2] + "'");
       }
       in_vertex = !seen_element;
       seen_element = true;
@@ -385,6 +391,22 @@ PointCloud load_point_cloud_from_memory(std::span<const std::byte> bytes, std::s
     fail(name, "unknown point cloud format '" + std::string(format) + "' (expected ply or xyz)");
   validate(cloud);
   return cloud;
+}
+
+bool is_point_cloud_file(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".xyz") return true;
+  if (ext != ".ply") return false;
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');  // a header longer than this is no cloud this function vouches for
+  in.read(head.data(), std::streamsize(head.size()));
+  head.resize(std::size_t(in.gcount()));
+  try {
+    return read_ply_header(head, path.string()).faces == 0;
+  } catch (const PointCloudError&) {
+    return false;  // the mesh loader names the problem
+  }
 }
 
 PointCloud load_point_cloud(const std::filesystem::path& path) {

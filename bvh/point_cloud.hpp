@@ -59,6 +59,10 @@ PointCloud load_point_cloud(const std::filesystem::path& path);
 PointCloud load_point_cloud_from_memory(std::span<const std::byte> bytes, std::string_view format,
                                         std::string_view name = "<memory>");
 
+/// Whether `path` holds a point cloud rather than a mesh: an .xyz file, or a PLY whose header declares no
+/// faces (no face element, or one of 0 faces). Reads only the header; false for any other file and for a PLY
+/// whose header cannot be read in its first 64 KiB (the mesh loader then names the problem).
+bool is_point_cloud_file(const std::filesystem::path& path);
 /// Writes an ascii PLY of the positions (and normals when present).
 void save_point_cloud_ply(const PointCloud& cloud, const std::filesystem::path& path);
 

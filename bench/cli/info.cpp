@@ -2,6 +2,7 @@
 #include "bench/cli/cli.hpp"
 #include "bench/core/content_hash.hpp"
 #include "bvh/mesh_io.hpp"
+#include "bvh/point_cloud.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -76,12 +77,40 @@ void print_mesh_text(const fs::path& path, const LoadedMesh& loaded, const std::
   for (const auto& w : r.warnings) std::printf("  warning         %s\n", w.c_str());
 }
 
+/// A point cloud file (a PLY without faces, XYZ): its points, normals, bounds and checksum.
+void print_cloud(const fs::path& path, const PointCloud& cloud, const std::string& checksum, bool json) {
+  const Box b = cloud.bounds();
+  if (json) {
+    std::cout << nlohmann::json{{"file", path.string()},
+                                {"point_cloud", true},
+                                {"points", cloud.size()},
+                                {"normals", cloud.has_normals()},
+                                {"bounds_min", {b.min.x(), b.min.y(), b.min.z()}},
+                                {"bounds_max", {b.max.x(), b.max.y(), b.max.z()}},
+                                {"checksum", checksum}}
+                     .dump(2)
+              << '\n';
+    return;
+  }
+  std::printf("%s (point cloud)\n  points          %zu\n  normals         %s\n", path.c_str(), cloud.size(),
+              cloud.has_normals() ? "yes" : "no");
+  std::printf("  bounds          [%g, %g] x [%g, %g] x [%g, %g]\n", b.min.x(), b.max.x(), b.min.y(),
+              b.max.y(), b.min.z(), b.max.z());
+  const Vec3 e = b.extent();
+  std::printf("  size            %g x %g x %g\n  checksum        %s\n", e.x(), e.y(), e.z(),
+              checksum.c_str());
+}
+
 int info_command(const InfoArgs& args) {
   if (fs::is_regular_file(args.mesh) && is_saved_tree(args.mesh)) {
     print_saved_tree(args.mesh, args.json);
     return 0;
   }
   const fs::path path = resolve_mesh_argument(args.mesh);
+  if (is_point_cloud_file(path)) {
+    print_cloud(path, load_point_cloud(path), ContentHash::to_hex(hash_file(path)), args.json);
+    return 0;
+  }
   const LoadedMesh loaded = load_mesh(path);
   const std::string checksum = ContentHash::to_hex(hash_file(path));
   if (args.json)
@@ -95,8 +124,13 @@ int info_command(const InfoArgs& args) {
 
 Command add_info_command(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
-  auto* info = app.add_subcommand("info", "Triangles, degenerate triangles, bounds and checksum of a mesh");
-  info->add_option("MESH", args->mesh, "Mesh file or catalog name (or a saved tree: its header)")->required();
+  auto* info = app.add_subcommand(
+      "info", "Triangles, degenerate triangles, bounds and checksum of a mesh (or the points of a cloud)");
+  info->add_option(
+          "MESH", args->mesh,
+          "Mesh file or catalog name, a point cloud (a PLY without faces, XYZ), or a saved tree (its "
+          "header)")
+      ->required();
   info->add_flag("--json", args->json, "Print JSON");
   info->footer("Example: bvhlab info meshes/pinion.off");
   return {info, [args] { return info_command(*args); }};

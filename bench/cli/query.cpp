@@ -4,6 +4,7 @@
 #include "bench/cloud_query.hpp"
 #include "bench/core/protocol.hpp"
 #include "bench/core/registry.hpp"
+#include "bvh/point_cloud.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -347,10 +348,31 @@ void print_text(const QueryRun& run, const QueryRequest& request, bool all_conta
   print_table(run, all_contacts, request.repeat > 0);
 }
 
-int query_command(const QueryArgs& args) {
-  const int sources = int(!args.pose.empty()) + int(!args.protocol.empty()) + int(!args.poses_file.empty());
+/// Without --cloud, a side whose file is a point cloud (a PLY without faces, XYZ) is read as one, as --cloud
+/// would have it, with a note: a cloud is taken as it is given, never refused as a mesh without faces.
+QueryArgs with_detected_clouds(QueryArgs args) {
+  if (!args.cloud.empty()) return args;
+  auto cloud_file = [](const std::string& argument) {
+    return !is_saved_tree_file(argument) && is_point_cloud_file(resolve_mesh_argument(argument));
+  };
+  const bool a = cloud_file(args.a), b = cloud_file(args.b);
+  if (!a && !b) return args;
+  args.cloud = a && b ? "both" : a ? "a" : "b";
+  std::fprintf(stderr, "bvhlab: %s: a point cloud file, queried as with --cloud %s\n",
+               (a && b ? args.a + " and " + args.b
+                : a    ? args.a
+                       : args.b)
+                   .c_str(),
+               args.cloud.c_str());
+  return args;
+}
+
+int query_command(const QueryArgs& given) {
+  const int sources =
+      int(!given.pose.empty()) + int(!given.protocol.empty()) + int(!given.poses_file.empty());
   if (sources != 1)
     throw CLI::ValidationError("query", "give B's pose with one of --pose, --protocol, --poses");
+  const QueryArgs args = with_detected_clouds(given);
   if (!args.cloud.empty()) refuse_cloud_options(args);
   const bool trees = args.cloud.empty() && saved_trees(args);
   const QueryRequest request = query_request(args, trees);

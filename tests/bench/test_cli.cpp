@@ -401,6 +401,45 @@ TEST_F(Cli, PosesOfPerPoseOutputQueryBackToTheSameAnswers) {
 }
 
 // ---------------------------------------------------------------------------------------------------------
+// Point cloud files
+
+/// 150 points on the surface of the cube [-0.5, 0.5]^3 (a 5 x 5 grid on each face), as a PLY without faces.
+void write_cube_points(const std::filesystem::path& file) {
+  std::string body;
+  for (int axis = 0; axis < 3; ++axis)
+    for (double side : {-0.5, 0.5})
+      for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j) {
+          double p[3];
+          p[axis] = side;
+          p[(axis + 1) % 3] = -0.4 + 0.2 * i;
+          p[(axis + 2) % 3] = -0.4 + 0.2 * j;
+          body += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
+        }
+  testing::write_text(file,
+                      "ply\nformat ascii 1.0\nelement vertex 150\nproperty float x\nproperty float y\n"
+                      "property float z\nend_header\n" +
+                          body);
+}
+
+// A PLY without faces is a point cloud to info and query, as --cloud would make it, not a mesh refused for
+// having no faces.
+TEST_F(Cli, APointCloudFileIsReadAsACloudByInfoAndQuery) {
+  write_cube_points(dir / "points.ply");
+  const Outcome info = ok("info points.ply");
+  EXPECT_NE(info.out.find("(point cloud)"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("points          150"), std::string::npos) << info.out;
+  EXPECT_TRUE(nlohmann::json::parse(ok("info points.ply --json").out)["point_cloud"].get<bool>());
+  for (const char* pose : {" --pose 5,0,0", " --pose 0,0,0", " --pose 20,0,0"}) {
+    const Outcome detected = ok(std::string("query big.obj points.ply --json") + pose);
+    EXPECT_NE(detected.err.find("queried as with --cloud b"), std::string::npos) << detected.err;
+    const Outcome told = ok(std::string("query big.obj points.ply --json --cloud b") + pose);
+    EXPECT_EQ(nlohmann::json::parse(detected.out)["collides"], nlohmann::json::parse(told.out)["collides"])
+        << pose;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------
 // Exit statuses, output paths, warnings
 
 // The loader warns about coordinates far from the origin (precision lost in reading); `query` on the same

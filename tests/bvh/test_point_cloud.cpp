@@ -185,6 +185,31 @@ TEST(PointCloudLoad, FilesRoundTripAndExtensionsAreChecked) {
   std::filesystem::remove_all(dir);
 }
 
+// A cloud file is told from a mesh file by its header alone: XYZ, or a PLY that declares no faces.
+TEST(PointCloudLoad, ACloudFileIsAPlyWithoutFacesOrXyz) {
+  const auto dir = std::filesystem::temp_directory_path() / ("bvhlab_kind_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto write = [&](const char* name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return dir / name;
+  };
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\n";
+  const std::string points = "0 0 0\n1 0 0\n0 1 0\n";
+  EXPECT_TRUE(is_point_cloud_file(write("a.ply", header + "end_header\n" + points)));
+  EXPECT_TRUE(is_point_cloud_file(write(
+      "b.ply", header + "element face 0\nproperty list uchar int vertex_indices\nend_header\n" + points)));
+  EXPECT_FALSE(is_point_cloud_file(
+      write("c.ply", header + "element face 1\nproperty list uchar int vertex_indices\nend_header\n" +
+                         points + "3 0 1 2\n")));
+  EXPECT_TRUE(is_point_cloud_file(write("d.xyz", points)));
+  EXPECT_FALSE(is_point_cloud_file(write("e.ply", "not a ply\n")));  // the mesh loader names the problem
+  EXPECT_FALSE(is_point_cloud_file(write("f.obj", "v 0 0 0\n")));
+  EXPECT_FALSE(is_point_cloud_file(dir / "missing.ply"));
+  std::filesystem::remove_all(dir);
+}
+
 double mesh_area(const Mesh& m) {
   double a = 0;
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
