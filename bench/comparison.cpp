@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <tuple>
 
 namespace bvhlab {
 namespace {
@@ -142,10 +143,9 @@ CurveStep curve_step(const SeriesSummary& a, const SeriesSummary& b, const std::
   step.same_work = same_work(a, b);
   const Interval& t = step.time_ratio;
   const bool measured = std::isfinite(t.lo) && std::isfinite(t.hi);
-  const bool more_work = !within_one_percent(a.bv_tests_per_query, b.bv_tests_per_query) &&
-                         b.bv_tests_per_query > a.bv_tests_per_query;
-  const bool less_work = !within_one_percent(a.bv_tests_per_query, b.bv_tests_per_query) &&
-                         b.bv_tests_per_query < a.bv_tests_per_query;
+  const bool changed = !within_one_percent(a.bv_tests_per_query, b.bv_tests_per_query);
+  const bool more_work = changed && b.bv_tests_per_query > a.bv_tests_per_query;
+  const bool less_work = changed && b.bv_tests_per_query < a.bv_tests_per_query;
   step.against_work = measured && ((more_work && t.hi < 1) || (less_work && t.lo > 1));
   return step;
 }
@@ -153,22 +153,23 @@ CurveStep curve_step(const SeriesSummary& a, const SeriesSummary& b, const std::
 }  // namespace
 
 std::vector<CurveStep> pmin_curve_steps(const std::vector<SeriesSummary>& series) {
-  std::map<std::string, std::vector<const SeriesSummary*>> curves;
-  std::vector<std::string> order;
+  using Key = std::tuple<std::string, std::string, std::string>;  // mesh, hierarchy, curve
+  std::map<Key, std::vector<const SeriesSummary*>> curves;
+  std::vector<Key> order;
   for (const SeriesSummary& s : series) {
     if (s.exact_strategy || s.p_min < 0) continue;
-    const std::string key = s.mesh + '\x1f' + s.hierarchy + '\x1f' + without_p_min(s.label);
+    Key key{s.mesh, s.hierarchy, without_p_min(s.label)};
     auto& points = curves[key];
-    if (points.empty()) order.push_back(key);
+    if (points.empty()) order.push_back(std::move(key));
     points.push_back(&s);
   }
   std::vector<CurveStep> steps;
-  for (const std::string& key : order) {
+  for (const Key& key : order) {
     auto& points = curves[key];
     std::stable_sort(points.begin(), points.end(),
                      [](const SeriesSummary* x, const SeriesSummary* y) { return x->p_min < y->p_min; });
     for (std::size_t k = 1; k < points.size(); ++k)
-      steps.push_back(curve_step(*points[k - 1], *points[k], without_p_min(points[k]->label)));
+      steps.push_back(curve_step(*points[k - 1], *points[k], std::get<2>(key)));
   }
   return steps;
 }

@@ -398,9 +398,9 @@ void readme_figures(std::ostream& md, bool figures_ok, const std::string& plot_e
     md << "![" << f.caption << "](" << f.file << ")\n\n*" << f.caption << "*\n\n";
 }
 
-/// Whether figure 3's p_min curves follow their work, step by step, over each pair's band.
-void readme_curves(std::ostream& md, const RunOutput& run) {
-  const std::vector<CurveStep> steps = pmin_curve_steps(summarize_band(run.rows));
+/// Whether figure 3's p_min curves follow their work, step by step, over each pair's band (`band_series`).
+void readme_curves(std::ostream& md, const std::vector<SeriesSummary>& band_series) {
+  const std::vector<CurveStep> steps = pmin_curve_steps(band_series);
   if (steps.empty()) return;
   std::set<std::string> curves;
   std::size_t same = 0;
@@ -439,15 +439,16 @@ void readme_bands(std::ostream& md, const std::vector<SummaryBand>& bands) {
   md << "\n";
 }
 
-/// The summary table over each pair's band: times beside the work.
-void readme_summary(std::ostream& md, const RunOutput& run, const std::vector<SummaryBand>& bands) {
+/// The summary table over each pair's band (`band_series`): times beside the work.
+void readme_summary(std::ostream& md, const RunOutput& run, const std::vector<SummaryBand>& bands,
+                    const std::vector<SeriesSummary>& band_series) {
   md << "## Summary over each pair's band\n\n";
   readme_bands(md, bands);
   md << "| mesh | hierarchy | strategy | mean µs | median µs | p99 µs | max µs | FP % | FN % | BV "
         "tests/query | "
         "triangle tests/query | estimates/query | bytes/triangle |\n"
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const auto& s : summarize_band(run.rows))
+  for (const auto& s : band_series)
     md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << series_name(s) << " | "
        << micros(s.mean_time_us) << " | " << micros(s.median_time_us) << " | " << micros(s.p99_time_us)
        << " | " << micros(s.max_time_us) << " | " << percent(s.fp_rate) << " | " << percent(s.fn_rate)
@@ -458,8 +459,9 @@ void readme_summary(std::ostream& md, const RunOutput& run, const std::vector<Su
 }
 
 /// The fastest inexact series within 4% wrong answers against the fastest exact one, per mesh pair.
-void readme_front(std::ostream& md, const RunOutput& run, const std::vector<SummaryBand>& bands) {
-  const auto front = error_time_front(summarize_band(run.rows), kFrontMaxError);
+void readme_front(std::ostream& md, const std::vector<SummaryBand>& bands,
+                  const std::vector<SeriesSummary>& band_series) {
+  const auto front = error_time_front(band_series, kFrontMaxError);
   if (std::none_of(front.begin(), front.end(),
                    [](const FrontPoint& f) { return f.fastest_exact.has_value(); }))
     return;
@@ -640,13 +642,14 @@ void readme_run(std::ostream& md, const RunStats& stats) {
 std::string report_readme(const RunOutput& run, bool figures_ok, const std::string& plot_error) {
   const std::vector<SummaryBand> bands = summary_bands(run);
   const std::vector<double> distances = row_distances(run);
+  const std::vector<SeriesSummary> band_series = summarize_band(run.rows);  // read by three sections
   std::ostringstream md;
   readme_header(md, run);
   readme_operating_point(md, run, bands);
   readme_figures(md, figures_ok, plot_error);
-  readme_curves(md, run);
-  readme_summary(md, run, bands);
-  readme_front(md, run, bands);
+  readme_curves(md, band_series);
+  readme_summary(md, run, bands, band_series);
+  readme_front(md, bands, band_series);
 
   readme_calibration(md, run);
   readme_per_distance(md, run, distances);

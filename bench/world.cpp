@@ -295,20 +295,30 @@ std::vector<WorldSeriesRow> run_frame_budgets(const Scene& scene, const PlannedH
   return rows;
 }
 
+/// A frame-budget series summed over the run's frames, with what picks its comparison: its schedule and the
+/// size of its budget in its own kind (tests, or microseconds; a budget of both kinds counts by tests).
+struct BudgetTotals {
+  RootRoundShortfall shortfall;
+  std::string schedule;
+  double budget = 0;
+};
+
 /// Each frame-budget series summed over the run's frames, in first-seen order.
-std::vector<RootRoundShortfall> frame_budget_totals(const std::vector<WorldSeriesRow>& rows) {
-  std::vector<RootRoundShortfall> out;
+std::vector<BudgetTotals> frame_budget_totals(const std::vector<WorldSeriesRow>& rows) {
+  std::vector<BudgetTotals> out;
   std::map<std::pair<std::string, std::string>, std::size_t> index;
   for (const WorldSeriesRow& row : rows) {
     if (row.schedule.empty()) continue;
     auto [it, fresh] = index.try_emplace({row.hierarchy, row.series}, out.size());
     if (fresh) {
-      out.emplace_back();
-      out.back().series = row.series;
-      out.back().hierarchy = row.hierarchy;
-      out.back().counts_tests = row.budget_bv_tests > 0;
+      BudgetTotals& t = out.emplace_back();
+      t.shortfall.series = row.series;
+      t.shortfall.hierarchy = row.hierarchy;
+      t.shortfall.counts_tests = row.budget_bv_tests > 0;
+      t.schedule = row.schedule;
+      t.budget = t.shortfall.counts_tests ? double(row.budget_bv_tests) : row.budget_deadline_us;
     }
-    RootRoundShortfall& s = out[it->second];
+    RootRoundShortfall& s = out[it->second].shortfall;
     ++s.frames;
     s.frames_short += row.untested > 0;
     s.candidates += row.candidates;
@@ -324,26 +334,21 @@ std::vector<RootRoundShortfall> frame_budget_totals(const std::vector<WorldSerie
 /// "The right tool" for every frame-budget series that left a pair without its root test in some frame,
 /// with the same schedule's smallest budget of the same kind that covered every round, when the run has one.
 std::vector<std::string> root_round_advice(const std::vector<WorldSeriesRow>& rows) {
-  std::map<std::string, const WorldSeriesRow*> row_of;
-  for (const WorldSeriesRow& row : rows) row_of.try_emplace(row.series, &row);
-  // The budget's size in its own kind: tests or microseconds (a budget of both kinds is compared by tests).
-  auto amount = [&](const RootRoundShortfall& s) {
-    const WorldSeriesRow& row = *row_of.at(s.series);
-    return s.counts_tests ? double(row.budget_bv_tests) : row.budget_deadline_us;
-  };
-  const std::vector<RootRoundShortfall> totals = frame_budget_totals(rows);
+  const std::vector<BudgetTotals> totals = frame_budget_totals(rows);
   std::vector<std::string> advice;
-  for (RootRoundShortfall s : totals) {
+  for (const BudgetTotals& short_one : totals) {
+    RootRoundShortfall s = short_one.shortfall;
     if (s.untested == 0) continue;
     double smallest = std::numeric_limits<double>::infinity();
-    for (const RootRoundShortfall& other : totals) {
-      if (other.untested > 0 || other.hierarchy != s.hierarchy || other.counts_tests != s.counts_tests ||
-          row_of.at(other.series)->schedule != row_of.at(s.series)->schedule || !(amount(other) < smallest))
+    for (const BudgetTotals& other : totals) {
+      const RootRoundShortfall& o = other.shortfall;
+      if (o.untested > 0 || o.hierarchy != s.hierarchy || o.counts_tests != s.counts_tests ||
+          other.schedule != short_one.schedule || !(other.budget < smallest))
         continue;
-      smallest = amount(other);
-      s.covered_series = other.series;
-      s.covered_colliding = other.colliding;
-      s.covered_missed = other.missed;
+      smallest = other.budget;
+      s.covered_series = o.series;
+      s.covered_colliding = o.colliding;
+      s.covered_missed = o.missed;
     }
     advice.push_back(root_round_advice(s));
   }
