@@ -170,19 +170,18 @@ PlyHeader read_ply_header(std::string_view text, std::string_view name) {
       have_format = true;
     } else if (w[0] == "element") {
       if (w.size() != 3) fail(name, where + "bad element line");
-      if (!seen_element) {
-        if (w[1] != "vertex") fail(name, where + "the first element is '" + w[1] + "', expected 'vertex'");
+      auto element_count = [&] {  // the element's count, a whole number
         std::size_t count = 0;
         const auto [ptr, ec] = std::from_chars(w[2].data(), w[2].data() + w[2].size(), count);
         if (ec != std::errc() || ptr != w[2].data() + w[2].size())
-          fail(name, where + "bad vertex count '" + w[2] + "'");
-        h.vertices = count;
+          fail(name, where + "bad " + w[1] + " count '" + w[2] + "'");
+        return count;
+      };
+      if (!seen_element) {
+        if (w[1] != "vertex") fail(name, where + "the first element is '" + w[1] + "', expected 'vertex'");
+        h.vertices = element_count();
       }
-      if (w[1] == "face") {
-        const auto [ptr, ec] = std::from_chars(w[2].data(), w[2].data() + w[2].size(), h.faces);
-        if (ec != std::errc() || ptr != w[2].data() + w[2].size())
-          fail(name, where + "bad face count '" + w[2] + "'");
-      }
+      if (w[1] == "face") h.faces = element_count();
       in_vertex = !seen_element;
       seen_element = true;
     } else if (w[0] == "property") {
@@ -393,9 +392,19 @@ PointCloud load_point_cloud_from_memory(std::span<const std::byte> bytes, std::s
   return cloud;
 }
 
-bool is_point_cloud_file(const std::filesystem::path& path) {
+namespace {
+
+/// The file's extension in lower case (".ply").
+std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+}  // namespace
+
+bool is_point_cloud_file(const std::filesystem::path& path) {
+  const std::string ext = lower_extension(path);
   if (ext == ".xyz") return true;
   if (ext != ".ply") return false;
   std::ifstream in(path, std::ios::binary);
@@ -410,8 +419,7 @@ bool is_point_cloud_file(const std::filesystem::path& path) {
 }
 
 PointCloud load_point_cloud(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  const std::string ext = lower_extension(path);
   if (ext != ".ply" && ext != ".xyz")
     fail(path.string(), "unknown extension '" + ext + "' (expected .ply or .xyz)");
   std::ifstream in(path, std::ios::binary);
