@@ -1,5 +1,5 @@
 // glTF input, checked and reduced to what the loader reads, before assimp sees it. Internal to the loader
-// (bvh/mesh_io.cpp); declared here so that it can be read and tested on its own.
+// (bvh/io/mesh_load.cpp); declared here so that it can be read and tested on its own.
 //
 // Why: assimp 5.2's glTF importer trusts the file. A line loop whose first segment has a bad index makes it
 // dereference null (found by tests/fuzz), a triangle fan of two indices writes past its face array, an
