@@ -8,7 +8,7 @@
 //   samples        counts from fixed area-weighted surface samples that move with their triangles
 //
 // A new policy is one header (and its .cpp) plus one line in `DensityUpdates`. These are deliberately not
-// densities of the bench's registry (bench/core/registry.hpp): every density there multiplies the runner's
+// densities of the bench's registry (engine/registry.hpp): every density there multiplies the runner's
 // instantiations, while an update policy only changes the counts of an `adb` tree between frames.
 //
 //   auto state = RecountMovedUpdate::start(tree.bvh, tree.density, update_params<RecountMovedUpdate>());
@@ -23,12 +23,8 @@
 #include "update_samples.hpp"
 #include "update_stale.hpp"
 
-#include <optional>
-#include <stdexcept>
 #include <string>
 #include <string_view>
-#include <tuple>
-#include <type_traits>
 #include <vector>
 
 namespace bvhlab {
@@ -44,51 +40,24 @@ constexpr bool all_update_adb(TypeList<Us...>) {
 }
 static_assert(all_update_adb(DensityUpdates{}));
 
-template <class... Us>
-std::vector<std::string> names(TypeList<Us...>) {
-  return {std::string(Us::name())...};
-}
-
-template <class F, class... Us>
-void for_each(F&& f, TypeList<Us...>) {
-  (f(std::type_identity<Us>{}), ...);
-}
-
 }  // namespace density_update
 
 /// The policies' names, in registration order.
 inline std::vector<std::string> density_update_names() {
-  return density_update::names(DensityUpdates{});
+  return type_names(DensityUpdates{});
 }
 
 /// Calls f(std::type_identity<U>{}) for every policy, in registration order.
 template <class F>
 void with_each_density_update(F&& f) {
-  density_update::for_each(std::forward<F>(f), DensityUpdates{});
+  for_each_type(std::forward<F>(f), DensityUpdates{});
 }
 
 /// Calls f(std::type_identity<U>{}) for the policy named `name` and returns what f returns; throws
 /// std::invalid_argument naming the choices for an unknown name.
 template <class F>
 auto with_density_update(std::string_view name, F&& f) {
-  using R = decltype(f(std::type_identity<StaleUpdate>{}));
-  std::optional<std::conditional_t<std::is_void_v<R>, bool, R>> out;
-  with_each_density_update([&](auto type) {
-    using U = typename decltype(type)::type;
-    if (out || U::name() != name) return;
-    if constexpr (std::is_void_v<R>) {
-      f(type);
-      out = true;
-    } else {
-      out.emplace(f(type));
-    }
-  });
-  if (!out) {
-    std::string known;
-    for (const std::string& n : density_update_names()) known += (known.empty() ? "" : ", ") + n;
-    throw std::invalid_argument("unknown density update '" + std::string(name) + "' (known: " + known + ")");
-  }
-  if constexpr (!std::is_void_v<R>) return *out;
+  return with_named_type("density update", name, std::forward<F>(f), DensityUpdates{});
 }
 
 }  // namespace bvhlab

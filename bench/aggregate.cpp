@@ -1,7 +1,7 @@
 #include "bench/aggregate.hpp"
 
-#include "bench/core/policies.hpp"
 #include "bench/report_tables.hpp"
+#include "engine/policies.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -8,7 +8,7 @@
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
-#include "bench/core/registry.hpp"
+#include "engine/registry.hpp"
 #include "traversal/exact.hpp"
 
 #include <benchmark/benchmark.h>

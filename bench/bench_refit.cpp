@@ -27,9 +27,9 @@
 #include "bench/core/ground_truth.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
-#include "bench/core/registry.hpp"
 #include "bvh/deform.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/registry.hpp"
 #include "traversal/exact.hpp"
 
 #include <benchmark/benchmark.h>

@@ -1,13 +1,13 @@
 #include "bench/deform.hpp"
 
 #include "adb/update.hpp"
-#include "bench/core/policies.hpp"
-#include "bench/core/registry.hpp"
 #include "bench/measure.hpp"
 #include "bench/prepare.hpp"
 #include "bench/report_tables.hpp"
 #include "bvh/deform.hpp"
 #include "bvh/mesh_sequence.hpp"
+#include "engine/policies.hpp"
+#include "engine/registry.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
 #include <fcl/narrowphase/collision.h>
@@ -89,8 +89,7 @@ std::vector<QueryRecord> answer(const StrategyVariant& variant, const TreeA& a, 
       timed_series(truth.poses, warmup, out,
                    [&](const RigidTransform& p) { return S::query(a, b, p, options); });
     } else {
-      throw std::invalid_argument("strategy " + variant.label() + " does not run on density " +
-                                  std::string(D::name()));
+      throw std::invalid_argument(strategy_info(variant.strategy).refusal(D::name()));
     }
   });
   return out;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "bench/core/scene.hpp"
+#include "bench/report_folder.hpp"
 #include "bench/run.hpp"
 
 #include <nlohmann/json_fwd.hpp>
@@ -59,8 +60,8 @@ nlohmann::json deform_document(const DeformOutput& output);
 /// answers missed and false; per density update its count error.
 std::string deform_readme(const DeformOutput& output, const std::vector<std::string>& figures = {});
 
-/// The whole report: the CSV, the figures (bench/plot_deform.py, when `figures`) and README.md. Returns why
-/// figures are missing ("" when drawn).
-std::string write_deform_report(const DeformOutput& output, const std::filesystem::path& dir, bool figures);
+/// What its report folder holds (write_report_folder, bench/report_folder.hpp): the CSV files, its figures,
+/// the README. `output` must outlive it.
+ReportFolder deform_report_folder(const DeformOutput& output);
 
 }  // namespace bvhlab

@@ -3,6 +3,7 @@
 #include "bench/deform.hpp"
 
 #include "bench/report.hpp"
+#include "bench/report_folder.hpp"
 #include "bench/report_tables.hpp"
 
 #include <fmt/format.h>
@@ -157,19 +158,16 @@ std::string deform_readme(const DeformOutput& output, const std::vector<std::str
   return md.str();
 }
 
-std::string write_deform_report(const DeformOutput& output, const std::filesystem::path& dir, bool figures) {
-  write_deform_csv(output, dir);
-  const std::vector<std::string> names{"deform_time_per_frame.png", "deform_error_vs_time.png"};
-  for (const auto& name : names) std::filesystem::remove(dir / name);
-  const std::string error =
-      figures ? run_plot_script({}, "plot_deform.py", dir, "") : "figures were not requested";
-  std::vector<std::string> drawn;
-  for (const auto& name : names)
-    if (std::filesystem::is_regular_file(dir / name)) drawn.push_back(name);
-  std::ofstream readme(dir / "README.md", std::ios::trunc);
-  readme << deform_readme(output, drawn);
-  if (!readme) throw std::runtime_error((dir / "README.md").string() + ": cannot write");
-  return error;
+ReportFolder deform_report_folder(const DeformOutput& output) {
+  ReportFolder folder;
+  folder.every_figure = false;  // a figure is drawn only where the run has its data
+  folder.figures = {"deform_time_per_frame.png", "deform_error_vs_time.png"};
+  folder.plot_script = "plot_deform.py";
+  folder.write_data = [&](const std::filesystem::path& d) { write_deform_csv(output, d); };
+  folder.readme = [&](const std::vector<std::string>& drawn, const std::string&) {
+    return deform_readme(output, drawn);
+  };
+  return folder;
 }
 
 }  // namespace bvhlab

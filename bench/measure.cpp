@@ -1,8 +1,8 @@
 #include "bench/measure.hpp"
 
 #include "bench/core/ground_truth.hpp"
-#include "bench/core/policies.hpp"
-#include "bench/core/tree_cache.hpp"
+#include "engine/policies.hpp"
+#include "engine/tree_cache.hpp"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -59,6 +59,20 @@ Truth exact_truth(const WorkloadSpec& workload, const PreparedHierarchy& exact, 
 }
 
 }  // namespace
+
+std::vector<PoseAnswer> answer_prepared(const PreparedQuery& query, std::span<const RigidTransform> poses,
+                                        int repeat) {
+  const double overhead = repeat > 0 ? clock_overhead_us() : 0;
+  const auto first = [&](const RigidTransform& pose) {
+    Result result;
+    query.run(std::span(&pose, 1), [&](std::size_t, const Result& r) { result = r; });
+    return result;
+  };
+  return answer_poses(poses, repeat, overhead, first,
+                      [&](std::span<const RigidTransform> all, std::vector<QueryRecord>& records) {
+                        query.time(all, 0, records);
+                      });
+}
 
 double clock_overhead_us() {
   std::vector<double> samples(20001);

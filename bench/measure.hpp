@@ -20,26 +20,6 @@
 
 namespace bvhlab {
 
-/// The timing loop: `warmup` untimed queries, then each pose timed on its own. A template so that each
-/// prepared hierarchy's run() compiles it around its own query, inlined.
-template <class Query>
-void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
-                  Query&& query) {
-  out.clear();
-  out.reserve(poses.size());
-  bool sink = false;
-  for (std::size_t k = 0; k < poses.size() && k < static_cast<std::size_t>(std::max(warmup, 0)); ++k)
-    sink ^= query(poses[k]).collides;
-  for (const RigidTransform& pose : poses) {
-    const auto start = Clock::now();
-    const Result r = query(pose);
-    const auto stop = Clock::now();
-    out.push_back({r.collides, r.exact, r.budget_exhausted, r.probability,
-                   std::chrono::duration<double, std::micro>(stop - start).count(), r.counters});
-  }
-  if (sink && out.empty()) std::fputc(' ', stderr);  // keeps the warm-up from being optimised away
-}
-
 /// What an empty timed region costs: the median of back-to-back clock reads. Subtracted from every query time
 /// (clamped at 0), so that sub-microsecond ADB answers are not inflated by the clock itself.
 double clock_overhead_us();
@@ -70,6 +50,11 @@ std::vector<PoseAnswer> answer_poses(std::span<const RigidTransform> poses, int 
   }
   return answers;
 }
+
+/// answer_poses with a prepared query of the run-time layer: its first answer at each pose, then `repeat`
+/// timed passes (PreparedQuery::time).
+std::vector<PoseAnswer> answer_prepared(const PreparedQuery& query, std::span<const RigidTransform> poses,
+                                        int repeat);
 
 using Truth = std::vector<std::vector<std::uint8_t>>;  // [group][pose] -> 0/1
 

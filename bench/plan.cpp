@@ -1,6 +1,6 @@
 #include "bench/plan.hpp"
 
-#include "bench/core/policies.hpp"
+#include "engine/policies.hpp"
 
 #include <algorithm>
 

@@ -14,6 +14,9 @@
 #pragma once
 
 #include "bench/core/scene.hpp"
+#include "bench/report_folder.hpp"
+
+#include <nlohmann/json_fwd.hpp>
 
 #include <filesystem>
 #include <string>
@@ -54,6 +57,10 @@ struct PointsOutput {
   std::vector<std::string> notes;
 };
 
+/// What points_rows.csv ("rows") and points_summary.csv ("summary") hold, keyed like their columns, with
+/// the CGAL cross-check's counts and the run's notes: Python's run_scene on a points scene.
+nlohmann::json points_document(const PointsOutput& output);
+
 /// Runs a points scene (scene.points set): every pair whose meshes are available (others are skipped with a
 /// note). Progress goes to stderr unless `quiet`. Throws std::invalid_argument for a scene without "points",
 /// MeshError for a mesh that does not load.
@@ -76,8 +83,8 @@ void write_points_csv(const PointsOutput& output, const std::filesystem::path& d
 /// The README of a points report: the totals per pair and density, the verdicts, the notes, the figures.
 std::string points_readme(const PointsOutput& output, const std::vector<std::string>& figures = {});
 
-/// The whole report: the CSV files, the figures (bench/plot_points.py, when `figures`) and README.md.
-/// Returns why figures are missing ("" when drawn).
-std::string write_points_report(const PointsOutput& output, const std::filesystem::path& dir, bool figures);
+/// What its report folder holds (write_report_folder, bench/report_folder.hpp): the CSV files, its figures,
+/// the README. `output` must outlive it.
+ReportFolder points_report_folder(const PointsOutput& output);
 
 }  // namespace bvhlab

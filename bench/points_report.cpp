@@ -3,9 +3,11 @@
 #include "bench/points.hpp"
 
 #include "bench/report.hpp"
+#include "bench/report_folder.hpp"
 #include "bench/report_tables.hpp"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <fstream>
 #include <sstream>
@@ -102,6 +104,27 @@ void write_rows(const std::vector<PointsRow>& rows, const std::filesystem::path&
 
 }  // namespace
 
+nlohmann::json points_document(const PointsOutput& output) {
+  const auto rows = [](const std::vector<PointsRow>& in, bool with_distance) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const PointsRow& r : in) {
+      nlohmann::json row = {
+          {"pair", r.pair},   {"points", r.points}, {"spacing", r.spacing},     {"series", r.series},
+          {"poses", r.poses}, {"clear", r.clear},   {"ambiguous", r.ambiguous}, {"colliding", r.colliding},
+          {"fp", r.fp},       {"fn", r.fn},         {"median_us", r.median_us}, {"mean_us", r.mean_us}};
+      if (with_distance) row["distance"] = r.distance;
+      out.push_back(std::move(row));
+    }
+    return out;
+  };
+  return {{"scene", output.scene},
+          {"rows", rows(output.rows, true)},
+          {"summary", rows(output.totals, false)},
+          {"cgal_checked", output.cgal_checked},
+          {"cgal_mismatches", output.cgal_mismatches},
+          {"notes", output.notes}};
+}
+
 std::vector<std::string> points_verdicts(const std::vector<PointsRow>& totals, double max_error) {
   std::vector<std::string> out;
   for (const Group& g : groups_of(totals))
@@ -171,19 +194,16 @@ std::string points_readme(const PointsOutput& output, const std::vector<std::str
   return md.str();
 }
 
-std::string write_points_report(const PointsOutput& output, const std::filesystem::path& dir, bool figures) {
-  write_points_csv(output, dir);
-  const std::vector<std::string> names{"points_error_vs_time.png", "points_fp_fn.png"};
-  for (const auto& name : names) std::filesystem::remove(dir / name);
-  const std::string error =
-      figures ? run_plot_script({}, "plot_points.py", dir, "") : "figures were not requested";
-  std::vector<std::string> drawn;
-  for (const auto& name : names)
-    if (std::filesystem::is_regular_file(dir / name)) drawn.push_back(name);
-  std::ofstream readme(dir / "README.md", std::ios::trunc);
-  readme << points_readme(output, drawn);
-  if (!readme) throw std::runtime_error((dir / "README.md").string() + ": cannot write");
-  return error;
+ReportFolder points_report_folder(const PointsOutput& output) {
+  ReportFolder folder;
+  folder.every_figure = false;  // a figure is drawn only where the run has its data
+  folder.figures = {"points_error_vs_time.png", "points_fp_fn.png"};
+  folder.plot_script = "plot_points.py";
+  folder.write_data = [&](const std::filesystem::path& d) { write_points_csv(output, d); };
+  folder.readme = [&](const std::vector<std::string>& drawn, const std::string&) {
+    return points_readme(output, drawn);
+  };
+  return folder;
 }
 
 }  // namespace bvhlab

@@ -1,12 +1,9 @@
 #include "bench/prepare.hpp"
 
-#include "bench/core/content_hash.hpp"
-#include "bench/core/policies.hpp"
-#include "bench/core/registry.hpp"
-#include "bench/core/tree_cache.hpp"
 #include "bench/measure.hpp"
 #include "bvh/mesh_io.hpp"
-#include "traversal/broad_phase/world_box.hpp"
+#include "engine/content_hash.hpp"
+#include "engine/tree_cache.hpp"
 #include "traversal/strategies.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
@@ -26,53 +23,48 @@ std::string g17(double v) {
   return buf;
 }
 
+void describe_tree(ModelInfo& m, const TreeInfo& tree) {
+  m.bv = tree.bv;
+  m.annotation = tree.annotation;
+  m.units = tree.units.file;
+  m.triangles = tree.triangles;
+  m.nodes = tree.nodes;
+  m.depth = tree.depth;
+  m.density_bytes = tree.density_bytes;
+  m.model_bytes = tree.model_bytes;
+  m.bytes_per_triangle = tree.triangles ? m.model_bytes / double(tree.triangles) : 0;
+  m.build_seconds = tree.build_seconds;
+  m.annotate_seconds = tree.annotate_seconds;
+}
+
 namespace {
 
-template <class BV, class D>
+/// Two trees of the run-time layer, each series prepared once per call (no dispatch per query).
 class BvhlabHierarchy final : public PreparedHierarchy {
  public:
-  BvhlabHierarchy(std::shared_ptr<const Tree<BV, D>> a, std::shared_ptr<const Tree<BV, D>> b)
-      : a_(std::move(a)), b_(std::move(b)), bounds_a_(root_bounds(a_->bvh)) {}
+  BvhlabHierarchy(AnyTree a, AnyTree b)
+      : a_(std::move(a)), b_(std::move(b)), exact_(a_.prepare(b_, StrategyVariant{})) {}
 
   void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
            std::vector<QueryRecord>& out) const override {
-    with_configured(variant, [&]<class S>(std::type_identity<S>, const typename S::Options& options) {
-      timed_series(poses, warmup, out,
-                   [&](const RigidTransform& p) { return S::query(*a_, *b_, p, options); });
-    });
+    a_.prepare(b_, variant)->time(poses, warmup, out);
   }
   [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
     Result result;
-    with_configured(variant, [&]<class S>(std::type_identity<S>, const typename S::Options& options) {
-      result = S::query(*a_, *b_, pose, options);
-    });
+    a_.prepare(b_, variant)->run(std::span(&pose, 1), [&](std::size_t, const Result& r) { result = r; });
     return result;
   }
   [[nodiscard]] bool exact_collides(const RigidTransform& pose) const override {
-    return query_exact(a_->bvh, b_->bvh, pose).collides;
+    bool collides = false;
+    exact_->run(std::span(&pose, 1), [&](std::size_t, const Result& r) { collides = r.collides; });
+    return collides;
   }
-  [[nodiscard]] Box world_box(const RigidTransform& pose) const override {
-    return bvhlab::world_box(a_->bvh, pose, bounds_a_);
-  }
-  [[nodiscard]] const void* tree_a() const override { return a_.get(); }
-  [[nodiscard]] const void* tree_b() const override { return b_.get(); }
-  [[nodiscard]] const std::type_info& tree_type() const override { return typeid(Tree<BV, D>); }
+  [[nodiscard]] Box world_box(const RigidTransform& pose) const override { return a_.world_box(pose); }
+  [[nodiscard]] std::pair<const AnyTree*, const AnyTree*> trees() const override { return {&a_, &b_}; }
 
  private:
-  /// Calls f(type_identity<S>, options) for the variant's strategy S, configured; throws when S cannot run
-  /// on these trees.
-  template <class F>
-  static void with_configured(const StrategyVariant& variant, F&& f) {
-    with_strategy(variant.strategy, [&]<class S>(std::type_identity<S> strategy) {
-      if constexpr (S::template accepts<D>)
-        f(strategy, strategy_options<S>(variant.values, variant.budget));
-      else
-        throw std::invalid_argument("strategy " + variant.label() + " does not run on trees with density '" +
-                                    std::string(D::name()) + "'");
-    });
-  }
-  std::shared_ptr<const Tree<BV, D>> a_, b_;
-  RootBounds bounds_a_;  ///< A's bounding ball and DOP vertices (traversal/broad_phase/world_box.hpp)
+  AnyTree a_, b_;
+  std::unique_ptr<PreparedQuery> exact_;  ///< the ground truth's query, made once
 };
 
 #ifdef BVHLAB_HAVE_FCL
@@ -140,30 +132,28 @@ class TreeStore {
         log_(std::move(log)),
         threads_(threads) {}
 
-  /// The tree of `object` for hierarchy `h` with density D (parameters `density`): from this run's memory,
-  /// else the disk cache, else built (a density starts from the plain tree, itself remembered).
-  template <class BV, class D>
-  std::shared_ptr<const Tree<BV, D>> tree(const ObjectData& object, const HierarchySpec& h,
-                                          const DensitySpec& density, ModelInfo* info = nullptr) {
+  /// The tree of `object` for hierarchy `h` with `density`: from this run's memory, else the disk cache,
+  /// else built (a density starts from the plain tree, itself remembered).
+  AnyTree tree(const ObjectData& object, const HierarchySpec& h, const DensitySpec& density,
+               ModelInfo* info = nullptr) {
     const std::string annotation = density.label();
-    const std::string key = plain_key<BV>(object, h) + (annotation == "none" ? "" : "|" + annotation);
-    using T = Tree<BV, D>;
-    if (auto hit = memo_.find(key); hit != memo_.end()) {
+    const std::string key = plain_key(object, h) + (annotation == "none" ? "" : "|" + annotation);
+    if (auto hit = trees_.find(key); hit != trees_.end()) {
       if (info) *info = infos_.at(key);
-      return std::static_pointer_cast<const T>(hit->second);
+      return hit->second;
     }
     CachedTreeTimes times;
     auto start = Clock::now();
-    std::optional<T> tree = cache_.load<BV, D>(key, object.mesh, &times, annotation);
+    std::optional<AnyTree> tree = cache_.load(key, h.bv, object.mesh, &times, annotation);
     stats_.preprocess_seconds += seconds_since(start);
     const bool from_cache = tree.has_value();
     if (!tree) {
-      tree.emplace(make_tree<BV, D>(object, h, density, times));
-      cache_.store(key, *tree, times, object.units);
+      tree.emplace(make_tree(object, h, density, times));
+      cache_.store(key, *tree, times);
     }
-    auto shared = std::make_shared<const T>(std::move(*tree));
-    remember(key, shared, describe(*shared, object, h, annotation, times, from_cache), info);
-    return shared;
+    trees_.emplace(key, *tree);
+    remember(key, describe(tree->info(), object, h, annotation, times, from_cache), info);
+    return *tree;
   }
 
 #ifdef BVHLAB_HAVE_FCL
@@ -172,7 +162,7 @@ class TreeStore {
                                                         ModelInfo* info) {
     const std::string key = "fcl|" + h.bv + "|" + object.key;
     using Model = fcl::BVHModel<FclBV>;
-    if (auto hit = memo_.find(key); hit != memo_.end()) {
+    if (auto hit = models_.find(key); hit != models_.end()) {
       *info = infos_.at(key);
       return std::static_pointer_cast<const Model>(hit->second);
     }
@@ -192,7 +182,8 @@ class TreeStore {
     m.bytes_per_triangle = m.triangles ? m.model_bytes / double(m.triangles) : 0;
     m.build_seconds = seconds_since(start);
     stats_.preprocess_seconds += m.build_seconds;
-    remember(key, std::shared_ptr<const Model>(model), m, info);
+    models_[key] = model;
+    remember(key, m, info);
     return model;
   }
 #endif
@@ -207,66 +198,58 @@ class TreeStore {
   }
 
  private:
-  template <class BV, class D>
-  Tree<BV, D> make_tree(const ObjectData& object, const HierarchySpec& h, const DensitySpec& density,
-                        CachedTreeTimes& times) {
-    if constexpr (std::is_same_v<D, NoDensity>) {
-      log_("building " + std::string(BV::name()) + " tree of " + object.spec->name + " (" +
+  AnyTree make_tree(const ObjectData& object, const HierarchySpec& h, const DensitySpec& density,
+                    CachedTreeTimes& times) {
+    if (density.name == "none") {
+      log_("building " + h.bv + " tree of " + object.spec->name + " (" +
            std::to_string(object.mesh.triangle_count()) + " triangles)");
       BuildOptions options = h.build;
       options.threads = threads_;
       options.progress = percent_logger(log_, "building: triangles placed", object.mesh.triangle_count());
-      Tree<BV, NoDensity> built{Bvh<BV>::build(object.mesh, options), {}};
+      AnyTree built = AnyTree::build(object.mesh, MeshUnits{object.units, 1}, h.bv, DensitySpec{}, options);
       ++stats_.trees_built;
-      times.build_seconds = built.bvh.stats().build_seconds;
+      times.build_seconds = built.info().build_seconds;
       return built;
-    } else {
-      ModelInfo plain_info;
-      Bvh<BV> bvh = tree<BV, NoDensity>(object, h, DensitySpec{}, &plain_info)->bvh;  // a copy to annotate
-      const auto start = Clock::now();
-      log_("annotating " + std::string(BV::name()) + " tree of " + object.spec->name + " (" +
-           density.label() + ")");
-      AnnotationContext context;
-      context.threads = threads_;
-      context.progress = percent_logger(log_, "annotating", object.mesh.triangle_count());
-      AnnotateStats annotate_stats;
-      Tree<BV, D> annotated =
-          annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &annotate_stats);
-      ++stats_.trees_annotated;
-      stats_.annotation_clip_calls += annotate_stats.clip_calls;
-      times.build_seconds = plain_info.build_seconds;
-      times.annotate_seconds = annotate_stats.seconds;
-      stats_.preprocess_seconds += seconds_since(start);
-      return annotated;
     }
+    ModelInfo plain_info;
+    const AnyTree plain = tree(object, h, DensitySpec{}, &plain_info);
+    const auto start = Clock::now();
+    log_("annotating " + h.bv + " tree of " + object.spec->name + " (" + density.label() + ")");
+    AnnotationContext context;
+    context.threads = threads_;
+    context.progress = percent_logger(log_, "annotating", object.mesh.triangle_count());
+    AnnotateStats annotate_stats;
+    AnyTree annotated = plain.annotated(density, context, &annotate_stats);
+    ++stats_.trees_annotated;
+    stats_.annotation_clip_calls += annotate_stats.clip_calls;
+    times.build_seconds = plain_info.build_seconds;
+    times.annotate_seconds = annotate_stats.seconds;
+    stats_.preprocess_seconds += seconds_since(start);
+    return annotated;
   }
 
-  template <class BV>
   static std::string plain_key(const ObjectData& object, const HierarchySpec& h) {
-    return "bvhlab-tree v1|" + object.key + "|bv=" + std::string(BV::name()) +
+    return "bvhlab-tree v1|" + object.key + "|bv=" + h.bv +
            "|split=" + std::string(to_string(h.build.split)) +
            "|leaf=" + std::to_string(h.build.max_leaf_triangles);
   }
 
-  template <class T>
-  static ModelInfo describe(const T& tree, const ObjectData& object, const HierarchySpec& h,
+  static ModelInfo describe(const TreeInfo& tree, const ObjectData& object, const HierarchySpec& h,
                             const std::string& annotation, const CachedTreeTimes& times, bool from_cache) {
     ModelInfo m;
+    describe_tree(m, tree);
     m.object = object.spec->name;
     m.hierarchy = h.name;
     m.bv = h.bv;
     m.annotation = annotation;
     m.units = object.units;
-    describe_tree_size(m, tree);
     m.build_seconds = times.build_seconds;
     m.annotate_seconds = times.annotate_seconds;
     m.from_cache = from_cache;
     return m;
   }
 
-  void remember(const std::string& key, std::shared_ptr<const void> value, const ModelInfo& info,
-                ModelInfo* out) {
-    memo_[key] = std::move(value);
+  void remember(const std::string& key, const ModelInfo& info, ModelInfo* out) {
     infos_[key] = info;
     order_.push_back(key);
     if (out) *out = info;
@@ -276,11 +259,11 @@ class TreeStore {
   RunStats& stats_;
   LogFn log_;
   unsigned threads_;
-  std::map<std::string, std::shared_ptr<const void>> memo_;
+  std::map<std::string, AnyTree> trees_;
+  std::map<std::string, std::shared_ptr<const void>> models_;  ///< FCL's
   std::map<std::string, ModelInfo> infos_;
   std::vector<std::string> order_;
 };
-
 // ---------------------------------------------------------------------------------------------------------
 // Objects.
 
@@ -385,18 +368,9 @@ std::unique_ptr<PreparedHierarchy> Preparation::hierarchy(const PlannedHierarchy
 #endif
   } else {
     const DensitySpec& density = planned.density;  // the plan decided whether the trees are annotated
-    with_volume(h.bv, [&]<class BV>(std::type_identity<BV>) {
-      with_density(density.name, [&]<class D>(std::type_identity<D>) {
-        if constexpr (DensityFor<D, BV>) {
-          auto ta = store_->tree<BV, D>(a, h, density, &info);
-          auto tb = &a == &b ? ta : store_->tree<BV, D>(b, h, density);
-          out = std::make_unique<BvhlabHierarchy<BV, D>>(ta, tb);
-        } else {
-          throw std::invalid_argument("density " + std::string(D::name()) + " cannot annotate " +
-                                      std::string(BV::name()) + " trees");
-        }
-      });
-    });
+    AnyTree ta = store_->tree(a, h, density, &info);
+    AnyTree tb = &a == &b ? ta : store_->tree(b, h, density);
+    out = std::make_unique<BvhlabHierarchy>(std::move(ta), std::move(tb));
   }
   out->model = info;
   return out;
@@ -405,8 +379,7 @@ std::unique_ptr<PreparedHierarchy> Preparation::hierarchy(const PlannedHierarchy
 std::unique_ptr<PreparedHierarchy> Preparation::plain_aabb(const ObjectData& a, const ObjectData& b) {
   HierarchySpec aabb;
   aabb.bv = aabb.name = "aabb";
-  return std::make_unique<BvhlabHierarchy<Aabb, NoDensity>>(store_->tree<Aabb, NoDensity>(a, aabb, {}),
-                                                            store_->tree<Aabb, NoDensity>(b, aabb, {}));
+  return std::make_unique<BvhlabHierarchy>(store_->tree(a, aabb, {}), store_->tree(b, aabb, {}));
 }
 
 std::vector<ModelInfo> Preparation::models() const {
@@ -429,17 +402,8 @@ BuildOutcome build_tree_file(const SceneObject& object, const HierarchySpec& hie
   TreeStore store({}, stats, std::move(log),
                   threads ? threads : std::max(1u, std::thread::hardware_concurrency()));
   const ObjectData data = load_object(object);
-  std::vector<std::byte> bytes;
-  with_volume(hierarchy.bv, [&]<class BV>(std::type_identity<BV>) {
-    with_density(density.name, [&]<class D>(std::type_identity<D>) {
-      if constexpr (DensityFor<D, BV>)
-        bytes = save_tree_to_buffer(*store.tree<BV, D>(data, hierarchy, density, &outcome.model),
-                                    {.units = data.units});
-      else
-        throw std::invalid_argument("density " + density.name + " cannot annotate " + hierarchy.bv +
-                                    " trees");
-    });
-  });
+  const std::vector<std::byte> bytes =
+      store.tree(data, hierarchy, density, &outcome.model).save_bytes(output.string());
   saved_tree_detail::write_file_atomically(output, bytes);
   outcome.file_bytes = std::filesystem::file_size(output);
   return outcome;

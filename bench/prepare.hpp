@@ -3,34 +3,23 @@
 // this run's memory, else the disk cache, else built and annotated. Internal to the runner (bench/run.cpp).
 #pragma once
 
-#include "adb/saved_tree.hpp"
-#include "adb/tree.hpp"
 #include "bench/plan.hpp"
 #include "bench/run.hpp"
+#include "engine/any_tree.hpp"
+#include "engine/timing.hpp"
 #include "traversal/result.hpp"
 
-#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
 #include <span>
 #include <string>
-#include <typeinfo>
+#include <utility>
 #include <vector>
 
 namespace bvhlab {
 
 using LogFn = std::function<void(const std::string&)>;
-using Clock = std::chrono::steady_clock;
-
-inline double micros_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
-}
-
-inline double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 /// `v` with all 17 significant digits (cache keys, messages that must name a value exactly).
 std::string g17(double v);
 
@@ -45,25 +34,8 @@ struct ObjectData {
 /// Loads the object's mesh and computes its key. Throws MeshError.
 ObjectData load_object(const SceneObject& spec);
 
-/// The size fields of `m` from a tree: counts, depth, and the bytes a query reads (nodes, volumes and what
-/// the density adds; polygons are not counted, an ADB query does not need them).
-template <class BV, class D>
-void describe_tree_size(ModelInfo& m, const Tree<BV, D>& tree) {
-  const BvhStats s = tree.bvh.stats();
-  m.triangles = s.triangles;
-  m.nodes = s.nodes;
-  m.depth = s.depth;
-  m.density_bytes = double(D::memory_bytes(tree.density));
-  m.model_bytes = double(s.nodes * s.bytes_per_node) + m.density_bytes;
-  m.bytes_per_triangle = s.triangles ? m.model_bytes / double(s.triangles) : 0;
-}
-
-/// One timed query, as the measure stage records it.
-struct QueryRecord {
-  bool collides = false, exact = true, budget_exhausted = false;
-  double probability = 0, micros = 0;
-  Counters counters;
-};
+/// The size and time fields of `m` from a tree's account of itself.
+void describe_tree(ModelInfo& m, const TreeInfo& tree);
 
 /// A planned hierarchy's trees for one pair of objects, ready to time.
 class PreparedHierarchy {
@@ -79,11 +51,8 @@ class PreparedHierarchy {
   [[nodiscard]] virtual Result query(const StrategyVariant& variant, const RigidTransform& pose) const = 0;
   /// A's world box when A is placed by `pose` (its root volume; traversal/broad_phase/world_box.hpp).
   [[nodiscard]] virtual Box world_box(const RigidTransform& pose) const = 0;
-  /// The two trees and their type (Tree<BV, D>), for code that runs many prepared pairs at once (a frame
-  /// budget); null and typeid(void) for FCL models.
-  [[nodiscard]] virtual const void* tree_a() const { return nullptr; }
-  [[nodiscard]] virtual const void* tree_b() const { return nullptr; }
-  [[nodiscard]] virtual const std::type_info& tree_type() const { return typeid(void); }
+  /// The two trees, for code that runs many prepared pairs at once (a frame budget); nulls for FCL models.
+  [[nodiscard]] virtual std::pair<const AnyTree*, const AnyTree*> trees() const { return {nullptr, nullptr}; }
   ModelInfo model;  ///< A's tree
 };
 

@@ -1,4 +1,6 @@
 #include "bench/report.hpp"
+
+#include "bench/report_folder.hpp"
 #include "bench/slices.hpp"
 #include "bench/summary_band.hpp"
 #include "bench/write.hpp"
@@ -713,42 +715,52 @@ std::string run_plot_script(const ReportOptions& options, const std::string& scr
   return script.filename().string() + " failed (exit status " + std::to_string(status) + "): " + text.str();
 }
 
+namespace {
+
+/// plot_report.py's arguments beyond the folder: the distance axis, each pair's band, the operating point.
+std::string report_plot_arguments(const RunOutput& run) {
+  const ReportSpec& r = run.scene.report;
+  // results.csv marks each row inside its pair's band; the bands' words title figure 3.
+  std::string arguments = " --quality-text " + shell_quote("each pair's summary band") +
+                          " --distance-label " + shell_quote(distance_label(run.scene));
+  for (const SummaryBand& band : summary_bands(run))
+    arguments += " --band " + shell_quote(band.mesh + "=" + band.text);
+  if (!r.operating_hierarchy.empty())
+    arguments += " --operating-strategy " + shell_quote(r.operating_strategy) + " --operating-hierarchy " +
+                 shell_quote(r.operating_hierarchy) + " --operating-p-min " + fmt("%.17g", r.operating_p_min);
+  return arguments;
+}
+
+}  // namespace
+
+ReportFolder report_folder(const RunOutput& run) {
+  ReportFolder folder;
+  for (const auto& f : report_figures()) folder.figures.push_back(f.file);
+  folder.plot_script = "plot_report.py";
+  folder.plot_arguments = report_plot_arguments(run);
+  folder.write_data = [&](const std::filesystem::path& d) {
+    write_results_csv(run, d / "results.csv");
+    write_results_json(run, d / "results.json");
+    write_calibration_csv(run, d / "calibration.csv");
+    if (run.per_pose != PerPose::none) write_poses_csv(run, d / "poses.csv");
+  };
+  folder.readme = [&](const std::vector<std::string>&, const std::string& plot_error) {
+    return report_readme(run, plot_error.empty(), plot_error);
+  };
+  return folder;
+}
+
 ReportFiles write_report(const RunOutput& run, const std::filesystem::path& dir,
                          const ReportOptions& options) {
+  const ReportFolderFiles written = write_report_folder(dir, report_folder(run), options);
   ReportFiles files;
-  files.dir = std::filesystem::absolute(dir);
-  std::filesystem::create_directories(files.dir);
+  files.dir = written.dir;
   files.results_csv = files.dir / "results.csv";
   files.results_json = files.dir / "results.json";
   files.calibration_csv = files.dir / "calibration.csv";
-  files.readme = files.dir / "README.md";
-  write_results_csv(run, files.results_csv);
-  write_results_json(run, files.results_json);
-  write_calibration_csv(run, files.calibration_csv);
-
-  for (const auto& f : report_figures()) std::filesystem::remove(files.dir / f.file);  // no stale figures
-  if (options.figures) {
-    const ReportSpec& r = run.scene.report;
-    // results.csv marks each row inside its pair's band; the bands' words title figure 3.
-    std::string arguments = " --quality-text " + shell_quote("each pair's summary band") +
-                            " --distance-label " + shell_quote(distance_label(run.scene));
-    for (const SummaryBand& band : summary_bands(run))
-      arguments += " --band " + shell_quote(band.mesh + "=" + band.text);
-    if (!r.operating_hierarchy.empty())
-      arguments += " --operating-strategy " + shell_quote(r.operating_strategy) + " --operating-hierarchy " +
-                   shell_quote(r.operating_hierarchy) + " --operating-p-min " +
-                   fmt("%.17g", r.operating_p_min);
-    files.plot_error = run_plot_script(options, "plot_report.py", files.dir, arguments);
-  } else {
-    files.plot_error = "figures were not requested";
-  }
-  for (const auto& f : report_figures())
-    if (std::filesystem::is_regular_file(files.dir / f.file)) files.figures.push_back(files.dir / f.file);
-  if (files.plot_error.empty() && files.figures.size() != report_figures().size())
-    files.plot_error = "plot_report.py did not draw every figure";
-  std::ofstream readme(files.readme, std::ios::trunc);
-  readme << report_readme(run, files.plot_error.empty(), files.plot_error);
-  if (!readme) throw std::runtime_error(files.readme.string() + ": write error");
+  files.readme = written.readme;
+  files.figures = written.figures;
+  files.plot_error = written.plot_error;
   return files;
 }
 

@@ -2,6 +2,7 @@
 // bench/plot_report.py (matplotlib), and a README.md with the tables, the figures and the operating point.
 #pragma once
 
+#include "bench/report_folder.hpp"
 #include "bench/run.hpp"
 #include "bench/timing_stats.hpp"
 
@@ -127,6 +128,10 @@ struct ReportFiles {
   std::vector<std::filesystem::path> figures;  ///< the PNGs that exist after plotting
   std::string plot_error;                      ///< why the figures are missing, if they are
 };
+
+/// What a pairs run's report folder holds: results.csv, results.json, calibration.csv (and poses.csv when
+/// the run kept per-pose rows), figures 1 to 5 and the README. `run` must outlive it.
+ReportFolder report_folder(const RunOutput& run);
 
 /// Writes everything into `dir` (created if needed). Plotting problems are reported in plot_error and in the
 /// README, never thrown: the numbers stay usable without matplotlib.

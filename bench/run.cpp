@@ -4,11 +4,11 @@
 
 #include "bench/advice.hpp"
 #include "bench/aggregate.hpp"
-#include "bench/core/policies.hpp"
 #include "bench/measure.hpp"
 #include "bench/plan.hpp"
 #include "bench/prepare.hpp"
 #include "bench/summary_band.hpp"
+#include "engine/policies.hpp"
 #include "traversal/strategies.hpp"
 
 #include <fmt/format.h>
@@ -166,9 +166,8 @@ Environment detect_environment() {
 }
 
 RunOutput run_scene(const Scene& scene, const RunOptions& options) {
-  if (scene.points)  // its series are its own (bench/points.hpp); Python and `bvhlab query` do not run them
-                     // yet
-    throw std::invalid_argument("scene " + scene.name + " is a points scene: run it with `bvhlab report`");
+  if (scene.world || scene.deform || scene.points)  // the other kinds run through make_experiment
+    throw std::invalid_argument("run_scene: scene " + scene.name + " is not a pairs scene (make_experiment)");
   const auto wall_start = Clock::now();
   RunOutput output = start_output(scene);
   RunStats& stats = output.stats;
@@ -228,9 +227,8 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
   strategy.name = request.strategy.strategy;
   scene.strategies = {strategy};
   const StrategyInfo& info = strategy_info(strategy.name);
-  if (info.needs_density && !info.accepts(request.density.name))
-    throw std::invalid_argument("strategy " + strategy.name + " does not run on trees with density '" +
-                                request.density.name + "'");
+  if (std::string refusal = info.refusal(request.density.name); !refusal.empty())
+    throw std::invalid_argument(refusal);
   if (request.hierarchy.is_fcl() && strategy.name != ExactStrategy::name())
     throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only");
   Preparation preparation(options.cache_dir, outcome.stats, log_of(options), threads_of(options.threads));

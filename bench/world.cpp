@@ -1,12 +1,11 @@
 #include "bench/world.hpp"
 
 #include "bench/advice.hpp"
-#include "bench/core/policies.hpp"
-#include "bench/core/registry.hpp"
 #include "bench/core/world_motion.hpp"
 #include "bench/plan.hpp"
 #include "bench/prepare.hpp"
 #include "bench/report_tables.hpp"
+#include "engine/policies.hpp"
 #include "traversal/broad_phase/registry.hpp"
 #include "traversal/frame_budget.hpp"
 
@@ -217,26 +216,18 @@ WorldSeriesRow run_variant(const StrategyVariant& variant, const std::vector<Can
 /// the schedule's memory of the previous frame when it keeps one (each pair named by its two instances).
 std::vector<PairOutcome> schedule(const PlannedHierarchy& planned, const std::vector<Candidate>& candidates,
                                   const FrameOptions& options, FrameMemory* memory, double& micros) {
-  std::vector<PairOutcome> out;
-  with_volume(planned.hierarchy->bv, [&]<class BV>(std::type_identity<BV>) {
-    with_density(planned.density.name, [&]<class D>(std::type_identity<D>) {
-      if constexpr (ProbabilityDensity<D> && DensityFor<D, BV>) {
-        std::vector<FramePair<BV, D>> pairs;
-        for (const Candidate& c : candidates) {
-          if (c.trees->tree_type() != typeid(Tree<BV, D>)) throw std::logic_error("frame budget: tree type");
-          pairs.push_back({static_cast<const Tree<BV, D>*>(c.trees->tree_a()),
-                           static_cast<const Tree<BV, D>*>(c.trees->tree_b()), c.b_to_a,
-                           std::uint64_t{c.instances.a} << 32 | c.instances.b});
-        }
-        const auto start = Clock::now();
-        out = schedule_frame<BV, D>(pairs, options, memory);
-        micros = micros_since(start);
-      } else {
-        throw std::invalid_argument("frame budgets need a probability density; hierarchy " +
-                                    planned.hierarchy->name + " carries " + planned.density.name);
-      }
-    });
-  });
+  std::vector<FramePairRef> pairs;
+  pairs.reserve(candidates.size());
+  for (const Candidate& c : candidates) {
+    const auto [a, b] = c.trees->trees();
+    if (!a)
+      throw std::invalid_argument("frame budgets run on bvhlab trees; hierarchy " + planned.hierarchy->name +
+                                  " has none");
+    pairs.push_back({a, b, c.b_to_a, std::uint64_t{c.instances.a} << 32 | c.instances.b});
+  }
+  const auto start = Clock::now();
+  std::vector<PairOutcome> out = AnyTree::schedule_frame(pairs, options, memory);
+  micros = micros_since(start);
   return out;
 }
 

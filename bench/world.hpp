@@ -8,6 +8,7 @@
 #pragma once
 
 #include "bench/core/scene.hpp"
+#include "bench/report_folder.hpp"
 #include "bench/run.hpp"
 
 #include <nlohmann/json_fwd.hpp>
@@ -107,9 +108,9 @@ void write_world_csv(const WorldOutput& output, const std::filesystem::path& dir
 /// like its CSV columns.
 nlohmann::json world_document(const WorldOutput& output);
 
-/// The whole report: the CSV files, the figures (bench/plot_world.py, when `figures`) and README.md.
-/// Returns why figures are missing ("" when drawn).
-std::string write_world_report(const WorldOutput& output, const std::filesystem::path& dir, bool figures);
+/// What its report folder holds (write_report_folder, bench/report_folder.hpp): the CSV files, its figures,
+/// the README. `output` must outlive it.
+ReportFolder world_report_folder(const WorldOutput& output);
 
 /// The README of a world report: per series the pairs missed and false (percent of colliding and of apart
 /// candidate pairs), median and 90th-percentile frame times; per broad phase the median frame time.

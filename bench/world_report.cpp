@@ -3,6 +3,7 @@
 #include "bench/world.hpp"
 
 #include "bench/report.hpp"
+#include "bench/report_folder.hpp"
 #include "bench/report_tables.hpp"
 
 #include <fmt/format.h>
@@ -241,19 +242,16 @@ nlohmann::json world_document(const WorldOutput& output) {
   return document;
 }
 
-std::string write_world_report(const WorldOutput& output, const std::filesystem::path& dir, bool figures) {
-  write_world_csv(output, dir);
-  const std::vector<std::string> names{"world_errors_vs_budget.png", "world_broad_phase_vs_objects.png"};
-  for (const auto& name : names) std::filesystem::remove(dir / name);
-  const std::string error =
-      figures ? run_plot_script({}, "plot_world.py", dir, "") : "figures were not requested";
-  std::vector<std::string> drawn;
-  for (const auto& name : names)
-    if (std::filesystem::is_regular_file(dir / name)) drawn.push_back(name);
-  std::ofstream readme(dir / "README.md", std::ios::trunc);
-  readme << world_readme(output, drawn);
-  if (!readme) throw std::runtime_error((dir / "README.md").string() + ": cannot write");
-  return error;
+ReportFolder world_report_folder(const WorldOutput& output) {
+  ReportFolder folder;
+  folder.every_figure = false;  // a figure is drawn only where the run has its data
+  folder.figures = {"world_errors_vs_budget.png", "world_broad_phase_vs_objects.png"};
+  folder.plot_script = "plot_world.py";
+  folder.write_data = [&](const std::filesystem::path& d) { write_world_csv(output, d); };
+  folder.readme = [&](const std::vector<std::string>& drawn, const std::string&) {
+    return world_readme(output, drawn);
+  };
+  return folder;
 }
 
 }  // namespace bvhlab

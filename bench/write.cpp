@@ -2,7 +2,7 @@
 // columns and the JSON rows come from one field table, so the two cannot drift apart.
 #include "bench/write.hpp"
 
-#include "bench/core/policies.hpp"
+#include "engine/policies.hpp"
 
 #include <nlohmann/json.hpp>
 

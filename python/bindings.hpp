@@ -5,7 +5,7 @@
 #pragma once
 
 #include "adb/parameters.hpp"
-#include "python/any_tree.hpp"
+#include "engine/any_tree.hpp"
 #include "volumes/geometry.hpp"
 
 #include <pybind11/numpy.h>

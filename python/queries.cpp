@@ -1,7 +1,7 @@
 // bvhlab.query and bvhlab.query_batch: one strategy variant between two trees, at one pose or over an array
 // of poses (checked first, then queried without the GIL, answered as numpy arrays); the protocol's poses.
 #include "bench/core/protocol.hpp"
-#include "python/any_tree.hpp"
+#include "engine/any_tree.hpp"
 #include "python/bindings.hpp"
 
 #include <algorithm>
@@ -96,6 +96,7 @@ QueryResult query(const AnyTree& a, const AnyTree& b, const py::object& pose, co
                   double deadline_us, const py::kwargs& parameters) {
   const StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
   const RigidTransform checked = pose_from(pose, rotation, translation);
+  check_same_kind_of_units(a.info(), b.info());
   const std::unique_ptr<PreparedQuery> prepared = a.prepare(b, variant);
   QueryResult out;
   py::gil_scoped_release release;
@@ -177,6 +178,7 @@ py::dict query_batch(const AnyTree& a, const AnyTree& b, const py::object& poses
                      double deadline_us, const py::kwargs& parameters) {
   const StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
   const std::vector<RigidTransform> checked = poses_from(poses, rotations, translations);
+  check_same_kind_of_units(a.info(), b.info());
   const std::unique_ptr<PreparedQuery> prepared = a.prepare(b, variant);
   BatchColumns columns(static_cast<py::ssize_t>(checked.size()));
   run_interruptibly(*prepared, checked, columns.sink());

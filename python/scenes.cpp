@@ -1,11 +1,7 @@
 // bvhlab.run_scene: the scene runner (bench/run.hpp) with its results as results.json holds them; the
 // policies' tables.
-#include "bench/core/policies.hpp"
-#include "bench/core/registry.hpp"
-#include "bench/deform.hpp"
-#include "bench/run.hpp"
-#include "bench/world.hpp"
-#include "bench/write.hpp"
+#include "bench/experiment.hpp"
+#include "engine/policies.hpp"
 #include "python/bindings.hpp"
 
 #include <pybind11/stl.h>
@@ -47,20 +43,14 @@ py::object run(const py::object& scene_argument, const py::object& cache, int th
   options.log = [quiet](const std::string& line) {
     if (!quiet) std::cerr << line << '\n';
   };
-  if (scene.deform && options.per_pose != PerPose::none)
-    throw py::value_error("per_pose: does not apply to a deform scene (its rows are per frame)");
+  const auto experiment = make_experiment(scene);
+  if (const auto option = experiment->refused_option(options, false))
+    throw py::value_error(*option + ": does not apply to a " + std::string(experiment->kind()) + " scene");
   nlohmann::json document;
   {
     py::gil_scoped_release release;
-    if (scene.world) {
-      document = world_document(run_world(scene, options));
-    } else if (scene.deform) {
-      document = deform_document(run_deform(scene, options));
-    } else {
-      const RunOutput output = run_scene(scene, options);
-      document = results_document(output);
-      if (options.per_pose != PerPose::none) document["poses"] = poses_document(output);
-    }
+    experiment->run(options);
+    document = experiment->document();
   }
   return from_json(document);
 }
@@ -82,7 +72,8 @@ void bind_scenes(py::module_& m) {
         "per_pose \"pairs\" (world_pairs.csv: per candidate pair and series, every answer or the wrong "
         "ones). A deform scene "
         "(\"deform\") returns \"rows\" (per frame, hierarchy, update and strategy), keyed like "
-        "deform_frames.csv.");
+        "deform_frames.csv. A points scene (\"points\") returns \"rows\" and \"summary\", keyed like "
+        "points_rows.csv and points_summary.csv.");
   m.def(
       "policies", [] { return from_json(policies_json()); },
       "The registered densities and strategies with their parameters (what `bvhlab policies` prints).");

@@ -1,8 +1,12 @@
 // bvhlab.Tree: a tree of any registered bounding volume and density, built from a mesh (saved and loaded)
 // or from a point cloud.
-#include "bench/core/registry.hpp"
-#include "python/any_tree.hpp"
+#include "engine/any_tree.hpp"
 #include "python/bindings.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <future>
 
 namespace bvhlab::python {
 
@@ -20,7 +24,7 @@ BuildArguments build_arguments(const std::string& bv, const std::string& density
   if (leaf < 1 || leaf > 255)
     throw py::value_error(std::string("leaf: ") + leaf_items + " per leaf must lie in [1, 255]");
   if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
-  (void)with_volume(bv, [](auto) { return 0; });  // an unknown name fails before the density's checks
+  check_volume_name(bv);  // an unknown name fails before the density's checks
   BuildArguments out{density_spec(density, parameter_values(parameters)), {}};
   out.options.split = split_method_from_string(split);
   out.options.max_leaf_triangles = out.options.max_leaf_points = static_cast<std::uint32_t>(leaf);
@@ -28,18 +32,53 @@ BuildArguments build_arguments(const std::string& bv, const std::string& density
   return out;
 }
 
+/// Thrown from a build's progress callback once Python has a pending signal: it abandons the build.
+struct BuildInterrupted {};
+
+/// Runs `build(options)` on a worker thread without the GIL; every 50 ms takes the GIL back and lets Python
+/// handle its signals. On Ctrl-C the build is told to stop at its next progress call, its tree is dropped
+/// (nothing half-built returns) and KeyboardInterrupt is raised.
+AnyTree build_interruptibly(BuildOptions options, const std::function<AnyTree(const BuildOptions&)>& build) {
+  std::atomic<bool> stop = false;
+  options.progress = [&stop](std::size_t, std::size_t) {
+    if (stop.load(std::memory_order_relaxed)) throw BuildInterrupted{};
+  };
+  auto result = std::async(std::launch::async, [&] { return build(options); });
+  bool interrupted = false;
+  {
+    py::gil_scoped_release release;
+    while (result.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+      py::gil_scoped_acquire acquire;
+      if (PyErr_CheckSignals() != 0) {  // the KeyboardInterrupt stays set until it is raised below
+        interrupted = true;
+        break;
+      }
+    }
+    stop = true;
+    result.wait();
+  }
+  if (!interrupted) return result.get();
+  try {
+    (void)result.get();
+  } catch (...) {  // BuildInterrupted, or whatever the build met first: Python's interrupt wins
+  }
+  throw py::error_already_set();
+}
+
 AnyTree build(const UnitMesh& mesh, const std::string& bv, const std::string& density,
               const std::string& split, int leaf, int threads, const py::kwargs& parameters) {
   const BuildArguments args = build_arguments(bv, density, split, leaf, "triangles", threads, parameters);
-  py::gil_scoped_release release;
-  return AnyTree::build(mesh, bv, args.density, args.options);
+  return build_interruptibly(args.options, [&](const BuildOptions& options) {
+    return AnyTree::build(mesh, bv, args.density, options);
+  });
 }
 
 AnyTree build_from_points(const UnitCloud& cloud, const std::string& bv, const std::string& density,
                           const std::string& split, int leaf, int threads, const py::kwargs& parameters) {
   const BuildArguments args = build_arguments(bv, density, split, leaf, "points", threads, parameters);
-  py::gil_scoped_release release;
-  return AnyTree::build_points(cloud, bv, args.density, args.options);
+  return build_interruptibly(args.options, [&](const BuildOptions& options) {
+    return AnyTree::build_points(cloud, bv, args.density, options);
+  });
 }
 
 AnyTree load(const py::object& file, const UnitMesh* mesh) {

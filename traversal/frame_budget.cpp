@@ -1,6 +1,8 @@
 // The frame scheduler's options and its registry of policies (traversal/frame_budget.hpp).
 #include "frame_budget.hpp"
 
+#include "../volumes/type_list.hpp"
+
 #include <algorithm>
 #include <iterator>
 #include <stdexcept>
@@ -85,9 +87,9 @@ std::span<const FramePolicy> frame_policies() {
 const FramePolicy& frame_policy(std::string_view name) {
   for (const FramePolicy& policy : kPolicies)
     if (policy.name == name) return policy;
-  std::string known;
-  for (const FramePolicy& policy : kPolicies) known += (known.empty() ? "" : ", ") + std::string(policy.name);
-  throw std::invalid_argument("frame: unknown policy '" + std::string(name) + "' (known: " + known + ")");
+  std::vector<std::string> known;
+  for (const FramePolicy& policy : kPolicies) known.emplace_back(policy.name);
+  throw unknown_name("frame policy", name, known);
 }
 
 namespace {
@@ -103,12 +105,12 @@ std::string_view frame_order_name(FrameOrder order) {
 }
 
 FrameOrder frame_order(std::string_view name) {
-  std::string known;
+  std::vector<std::string> known;
   for (FrameOrder order : frame_orders()) {
     if (frame_order_name(order) == name) return order;
-    known += (known.empty() ? "" : ", ") + std::string(frame_order_name(order));
+    known.emplace_back(frame_order_name(order));
   }
-  throw std::invalid_argument("frame: unknown order '" + std::string(name) + "' (known: " + known + ")");
+  throw unknown_name("frame order", name, known);
 }
 
 void FrameOptions::validate() const {

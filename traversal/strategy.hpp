@@ -1,6 +1,6 @@
 // The Strategy concept: what a traversal strategy must provide so that scenes, the CLI, the runner, the
 // report and the plot script can name it, configure it and run it. The shipped strategies are
-// traversal/strategies.hpp; the registry that names them at run time is bench/core/registry.hpp.
+// traversal/strategies.hpp; the registry that names them at run time is engine/registry.hpp.
 //
 // Concept `Strategy<S>` (in the manner of a CGAL concept page)
 // ------------------------------------------------------------

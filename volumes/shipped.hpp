@@ -1,5 +1,5 @@
 // The bounding-volume models bvhlab ships, listed once. The CLI, scenes and benchmarks offer exactly these
-// (bench/core/registry.hpp), and the typed volume tests run over them (tests/support/volume_lists.hpp).
+// (engine/registry.hpp), and the typed volume tests run over them (tests/support/volume_lists.hpp).
 #pragma once
 
 #include "aabb.hpp"
@@ -8,12 +8,9 @@
 #include "obb.hpp"
 #include "restricted_box.hpp"
 #include "sphere.hpp"
+#include "type_list.hpp"
 
 namespace bvhlab {
-
-/// A compile-time list of types.
-template <class... Ts>
-struct TypeList {};
 
 /// Every shipped model, in the order tools list them. A new model is added here, and nowhere else.
 using ShippedVolumes = TypeList<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop24, Dop<26>, Obb, Sphere, RestrictedBox>;

@@ -1,6 +1,6 @@
 // bvhlab build: builds (and optionally annotates) one mesh's tree and saves it without polygons.
 #include "bench/cli/cli.hpp"
-#include "bench/core/registry.hpp"
+#include "engine/specs.hpp"
 
 #include <algorithm>
 #include <cstdint>

@@ -2,9 +2,9 @@
 // helpers the subcommands share.
 #pragma once
 
-#include "bench/core/policies.hpp"
 #include "bench/core/scene.hpp"
 #include "bench/run.hpp"
+#include "engine/policies.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -1,7 +1,6 @@
 // What the bvhlab subcommands share: mesh arguments, the cache, the policies' parameter options.
 #include "bench/cli/cli.hpp"
 #include "bench/core/mesh_catalog.hpp"
-#include "bench/core/registry.hpp"
 
 #include <algorithm>
 #include <cstdlib>
@@ -124,14 +123,7 @@ void ParameterOptions::refuse_others(const std::vector<const std::vector<ParamSp
 
 DensitySpec density_from(const std::string& name, const ParameterOptions& options) {
   const DensityInfo& info = density_info(name);
-  DensitySpec density;
-  density.name = name;
-  const ParamValues given = options.pick(info.parameters);
-  density.values = with_density(name, [&]<class D>(std::type_identity<D>) {
-    (void)density_params<D>(given);
-    return resolve_parameters(D::parameters(), given, D::name());
-  });
-  return density;
+  return density_spec(name, options.pick(info.parameters));
 }
 
 }  // namespace bvhlab::cli

@@ -1,8 +1,8 @@
 // bvhlab info: what a mesh file holds, or what a saved tree's header says.
 #include "bench/cli/cli.hpp"
-#include "bench/core/content_hash.hpp"
 #include "bvh/mesh_io.hpp"
 #include "bvh/point_cloud.hpp"
+#include "engine/content_hash.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -3,8 +3,9 @@
 #include "bench/cli/cli.hpp"
 #include "bench/cloud_query.hpp"
 #include "bench/core/protocol.hpp"
-#include "bench/core/registry.hpp"
 #include "bvh/point_cloud.hpp"
+#include "engine/specs.hpp"
+#include "traversal/strategies.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -139,9 +140,8 @@ QueryPolicies query_policies(const QueryArgs& args) {
   const StrategyInfo& strategy = strategy_info(out.strategy);
   if (out.density.empty())  // the first density the strategy runs on: none when it needs none
     out.density = strategy.densities.empty() ? std::string(NoDensity::name()) : strategy.densities.front();
-  if (!strategy.accepts(out.density))
-    throw CLI::ValidationError("--density",
-                               "strategy " + out.strategy + " does not run on density " + out.density);
+  if (std::string refusal = strategy.refusal(out.density); !refusal.empty())
+    throw CLI::ValidationError("--density", refusal);
   return out;
 }
 

@@ -1,10 +1,7 @@
 // bvhlab run, report and demo: run a scene and write its results, or its report folder.
 #include "bench/cli/cli.hpp"
-#include "bench/deform.hpp"
-#include "bench/points.hpp"
+#include "bench/experiment.hpp"
 #include "bench/report.hpp"
-#include "bench/world.hpp"
-#include "bench/write.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -37,18 +34,22 @@ RunOptions scene_run_options(const SceneArgs& args) {
   return options;
 }
 
-/// --per-pose asks for one row per query of a pair scene or per candidate pair of a world scene; deform and
-/// points scenes keep no such rows, so it is refused there rather than ignored.
-void check_per_pose_applies(const Scene& scene, const RunOptions& options) {
-  if (options.per_pose == PerPose::none || !(scene.deform || scene.points)) return;
-  throw CLI::ValidationError("--per-pose", std::string("does not apply to a ") +
-                                               (scene.deform ? "deform" : "points") + " scene (scene " +
-                                               scene.name + ")");
+/// The scene's experiment, with the options it cannot honour refused by name before any work.
+std::unique_ptr<Experiment> checked_experiment(const Scene& scene, const RunOptions& options, bool snippet) {
+  auto experiment = make_experiment(scene);
+  if (const auto option = experiment->refused_option(options, snippet))
+    throw CLI::ValidationError(
+        *option == "per_pose" ? "--per-pose" : "--snippet",
+        "does not apply to a " + std::string(experiment->kind()) + " scene (scene " + scene.name + ")");
+  return experiment;
 }
 
-/// poses.csv, when --per-pose asked for it.
-void write_poses(const RunOutput& output, const fs::path& dir) {
-  if (output.per_pose != PerPose::none) write_poses_csv(output, dir / "poses.csv");
+/// 3 (saying why) when the ground truth is suspect, else `otherwise`.
+int exit_status(const Experiment& experiment, int otherwise) {
+  const auto [status, reason] = experiment.status();
+  if (!status) return otherwise;
+  std::fprintf(stderr, "bvhlab: %s\n", reason.c_str());
+  return status;
 }
 
 struct DemoArgs {
@@ -57,26 +58,6 @@ struct DemoArgs {
   std::string snippet_file;
   bool no_fetch = false;
 };
-
-void print_run_summary(const RunOutput& run) {
-  const RunStats& s = run.stats;
-  std::fprintf(
-      stderr,
-      "%zu queries in %.1f s (preprocessing %.1f s, ground truth %.1f s); trees built %zu, annotated %zu, "
-      "from cache %zu, rejected %zu; FCL models %zu; CGAL cross-check %zu poses, %zu disagreements\n",
-      s.queries, s.wall_seconds, s.preprocess_seconds, s.truth_seconds, s.trees_built, s.trees_annotated,
-      s.tree_cache_hits, s.tree_cache_rejected, s.fcl_models_built, s.cgal_checked, s.cgal_mismatches);
-}
-
-int exit_status(const RunOutput& run) {
-  if (run.stats.cgal_mismatches) {
-    std::fprintf(stderr,
-                 "bvhlab: the ground truth disagrees with CGAL on %zu poses; the error rates are suspect\n",
-                 run.stats.cgal_mismatches);
-    return 3;
-  }
-  return 0;
-}
 
 /// Fetches the scene's missing meshes that meshes/fetch.sh knows; failures are reported, not fatal.
 void fetch_missing_meshes(const Scene& scene) {
@@ -94,66 +75,17 @@ void fetch_missing_meshes(const Scene& scene) {
                  "without the missing ones\n");
 }
 
-/// A world scene's run: its CSV files, figures (when asked) and README in `dir`; prints the README's path.
-/// 4 if figures were asked for and could not be drawn.
-int run_world_scene(const Scene& scene, const RunOptions& options, const fs::path& dir, bool figures,
-                    bool quiet) {
-  const WorldOutput output = run_world(scene, options);
-  const std::string plot_error = write_world_report(output, dir, figures);
-  if (!quiet) std::fputs(world_readme(output).c_str(), stderr);
-  if (figures && !plot_error.empty()) std::fprintf(stderr, "bvhlab: %s\n", plot_error.c_str());
-  std::printf("%s\n", fs::absolute(dir / "README.md").c_str());
-  return figures && !plot_error.empty() ? 4 : 0;
-}
-
-/// A deform scene's run, written like a world scene's.
-int run_deform_scene(const Scene& scene, const RunOptions& options, const fs::path& dir, bool figures,
-                     bool quiet) {
-  const DeformOutput output = run_deform(scene, options);
-  const std::string plot_error = write_deform_report(output, dir, figures);
-  if (!quiet) std::fputs(deform_readme(output).c_str(), stderr);
-  if (figures && !plot_error.empty()) std::fprintf(stderr, "bvhlab: %s\n", plot_error.c_str());
-  std::printf("%s\n", fs::absolute(dir / "README.md").c_str());
-  return figures && !plot_error.empty() ? 4 : 0;
-}
-
-/// A points scene's run: its CSV files, figures (when asked) and README in `dir`; prints the README's path
-/// and, on stderr, the figures'. 3 if the mesh truth disagrees with CGAL, 4 if figures could not be drawn.
-int run_points_scene(const Scene& scene, const fs::path& dir, bool figures, bool quiet) {
-  const PointsOutput output = run_points(scene, quiet);
-  const std::string plot_error = write_points_report(output, dir, figures);
-  if (!quiet) std::fputs(points_text(output).c_str(), stderr);
-  if (figures && !plot_error.empty()) std::fprintf(stderr, "bvhlab: %s\n", plot_error.c_str());
-  for (const char* figure : {"points_error_vs_time.png", "points_fp_fn.png"})
-    if (fs::is_regular_file(dir / figure))
-      std::fprintf(stderr, "bvhlab: figure %s\n", fs::absolute(dir / figure).c_str());
-  std::printf("%s\n", fs::absolute(dir / "README.md").c_str());
-  if (output.cgal_mismatches) {
-    std::fprintf(stderr,
-                 "bvhlab: the mesh truth disagrees with CGAL on %zu poses; the error rates are suspect\n",
-                 output.cgal_mismatches);
-    return 3;
-  }
-  return figures && !plot_error.empty() ? 4 : 0;
-}
-
 int run_command(const SceneArgs& args) {
   const RunOptions options = scene_run_options(args);
   const Scene scene = load_scene(args.scene_file);
-  check_per_pose_applies(scene, options);
+  const auto experiment = checked_experiment(scene, options, false);
   const fs::path dir = args.out_dir.empty() ? fs::path("results") / scene.name : fs::path(args.out_dir);
   make_output_dir("--output", dir);
-  if (scene.world) return run_world_scene(scene, options, dir, false, args.quiet);
-  if (scene.deform) return run_deform_scene(scene, options, dir, false, args.quiet);
-  if (scene.points) return run_points_scene(scene, dir, false, args.quiet);
-  const RunOutput output = run_scene(scene, options);
-  write_results_csv(output, dir / "results.csv");
-  write_results_json(output, dir / "results.json");
-  write_calibration_csv(output, dir / "calibration.csv");
-  write_poses(output, dir);
-  if (!args.quiet) print_run_summary(output);
-  std::printf("%s\n", fs::absolute(dir / "results.csv").c_str());
-  return exit_status(output);
+  experiment->run(options);
+  const fs::path written = experiment->write_results(dir);
+  if (!args.quiet) std::fputs(experiment->summary().c_str(), stderr);
+  std::printf("%s\n", fs::absolute(written).c_str());
+  return exit_status(*experiment, 0);
 }
 
 /// What report and demo share: a loaded scene to run, and where and how to write its report.
@@ -169,27 +101,25 @@ struct ReportJob {
 /// Runs the scene and writes the report (and the snippet, if asked): 3 if the ground truth is suspect, 4 if
 /// figures were asked for and could not be drawn.
 int run_report(const ReportJob& job) {
-  if (job.scene.world) return run_world_scene(job.scene, job.options, job.dir, job.figures, job.quiet);
-  if (job.scene.deform) return run_deform_scene(job.scene, job.options, job.dir, job.figures, job.quiet);
-  if (job.scene.points) return run_points_scene(job.scene, job.dir, job.figures, job.quiet);
-  const RunOutput output = run_scene(job.scene, job.options);
+  const auto experiment = checked_experiment(job.scene, job.options, !job.snippet_file.empty());
+  experiment->run(job.options);
   ReportOptions report_options;
   report_options.figures = job.figures;
-  const ReportFiles files = write_report(output, job.dir, report_options);
-  write_poses(output, files.dir);
+  const ReportFolder folder = experiment->report_folder();
+  const ReportFolderFiles files = write_report_folder(job.dir, folder, report_options);
   if (!job.snippet_file.empty()) {
     std::ofstream snippet(job.snippet_file, std::ios::trunc);
-    snippet << report_snippet(output, files.dir);
+    snippet << experiment->snippet(files.dir);
     if (!snippet) throw std::runtime_error(job.snippet_file + ": cannot write");
   }
-  if (!job.quiet) print_run_summary(output);
-  if (!files.plot_error.empty()) std::fprintf(stderr, "bvhlab: %s\n", files.plot_error.c_str());
+  if (!job.quiet) std::fputs(experiment->summary().c_str(), stderr);
+  if (job.figures && !files.plot_error.empty())
+    std::fprintf(stderr, "bvhlab: %s\n", files.plot_error.c_str());
   const double seconds = std::chrono::duration<double>(Clock::now() - job.start).count();
   std::fprintf(stderr, "bvhlab: report written in %.0f s with %zu of %zu figures\n", seconds,
-               files.figures.size(), report_figures().size());
+               files.figures.size(), folder.figures.size());
   std::printf("%s\n", files.readme.c_str());
-  const int status = exit_status(output);
-  return status ? status : (job.figures && !files.plot_error.empty() ? 4 : 0);
+  return exit_status(*experiment, job.figures && !files.plot_error.empty() ? 4 : 0);
 }
 
 int report_command(const SceneArgs& args) {
@@ -197,7 +127,7 @@ int report_command(const SceneArgs& args) {
   job.start = Clock::now();
   job.options = scene_run_options(args);
   job.scene = load_scene(args.scene_file);
-  check_per_pose_applies(job.scene, job.options);
+  (void)checked_experiment(job.scene, job.options, !args.snippet_file.empty());  // refusals before any work
   job.dir = args.out_dir;
   make_output_dir("--output", job.dir);
   job.snippet_file = args.snippet_file;
@@ -211,6 +141,7 @@ int demo_command(const DemoArgs& args) {
   ReportJob job;
   job.start = Clock::now();
   job.scene = load_scene(args.scene);
+  (void)checked_experiment(job.scene, job.options, !args.snippet_file.empty());  // refusals before any work
   job.dir = fs::path(args.build_dir) / "report" / job.scene.name;
   make_output_dir("--build-dir", job.dir);
   job.snippet_file = args.snippet_file;

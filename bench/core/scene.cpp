@@ -4,11 +4,11 @@
 
 #include "bench/core/scene_json.hpp"
 
-#include "bench/core/content_hash.hpp"
 #include "bench/core/mesh_catalog.hpp"
-#include "bench/core/policies.hpp"
 #include "bench/core/protocol.hpp"
-#include "bench/core/registry.hpp"
+#include "engine/content_hash.hpp"
+#include "engine/policies.hpp"
+#include "traversal/strategies.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -126,9 +126,7 @@ std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Sk
                    [&](const HierarchySpec& h) { return scene.applies(spec, h); }))
     s.fail("\"" + spec.name + "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\" only)");
   checked(s, [&] {
-    for (const StrategyVariant& v : expand(spec))
-      with_strategy(v.strategy,
-                    [&]<class S>(std::type_identity<S>) { (void)strategy_options<S>(v.values, v.budget); });
+    for (const StrategyVariant& v : expand(spec)) check_strategy_options(v);
     return 0;
   });
   return spec;
@@ -240,53 +238,12 @@ std::vector<std::string> hierarchy_bv_names() {
   return names;
 }
 
-std::string DensitySpec::label() const {
-  return density_label(name, values);
-}
-
 std::string DensityUpdateSpec::label() const {
   return with_density_update(name, [&]<class U>(std::type_identity<U>) {
     const std::string params =
         describe_parameters(U::parameters(), values, [](const ParamSpec&) { return true; });
     return name + (params.empty() ? "" : " " + params);
   });
-}
-
-std::string StrategyVariant::budget_label() const {
-  return bvhlab::budget_label(budget);
-}
-
-std::string StrategyVariant::label() const {
-  return strategy_label(strategy, values, budget);
-}
-
-double StrategyVariant::value_or(std::string_view name, double fallback) const {
-  const auto it = values.find(name);
-  return it == values.end() ? fallback : it->second;
-}
-
-std::vector<StrategyVariant> expand(const StrategySpec& spec) {
-  const StrategyInfo& info = strategy_info(spec.name);
-  // Cross product of the given values (a sweep may hold several), in the order of the parameter table.
-  std::vector<ParamValues> combos{{}};
-  for (const ParamSpec& p : info.parameters) {
-    const auto given = spec.values.find(p.name);
-    if (given == spec.values.end()) continue;
-    std::vector<ParamValues> next;
-    for (const ParamValues& combo : combos)
-      for (double v : given->second) {
-        ParamValues c = combo;
-        c[std::string(p.name)] = v;
-        next.push_back(std::move(c));
-      }
-    combos = std::move(next);
-  }
-  const std::vector<Budget> budgets = spec.budgets.empty() ? std::vector<Budget>{Budget{}} : spec.budgets;
-  std::vector<StrategyVariant> out;
-  for (const ParamValues& combo : combos)
-    for (const Budget& budget : budgets)
-      out.push_back({spec.name, resolve_parameters(info.parameters, combo, spec.name), budget});
-  return out;
 }
 
 const SceneObject* Scene::object(std::string_view name) const {
@@ -479,13 +436,7 @@ DensitySpec parse_density_spec(const Node& a) {
   for (const ParamSpec& p : info.parameters)
     if (a.has(std::string(p.name)))
       given[std::string(p.name)] = read_parameter(a.child(std::string(p.name)), p);
-  density.values = checked(a, [&] {
-    return with_density(density.name, [&]<class D>(std::type_identity<D>) {
-      (void)density_params<D>(given);  // the density's own checks, beyond each parameter's range
-      return resolve_parameters(D::parameters(), given, D::name());
-    });
-  });
-  return density;
+  return checked(a, [&] { return density_spec(density.name, given); });
 }
 
 /// One entry of "hierarchies"; nullopt (with a note in the scene) for an optional one this build lacks.

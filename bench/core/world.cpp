@@ -1,9 +1,9 @@
 // The "world" section of a scene: many instances of the scene's objects, their motion over frames, the broad
 // phases that find candidate pairs and the budgets shared across a frame (format: bench/scenes/README.md).
-#include "bench/core/content_hash.hpp"
-#include "bench/core/policies.hpp"
 #include "bench/core/scene_json.hpp"
 #include "bench/core/world_motion.hpp"
+#include "engine/content_hash.hpp"
+#include "engine/policies.hpp"
 #include "traversal/broad_phase/registry.hpp"
 #include "traversal/frame_budget.hpp"
 

@@ -359,7 +359,11 @@ TEST_F(Cli, PerPoseIsRefusedForADeformScene) {
   expect_refused("run d.json -o out -q --per-pose all", "--per-pose: does not apply to a deform scene");
   expect_refused("report d.json -o out -q --no-figures --per-pose wrong",
                  "--per-pose: does not apply to a deform scene");
+  // A README snippet summarizes a pairs report only: asked of another kind, it is refused, not ignored.
+  expect_refused("report d.json -o out -q --no-figures --snippet snippet.md",
+                 "--snippet: does not apply to a deform scene");
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "snippet.md"));
 }
 
 // The pose column pasted into `bvhlab query` (as a pose list, one per line as --pose takes it) gives the

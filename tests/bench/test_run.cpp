@@ -1,10 +1,10 @@
 // The scene runner: only what a scene names is built; the cache is used, and a damaged entry is rebuilt,
 // never trusted; the CSV keeps its schema; the report is written.
 #include "bench/core/protocol.hpp"
-#include "bench/core/tree_cache.hpp"
 #include "bench/report.hpp"
 #include "bench/run.hpp"
 #include "bench/write.hpp"
+#include "engine/tree_cache.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 #include "volumes/aabb.hpp"
@@ -198,19 +198,24 @@ TEST_F(RunTest, AnEntryWithAValidChecksumButWrongGeometryIsRejected) {
   std::vector<Aabb> shrunk = good.volumes();
   for (auto& v : shrunk) v = Aabb::fit(std::vector<Vec3>{Vec3::Zero()});
   const Tree<Aabb, NoDensity> bad{Bvh<Aabb>::from_parts(good.nodes(), shrunk, good.triangle_ids()), {}};
+  // Handles of the run-time layer, as the runner holds them (no mesh: nothing checks the volumes yet).
+  const auto handle = [](const Tree<Aabb, NoDensity>& tree) {
+    return AnyTree::from_bytes(save_tree_to_buffer(tree), "test tree");
+  };
   TreeCache cache(dir / "cache", [this](const std::string& m) { messages.push_back(m); });
-  cache.store("key", bad, {});
-  EXPECT_FALSE((cache.load<Aabb, NoDensity>("key", mesh).has_value()));
+  cache.store("key", handle(bad), {});
+  EXPECT_FALSE(cache.load("key", "aabb", mesh).has_value());
   EXPECT_EQ(cache.counts().rejected, 1u);
   // The same entry with the right volumes loads, with its polygons re-attached.
-  cache.store("key", Tree<Aabb, NoDensity>{good, {}}, {});
-  const auto loaded = cache.load<Aabb, NoDensity>("key", mesh);
+  cache.store("key", handle(Tree<Aabb, NoDensity>{good, {}}), {});
+  const auto loaded = cache.load("key", "aabb", mesh);
   ASSERT_TRUE(loaded.has_value());
-  EXPECT_TRUE(loaded->bvh.has_polygons());
-  EXPECT_EQ(loaded->bvh.triangles().size(), mesh.triangle_count());
-  // A tree for a mesh with other triangle counts is refused.
+  EXPECT_TRUE(loaded->info().polygons);
+  EXPECT_EQ(loaded->info().triangles, mesh.triangle_count());
+  // A tree for a mesh with other triangle counts is refused, and so is one asked for as another volume.
   const Mesh other = testing::make_torus(0.7, 0.25, 20, 12);
-  EXPECT_FALSE((cache.load<Aabb, NoDensity>("key", other).has_value()));
+  EXPECT_FALSE(cache.load("key", "aabb", other).has_value());
+  EXPECT_FALSE(cache.load("key", "obb", mesh).has_value());
 }
 
 TEST_F(RunTest, CsvSchemaAndRates) {

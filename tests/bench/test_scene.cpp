@@ -1,6 +1,6 @@
 // Scene files: a full scene parses into what it says; every bad field is refused with its JSON path.
-#include "bench/core/registry.hpp"
 #include "bench/core/scene.hpp"
+#include "engine/registry.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/strategies.hpp"

@@ -5,8 +5,8 @@
 // A SceneError naming the source is the expected way to refuse. Anything else -- another exception, a crash,
 // a sanitizer report, or an accepted scene that breaks the parser's promises (every transform rigid and
 // finite, every name resolvable) -- is a finding.
-#include "bench/core/policies.hpp"
 #include "bench/core/scene.hpp"
+#include "engine/policies.hpp"
 
 #include <cmath>
 #include <cstdint>

@@ -2,6 +2,7 @@
 on the same trees and poses."""
 import csv
 import json
+import os
 
 import numpy as np
 import pytest
@@ -226,3 +227,21 @@ def test_deform_scene_rows(gear_file, cli, tmp_path):
         (r["hierarchy"], r["update"], r["colliding"]) for r in rows]
     with pytest.raises(ValueError, match="per_pose: does not apply to a deform scene"):
         bvhlab.run_scene(deform_scene(gear_file), per_pose="all")
+
+
+def test_points_scene_rows(source_dir, cli, tmp_path):
+    """A points scene runs from Python as from the CLI: the same experiment behind both, the same rows."""
+    scene_file = os.path.join(source_dir, "bench", "scenes", "points_small.json")
+    points = bvhlab.run_scene(scene_file)
+    summary = points["summary"]
+    assert {r["series"] for r in summary} >= {"exact_mesh", "exact_points", "adb p_min=0.9"}
+    exact_mesh = [r for r in summary if r["series"] == "exact_mesh"]
+    assert exact_mesh and all(r["fp"] == r["fn"] == 0 for r in exact_mesh)
+    assert points["cgal_mismatches"] == 0 and points["cgal_checked"] > 0
+    cli("run", scene_file, "-o", tmp_path / "out", "--quiet", parse_json=False)
+    with open(tmp_path / "out" / "points_summary.csv") as f:
+        written = list(csv.DictReader(f))
+    key = lambda r: (r["pair"], int(r["points"]), r["series"], int(r["clear"]), int(r["fp"]), int(r["fn"]))
+    assert [key(r) for r in written] == [key(r) for r in summary]
+    with pytest.raises(ValueError, match="per_pose: does not apply to a points scene"):
+        bvhlab.run_scene(scene_file, per_pose="wrong")

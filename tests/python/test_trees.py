@@ -1,5 +1,8 @@
 """Trees of every volume and density: what they report, and saved and loaded trees answering like the
 original, in this module and in the bvhlab CLI."""
+import threading
+import time
+
 import numpy as np
 import pytest
 
@@ -100,3 +103,39 @@ def test_broken_saved_trees_are_refused(tmp_path, gear):
         with pytest.raises(bvhlab.SavedTreeError, match=bad.name):
             bvhlab.Tree.load(bad)
     assert issubclass(bvhlab.SavedTreeError, ValueError)
+
+
+def _wavy_grid(n):
+    """A wavy n x n grid of quads (2 n^2 triangles): a mesh whose size the test chooses."""
+    u = np.linspace(-1.0, 1.0, n + 1)
+    x, y = np.meshgrid(u, u, indexing="ij")
+    vertices = np.stack([x, y, 0.1 * np.sin(6 * x) * np.cos(5 * y)], axis=-1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    corner = (i * (n + 1) + j).ravel()
+    triangles = np.concatenate([np.stack([corner, corner + n + 1, corner + 1], axis=1),
+                                np.stack([corner + 1, corner + n + 1, corner + n + 2], axis=1)])
+    return bvhlab.Mesh(vertices, triangles.astype(np.int64))
+
+
+def test_ctrl_c_interrupts_a_build_within_half_a_second():
+    """SIGINT (Ctrl-C) in the middle of building and annotating a tree raises KeyboardInterrupt soon after,
+    not once the tree is done, and no tree comes back. The mesh is sized from a small build's time so that the
+    whole build would take at least 3 s."""
+    import os
+    import signal
+
+    start = time.perf_counter()
+    bvhlab.Tree(_wavy_grid(60), "aabb", density="adb", threads=1)
+    per_triangle = max(time.perf_counter() - start, 1e-6) / (2 * 60 * 60)
+    n = int(min(1500, np.ceil(np.sqrt(3.0 / per_triangle / 2))))
+    mesh = _wavy_grid(n)
+    timer = threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGINT))
+    begin = time.perf_counter()
+    timer.start()
+    tree = None
+    with pytest.raises(KeyboardInterrupt):
+        tree = bvhlab.Tree(mesh, "aabb", density="adb", threads=1)
+    late = time.perf_counter() - begin - 0.2
+    timer.join()
+    assert tree is None
+    assert late < 0.5, f"KeyboardInterrupt {late:.2f} s after Ctrl-C (a mesh of {2 * n * n} triangles)"

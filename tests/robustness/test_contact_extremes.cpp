@@ -7,7 +7,7 @@
 #include "bench/core/ground_truth.hpp"
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
-#include "bench/core/registry.hpp"
+#include "engine/registry.hpp"
 #include "robust_support.hpp"
 #include "support/generated_meshes.hpp"
 

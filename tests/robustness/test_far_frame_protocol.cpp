@@ -6,7 +6,7 @@
 // loader in far frames are in test_far_frames.cpp.
 #include "bench/core/ground_truth.hpp"
 #include "bench/core/mesh_catalog.hpp"
-#include "bench/core/registry.hpp"
+#include "engine/registry.hpp"
 #include "robust_support.hpp"
 #include "support/generated_meshes.hpp"
 

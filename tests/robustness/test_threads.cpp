@@ -5,8 +5,8 @@
 // threads), which also catches races that happen not to change an answer.
 #include "bench/core/mesh_catalog.hpp"
 #include "bench/core/protocol.hpp"
-#include "bench/core/registry.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/registry.hpp"
 #include "robust_support.hpp"
 #include "support/meshes.hpp"
 

@@ -1,5 +1,5 @@
 // A density that exists only under tests/, to prove that the density axis takes a new policy through its
-// header and one registry line (bench/core/registry.hpp, under BVHLAB_TEST_POLICIES): nothing else in adb/,
+// header and one registry line (engine/registry.hpp, under BVHLAB_TEST_POLICIES): nothing else in adb/,
 // traversal/ or bench/ names it, yet scenes, the CLI, saved trees, the runner, the report and the plot script
 // run it (tests/bench/test_policies.cpp; the test CLI `bvhlab_test_policies`, tests/bench/CMakeLists.txt).
 #pragma once

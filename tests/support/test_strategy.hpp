@@ -1,5 +1,5 @@
 // A strategy that exists only under tests/, to prove that the strategy axis takes a new policy through its
-// header and one registry line (bench/core/registry.hpp, under BVHLAB_TEST_POLICIES): nothing else in
+// header and one registry line (engine/registry.hpp, under BVHLAB_TEST_POLICIES): nothing else in
 // traversal/ or bench/ names it, yet scenes, the CLI, the runner, the report and the plot script run it
 // (tests/bench/test_policies.cpp; the test CLI `bvhlab_test_policies`, tests/bench/CMakeLists.txt).
 #pragma once

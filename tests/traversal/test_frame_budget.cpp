@@ -563,13 +563,13 @@ TEST(FrameBudget, BadOptionsAreRefusedByName) {
   refused(late, "deadline");
   FrameOptions unknown;
   unknown.policy = "fastest";
-  refused(unknown, "unknown policy 'fastest'");
+  refused(unknown, "unknown frame policy 'fastest'");
   refused(unknown, "adb_probability, uncertainty_per_cost, equal_split, round_robin");
   try {
     frame_order("sideways");
     ADD_FAILURE() << "order 'sideways' not refused";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown order 'sideways' (known: best_first, depth_first)"),
+    EXPECT_NE(std::string(e.what()).find("unknown frame order 'sideways' (known: best_first, depth_first)"),
               std::string::npos)
         << e.what();
   }

@@ -2,6 +2,7 @@
 // (a model of BroadPhase, broad_phase.hpp) and one entry in RegisteredBroadPhases below.
 #pragma once
 
+#include "../../volumes/type_list.hpp"
 #include "broad_phase.hpp"
 #include "brute_force.hpp"
 #include "dynamic_aabb_tree.hpp"
@@ -11,10 +12,7 @@
 
 namespace bvhlab {
 
-template <class... Bs>
-struct BroadPhaseList {};
-
-using RegisteredBroadPhases = BroadPhaseList<BruteForce, SweepAndPrune, DynamicAabbTree>;
+using RegisteredBroadPhases = TypeList<BruteForce, SweepAndPrune, DynamicAabbTree>;
 
 /// A broad phase chosen at run time: the concept's operations behind one virtual call per frame.
 class AnyBroadPhase {
@@ -38,34 +36,21 @@ class Holder final : public AnyBroadPhase {
   B model_;
 };
 
-template <class... Bs>
-std::vector<std::string> names(BroadPhaseList<Bs...>) {
-  return {std::string(Bs::name())...};
-}
-
-template <class... Bs>
-std::unique_ptr<AnyBroadPhase> make(std::string_view name, BroadPhaseList<Bs...>) {
-  std::unique_ptr<AnyBroadPhase> out;
-  ((out = !out && Bs::name() == name ? std::make_unique<Holder<Bs>>() : std::move(out)), ...);
-  return out;
-}
-
 }  // namespace broad_phase_detail
 
 /// The registered broad phases' names, in registry order.
 inline std::vector<std::string> broad_phase_names() {
-  return broad_phase_detail::names(RegisteredBroadPhases{});
+  return type_names(RegisteredBroadPhases{});
 }
 
 /// A fresh broad phase (default options) by name; std::invalid_argument listing the known names otherwise.
 inline std::unique_ptr<AnyBroadPhase> make_broad_phase(std::string_view name) {
-  auto out = broad_phase_detail::make(name, RegisteredBroadPhases{});
-  if (!out) {
-    std::string known;
-    for (const auto& n : broad_phase_names()) known += (known.empty() ? "" : ", ") + n;
-    throw std::invalid_argument("unknown broad phase '" + std::string(name) + "' (known: " + known + ")");
-  }
-  return out;
+  return with_named_type(
+      "broad phase", name,
+      []<class B>(std::type_identity<B>) -> std::unique_ptr<AnyBroadPhase> {
+        return std::make_unique<broad_phase_detail::Holder<B>>();
+      },
+      RegisteredBroadPhases{});
 }
 
 }  // namespace bvhlab

@@ -1,21 +1,19 @@
 // The one place where run-time names meet compile-time policies: bounding volumes, densities and traversal
-// strategies. A new policy is named here (one line in its list) and nowhere else outside its own header;
-// tools instantiate only what they are asked for.
+// strategies. A new policy is named here (one line in its list) and nowhere else outside its own header.
+// Only the run-time layer (engine/) includes it: everything else reaches the policies through its handle
+// (engine/any_tree.hpp) and its tables (engine/policies.hpp), so each combination is compiled once.
 #pragma once
 
 #include "adb/adb_density.hpp"
 #include "adb/adb_normal_density.hpp"
 #include "adb/adb_paper_density.hpp"
 #include "adb/tree.hpp"
+#include "engine/specs.hpp"
 #include "traversal/strategies.hpp"
 #include "volumes/shipped.hpp"
 
-#include <optional>
-#include <stdexcept>
 #include <string>
 #include <string_view>
-#include <tuple>
-#include <type_traits>
 #include <vector>
 
 #ifdef BVHLAB_TEST_POLICIES
@@ -53,85 +51,35 @@ using RegisteredStrategies = TypeList<ExactStrategy, AllContactsStrategy, Guided
                                       TimeCriticalStrategy, testing::RootOverlapStrategy>;
 #endif
 
-namespace registry_detail {
-
-template <class... Ts>
-std::vector<std::string> names(TypeList<Ts...>) {
-  return {std::string(Ts::name())...};
-}
-
-inline std::string joined(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
-/// Calls f(std::type_identity<T>{}) for the T of the list whose name() is `name`; throws naming the choices.
-template <class F, class... Ts>
-auto with_named(std::string_view kind, std::string_view name, F&& f, TypeList<Ts...> list) {
-  auto unknown = [&] {
-    return std::invalid_argument("unknown " + std::string(kind) + " '" + std::string(name) +
-                                 "' (known: " + joined(names(list)) + ")");
-  };
-  using First = std::tuple_element_t<0, std::tuple<Ts...>>;
-  using R = decltype(f(std::type_identity<First>{}));
-  if constexpr (std::is_void_v<R>) {
-    bool found = false;
-    ((found = found || (Ts::name() == name ? (f(std::type_identity<Ts>{}), true) : false)), ...);
-    if (!found) throw unknown();
-  } else {
-    std::optional<R> out;
-    ((out || Ts::name() != name ? void() : void(out.emplace(f(std::type_identity<Ts>{})))), ...);
-    if (!out) throw unknown();
-    return *out;
-  }
-}
-
-template <class F, class... Ts>
-void for_each(F&& f, TypeList<Ts...>) {
-  (f(std::type_identity<Ts>{}), ...);
-}
-
-}  // namespace registry_detail
-
 /// Calls f(std::type_identity<BV>{}) for the BV whose name() is `name`; throws naming the choices.
 template <class F>
 auto with_volume(std::string_view name, F&& f) {
-  return registry_detail::with_named("bounding volume", name, std::forward<F>(f), RegisteredVolumes{});
+  return with_named_type("bounding volume", name, std::forward<F>(f), RegisteredVolumes{});
 }
 /// Calls f(std::type_identity<BV>{}) for every registered BV, in registration order.
 template <class F>
 void with_each_volume(F&& f) {
-  registry_detail::for_each(std::forward<F>(f), RegisteredVolumes{});
-}
-inline std::vector<std::string> volume_names() {
-  return registry_detail::names(RegisteredVolumes{});
+  for_each_type(std::forward<F>(f), RegisteredVolumes{});
 }
 
 /// Calls f(std::type_identity<D>{}) for the density whose name() is `name`; throws naming the choices.
 template <class F>
 auto with_density(std::string_view name, F&& f) {
-  return registry_detail::with_named("density", name, std::forward<F>(f), RegisteredDensities{});
+  return with_named_type("density", name, std::forward<F>(f), RegisteredDensities{});
 }
 template <class F>
 void with_each_density(F&& f) {
-  registry_detail::for_each(std::forward<F>(f), RegisteredDensities{});
-}
-inline std::vector<std::string> density_names() {
-  return registry_detail::names(RegisteredDensities{});
+  for_each_type(std::forward<F>(f), RegisteredDensities{});
 }
 
 /// Calls f(std::type_identity<S>{}) for the strategy whose name() is `name`; throws naming the choices.
 template <class F>
 auto with_strategy(std::string_view name, F&& f) {
-  return registry_detail::with_named("strategy", name, std::forward<F>(f), RegisteredStrategies{});
+  return with_named_type("strategy", name, std::forward<F>(f), RegisteredStrategies{});
 }
 template <class F>
 void with_each_strategy(F&& f) {
-  registry_detail::for_each(std::forward<F>(f), RegisteredStrategies{});
-}
-inline std::vector<std::string> strategy_names() {
-  return registry_detail::names(RegisteredStrategies{});
+  for_each_type(std::forward<F>(f), RegisteredStrategies{});
 }
 
 }  // namespace bvhlab

@@ -1,4 +1,4 @@
-// The registered densities and strategies (bench/core/registry.hpp) as run-time tables: what the scene
+// The registered densities and strategies (engine/registry.hpp) as run-time tables: what the scene
 // parser, the CLI, the runner, the report and the plot script read to name, check and label them. Nothing
 // outside a policy's header and its registry line says which strategies exist or what they take.
 #pragma once
@@ -30,6 +30,9 @@ struct StrategyInfo {
   std::vector<std::string> densities;  ///< the registered densities it runs on
   std::vector<ParamSpec> parameters;
   [[nodiscard]] bool accepts(std::string_view density) const;
+  /// Empty when it runs on `density`; else the one message every caller gives: "strategy adb does not run
+  /// on trees with density 'none' (it runs on: adb, adb_paper, adb_normal)".
+  [[nodiscard]] std::string refusal(std::string_view density) const;
   [[nodiscard]] const ParamSpec* parameter(std::string_view name) const;
 };
 

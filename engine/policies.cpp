@@ -1,6 +1,6 @@
-#include "bench/core/policies.hpp"
+#include "engine/policies.hpp"
 
-#include "bench/core/registry.hpp"
+#include "engine/registry.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -73,6 +73,12 @@ std::string_view budget_text(BudgetUse use) {
 
 bool StrategyInfo::accepts(std::string_view density) const {
   return std::find(densities.begin(), densities.end(), density) != densities.end();
+}
+
+std::string StrategyInfo::refusal(std::string_view density) const {
+  if (accepts(density)) return {};
+  return "strategy " + name + " does not run on trees with density '" + std::string(density) +
+         "' (it runs on: " + joined_names(densities) + ")";
 }
 
 const ParamSpec* StrategyInfo::parameter(std::string_view name) const {

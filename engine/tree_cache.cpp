@@ -1,4 +1,4 @@
-#include "bench/core/tree_cache.hpp"
+#include "engine/tree_cache.hpp"
 
 #include "adb/file_io.hpp"
 
@@ -24,6 +24,42 @@ void write_file_bytes(const std::filesystem::path& file, std::span<const std::by
 
 TreeCache::TreeCache(std::filesystem::path dir, std::function<void(const std::string&)> log)
     : dir_(std::move(dir)), log_(std::move(log)) {}
+
+std::optional<AnyTree> TreeCache::load(const std::string& key, std::string_view bv, const Mesh& mesh,
+                                       CachedTreeTimes* times, std::string_view expected_density) {
+  if (!enabled()) return std::nullopt;
+  const auto file = tree_file(key, bv);
+  if (!std::filesystem::exists(file) && !std::filesystem::exists(meta_file(file))) {
+    ++counts_.misses;
+    return std::nullopt;
+  }
+  try {
+    const std::vector<std::byte> payload = read_checked_payload(key, file, times);
+    AnyTree tree = AnyTree::from_bytes(payload, file.string(), &mesh);
+    if (tree.info().bv != bv)
+      throw std::runtime_error("a " + tree.info().bv + " tree, expected " + std::string(bv));
+    if (tree.info().annotation != expected_density)
+      throw std::runtime_error("annotated as '" + tree.info().annotation + "', expected '" +
+                               std::string(expected_density) + "'");
+    ++counts_.hits;
+    return tree;
+  } catch (const std::exception& e) {
+    ++counts_.rejected;
+    say("tree cache: rejected " + file.filename().string() + " (" + e.what() + "); rebuilding");
+    return std::nullopt;
+  }
+}
+
+void TreeCache::store(const std::string& key, const AnyTree& tree, const CachedTreeTimes& times) {
+  if (!enabled()) return;
+  const auto file = tree_file(key, tree.info().bv);
+  try {
+    write_entry(key, file, tree.save_bytes(file.string()), times);
+    ++counts_.stored;
+  } catch (const std::exception& e) {
+    say("tree cache: could not store " + file.string() + " (" + e.what() + ")");
+  }
+}
 
 std::filesystem::path TreeCache::tree_file(const std::string& key, std::string_view bv) const {
   return dir_ / (std::string(bv) + "-" + ContentHash().update(key).hex() + ".tree");

@@ -1,0 +1,88 @@
+#include "engine/specs.hpp"
+
+#include "engine/policies.hpp"
+#include "engine/registry.hpp"
+
+namespace bvhlab {
+
+std::vector<std::string> volume_names() {
+  return type_names(RegisteredVolumes{});
+}
+std::vector<std::string> density_names() {
+  return type_names(RegisteredDensities{});
+}
+std::vector<std::string> strategy_names() {
+  return type_names(RegisteredStrategies{});
+}
+
+std::string DensitySpec::label() const {
+  return density_label(name, values);
+}
+
+std::string StrategyVariant::budget_label() const {
+  return bvhlab::budget_label(budget);
+}
+
+std::string StrategyVariant::label() const {
+  return strategy_label(strategy, values, budget);
+}
+
+double StrategyVariant::value_or(std::string_view name, double fallback) const {
+  const auto it = values.find(name);
+  return it == values.end() ? fallback : it->second;
+}
+
+std::vector<StrategyVariant> expand(const StrategySpec& spec) {
+  const StrategyInfo& info = strategy_info(spec.name);
+  // Cross product of the given values (a sweep may hold several), in the order of the parameter table.
+  std::vector<ParamValues> combos{{}};
+  for (const ParamSpec& p : info.parameters) {
+    const auto given = spec.values.find(p.name);
+    if (given == spec.values.end()) continue;
+    std::vector<ParamValues> next;
+    for (const ParamValues& combo : combos)
+      for (double v : given->second) {
+        ParamValues c = combo;
+        c[std::string(p.name)] = v;
+        next.push_back(std::move(c));
+      }
+    combos = std::move(next);
+  }
+  const std::vector<Budget> budgets = spec.budgets.empty() ? std::vector<Budget>{Budget{}} : spec.budgets;
+  std::vector<StrategyVariant> out;
+  for (const ParamValues& combo : combos)
+    for (const Budget& budget : budgets)
+      out.push_back({spec.name, resolve_parameters(info.parameters, combo, spec.name), budget});
+  return out;
+}
+
+void check_volume_name(std::string_view name) {
+  with_volume(name, [](auto) {});
+}
+
+DensitySpec density_spec(const std::string& name, const ParamValues& given) {
+  DensitySpec density;
+  density.name = name;
+  density.values = with_density(name, [&]<class D>(std::type_identity<D>) {
+    (void)density_params<D>(given);  // the density's own checks of the combination
+    return resolve_parameters(D::parameters(), given, D::name());
+  });
+  return density;
+}
+
+StrategyVariant strategy_variant(const std::string& name, const ParamValues& given, const Budget& budget) {
+  StrategyVariant variant;
+  variant.strategy = name;
+  variant.values = resolve_parameters(strategy_info(name).parameters, given, name);
+  variant.budget = budget;
+  check_strategy_options(variant);
+  return variant;
+}
+
+void check_strategy_options(const StrategyVariant& variant) {
+  with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
+    (void)strategy_options<S>(variant.values, variant.budget);
+  });
+}
+
+}  // namespace bvhlab

@@ -1,0 +1,54 @@
+// Behind AnyTree (engine/any_tree.hpp): the typed tree's virtual operations, and the table of the
+// constructors of one volume and density, which the generated translation units define
+// (engine/typed_tree.hpp). Internal to engine/.
+#pragma once
+
+#include "engine/any_tree.hpp"
+#include "traversal/broad_phase/world_box.hpp"
+
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace bvhlab::engine_detail {
+
+/// The typed tree behind a handle: every operation that needs the tree's type is a virtual here.
+struct TreeModel {
+  virtual ~TreeModel() = default;
+  [[nodiscard]] virtual std::vector<std::byte> save_bytes(const std::string& source) const = 0;
+  /// `self` is this model's own shared pointer: the prepared query keeps both trees alive.
+  [[nodiscard]] virtual std::unique_ptr<PreparedQuery> prepare(std::shared_ptr<const TreeModel> self,
+                                                               std::shared_ptr<const TreeModel> b,
+                                                               const StrategyVariant& variant) const = 0;
+  [[nodiscard]] virtual Box world_box(const RigidTransform& pose) const = 0;
+  /// schedule_frame on `pairs`, whose first A is this model.
+  [[nodiscard]] virtual std::vector<PairOutcome> schedule(std::span<const FramePairRef> pairs,
+                                                          const FrameOptions& options,
+                                                          FrameMemory* memory) const = 0;
+  TreeInfo info;
+};
+
+using ModelPtr = std::shared_ptr<const TreeModel>;
+
+/// The constructors of trees of one registered volume and density.
+struct PairOps {
+  ModelPtr (*build)(const Mesh& mesh, const MeshUnits& units, const DensitySpec& density,
+                    const BuildOptions& options);
+  ModelPtr (*build_points)(const UnitCloud& cloud, const DensitySpec& density, const BuildOptions& options);
+  /// A saved tree's bytes, whose header names this volume and density; `mesh`: polygons re-attached.
+  ModelPtr (*load)(std::span<const std::byte> bytes, const std::string& source, const Mesh* mesh,
+                   const MeshUnits& units);
+  /// `plain`, a mesh's tree of this volume without a density, annotated: a copy.
+  ModelPtr (*annotate)(const TreeModel& plain, const DensitySpec& density, const AnnotationContext& context,
+                       AnnotateStats* stats);
+};
+
+/// The operations of the V-th registered volume with the D-th registered density: defined in
+/// volume_slot_<V>_<D>.cpp (generated from engine/volume_slot.cpp.in), so that each combination's
+/// instantiations compile in a translation unit of their own, in parallel.
+template <std::size_t V, std::size_t D>
+const PairOps& slot_ops();
+
+}  // namespace bvhlab::engine_detail

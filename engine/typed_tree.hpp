@@ -1,0 +1,344 @@
+// The typed trees behind AnyTree and their operations: included only by the generated translation units
+// (engine/volume_slot.cpp.in), each of which instantiates pair_ops<BV, D> for one registered volume and
+// density, with every strategy on them. Internal to engine/.
+#pragma once
+
+#include "adb/saved_tree.hpp"
+#include "engine/cloud_trees.hpp"
+#include "engine/policies.hpp"
+#include "engine/registry.hpp"
+#include "engine/tree_model.hpp"
+#include "traversal/frame_budget.hpp"
+#include "traversal/strategies.hpp"
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace bvhlab::engine_detail {
+
+/// Checks a decoded tree against its mesh and re-attaches the polygons (saved trees carry none).
+/// Throws std::runtime_error naming the first defect.
+template <class BV, Density D>
+Tree<BV, D> attach_polygons(const Tree<BV, D>& saved, const Mesh& mesh) {
+  const Bvh<BV>& bvh = saved.bvh;
+  const std::size_t n = mesh.triangles.size();
+  const auto& ids = bvh.triangle_ids();
+  if (bvh.nodes().empty()) throw std::runtime_error("the tree has no nodes");
+  if (bvh.volumes().size() != bvh.nodes().size()) throw std::runtime_error("node and volume counts differ");
+  if (ids.size() != n)
+    throw std::runtime_error("the tree covers " + std::to_string(ids.size()) + " triangles, the mesh has " +
+                             std::to_string(n));
+  std::vector<bool> seen(n, false);
+  for (std::uint32_t id : ids) {
+    if (id >= n || seen[id]) throw std::runtime_error("triangle ids are not a permutation of the mesh's");
+    seen[id] = true;
+  }
+  const auto ranges = node_triangle_ranges(bvh.nodes());  // throws on a malformed topology
+  if (ranges.front() != std::pair<std::uint32_t, std::uint32_t>{0, static_cast<std::uint32_t>(n)})
+    throw std::runtime_error("the root does not cover every triangle");
+  std::vector<TrianglePoints> triangles;
+  triangles.reserve(n);
+  for (std::uint32_t id : ids) triangles.push_back(mesh.triangle(id));
+  // Volumes stored relative to their parent (hierarchical BVs) are checked through their decoded boxes.
+  const std::vector<Box> boxes = bvh.node_boxes();
+  for (std::size_t i = 0; i < bvh.nodes().size(); ++i) {
+    const auto node = static_cast<std::uint32_t>(i);
+    if (!bvh.node(node).is_leaf()) continue;
+    for (std::uint32_t t = ranges[i].first; t < ranges[i].second; ++t)
+      for (const Vec3& v : triangles[t]) {
+        bool inside = false;
+        if constexpr (requires { bvh.volume(node).contains(v); })
+          inside = bvh.volume(node).contains(v);
+        else
+          inside = boxes[i].contains(v);
+        if (!inside)
+          throw std::runtime_error("leaf " + std::to_string(i) + "'s volume does not contain its triangles");
+      }
+  }
+  Bvh<BV> with_polygons = [&] {
+    if constexpr (requires { bvh.root_volume(); })
+      return Bvh<BV>::from_parts(bvh.nodes(), bvh.volumes(), ids, std::move(triangles), bvh.root_volume());
+    else
+      return Bvh<BV>::from_parts(bvh.nodes(), bvh.volumes(), ids, std::move(triangles));
+  }();
+  // The density's data was validated when the saved tree was decoded (D::decode).
+  return Tree<BV, D>{std::move(with_polygons), saved.density};
+}
+
+template <class BV, class D>
+struct TypedBase;
+
+/// The densities a tree over points can carry (with_cloud_density): only these compile the surface test.
+template <class D>
+inline constexpr bool kCloudDensity = std::is_same_v<D, NoDensity> || std::is_same_v<D, AdbDensity>;
+
+/// Strategy S on two trees of one type, configured once; with kSurfaces, with the clouds' surface test at
+/// the leaves (traversal/point_leaves.hpp), made per pose as query_exact_points and query_adb_points make it.
+template <class S, class BV, class D, bool kSurfaces>
+class TypedQuery final : public PreparedQuery {
+ public:
+  TypedQuery(std::shared_ptr<const TypedBase<BV, D>> a, std::shared_ptr<const TypedBase<BV, D>> b,
+             typename S::Options options)
+      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)) {}
+
+  void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
+    for (std::size_t i = 0; i < poses.size(); ++i) sink(i, query(poses[i]));
+  }
+  void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out) const override {
+    timed_series(poses, warmup, out, [this](const RigidTransform& pose) { return query(pose); });
+  }
+
+ private:
+  /// Not inlined: both loops call one copy of the traversal (a direct call per query, not a virtual one),
+  /// which halves what each combination costs to compile.
+  [[gnu::noinline]] Result query(const RigidTransform& pose) const {
+    if constexpr (kSurfaces) {
+      const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), pose);
+      return S::query(a_->tree, b_->tree, pose, options_, leaves);
+    } else {
+      return S::query(a_->tree, b_->tree, pose, options_);
+    }
+  }
+  std::shared_ptr<const TypedBase<BV, D>> a_, b_;
+  typename S::Options options_;
+};
+
+/// A typed tree, of a mesh or of a point cloud (then with its surface): what a query needs of either.
+template <class BV, class D>
+struct TypedBase : TreeModel {
+  TypedBase(Tree<BV, D> built, const MeshUnits& units, double build_seconds, double annotate_seconds)
+      : tree(std::move(built)), bounds(root_bounds(tree.bvh)) {
+    const BvhStats s = tree.bvh.stats();
+    info.bv = BV::name();
+    info.density = D::name();
+    info.annotation = D::describe(tree.density);
+    info.triangles = tree.bvh.has_points() ? 0 : s.triangles;
+    info.points = tree.bvh.point_ids().size();
+    info.nodes = s.nodes;
+    info.depth = s.depth;
+    info.density_bytes = double(D::memory_bytes(tree.density));
+    info.model_bytes = double(s.nodes * s.bytes_per_node) + info.density_bytes;
+    info.build_seconds = build_seconds;
+    info.annotate_seconds = annotate_seconds;
+    info.polygons = tree.bvh.has_polygons();
+    info.units = units;
+  }
+
+  /// A mesh's side of a point query; a cloud's tree gives its surface.
+  [[nodiscard]] virtual SurfaceSide side() const { return mesh_side(); }
+
+  [[nodiscard]] std::unique_ptr<PreparedQuery> prepare(ModelPtr self, ModelPtr b,
+                                                       const StrategyVariant& variant) const override {
+    auto other = std::dynamic_pointer_cast<const TypedBase>(b);
+    if (!other)
+      throw std::invalid_argument("the two trees differ in BV or density (" + info.bv + ", " +
+                                  info.annotation + " vs " + b->info.bv + ", " + b->info.annotation + ")");
+    auto a = std::static_pointer_cast<const TypedBase>(std::move(self));
+    std::unique_ptr<PreparedQuery> out;
+    with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
+      if constexpr (S::template accepts<D>)
+        out = prepare_typed<S>(std::move(a), std::move(other), variant);
+      else
+        throw std::invalid_argument(strategy_info(variant.strategy).refusal(D::name()));
+    });
+    return out;
+  }
+
+  [[nodiscard]] Box world_box(const RigidTransform& pose) const override {
+    return bvhlab::world_box(tree.bvh, pose, bounds);
+  }
+
+  [[nodiscard]] std::vector<PairOutcome> schedule(std::span<const FramePairRef> pairs,
+                                                  const FrameOptions& options,
+                                                  FrameMemory* memory) const override {
+    if constexpr (ProbabilityDensity<D>) {
+      std::vector<FramePair<BV, D>> typed;
+      typed.reserve(pairs.size());
+      for (const FramePairRef& p : pairs) {
+        const auto* a = dynamic_cast<const TypedBase*>(p.a->model().get());
+        const auto* b = dynamic_cast<const TypedBase*>(p.b->model().get());
+        if (!a || !b)
+          throw std::invalid_argument("a frame budget runs on trees of one volume and density; " + info.bv +
+                                      ", " + info.annotation + " met another");
+        typed.push_back({&a->tree, &b->tree, p.b_to_a, p.identity});
+      }
+      return schedule_frame<BV, D>(std::span<const FramePair<BV, D>>(typed), options, memory);
+    } else {
+      throw std::invalid_argument("frame budgets need a density with probabilities; the trees carry " +
+                                  info.density);
+    }
+  }
+
+  Tree<BV, D> tree;
+  RootBounds bounds;  ///< the root's bounding ball and DOP vertices (traversal/broad_phase/world_box.hpp)
+
+ private:
+  /// S configured, checked against both trees, with the surface test when either is a cloud's.
+  template <class S>
+  std::unique_ptr<PreparedQuery> prepare_typed(std::shared_ptr<const TypedBase> a,
+                                               std::shared_ptr<const TypedBase> b,
+                                               const StrategyVariant& variant) const {
+    if constexpr (ProbabilityDensity<D>)  // refuses trees annotated with other parameters, before any pose
+      (void)D::estimator(tree.density, b->tree.density);
+    auto options = strategy_options<S>(variant.values, variant.budget);
+    if (side().is_cloud() || b->side().is_cloud()) {
+      if constexpr (kCloudDensity<D>)
+        return prepare_points<S>(std::move(a), std::move(b), std::move(options), variant.strategy);
+      else
+        throw std::logic_error("a tree over points with density " + info.density);
+    }
+    if (S::needs_polygons && !(info.polygons && b->info.polygons))
+      throw std::invalid_argument(
+          "strategy " + variant.strategy +
+          " tests triangles, and a tree was loaded without polygons (load it with its "
+          "mesh)");
+    return std::make_unique<TypedQuery<S, BV, D, false>>(std::move(a), std::move(b), std::move(options));
+  }
+
+  /// S with the surface test, after SurfaceLeaves' checks of the two sides (so running cannot fail).
+  template <class S>
+  static std::unique_ptr<PreparedQuery> prepare_points(std::shared_ptr<const TypedBase> a,
+                                                       std::shared_ptr<const TypedBase> b,
+                                                       typename S::Options options, const std::string& name) {
+    (void)SurfaceLeaves<BV>(a->tree.bvh, a->side(), b->tree.bvh, b->side(), RigidTransform{});
+    if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, name); !refusal.empty())
+      throw std::invalid_argument(refusal);
+    if constexpr (takes_leaf_test<S, BV, D>)
+      return std::make_unique<TypedQuery<S, BV, D, true>>(std::move(a), std::move(b), std::move(options));
+    else
+      throw std::logic_error("cloud_query_refusal let strategy " + name + " through without a leaf test");
+  }
+};
+
+/// A mesh's tree.
+template <class BV, class D>
+struct TypedModel final : TypedBase<BV, D> {
+  using TypedBase<BV, D>::TypedBase;
+
+  [[nodiscard]] std::vector<std::byte> save_bytes(const std::string& source) const override {
+    SaveOptions options;
+    options.units = this->info.units.file;
+    return save_tree_to_buffer(this->tree, options, source);
+  }
+};
+
+/// A point cloud's tree, its surface and the tree's sphere coverings (the cloud's side of a point query).
+template <class BV, class D>
+struct PointModel final : TypedBase<BV, D> {
+  PointModel(const PointCloud& cloud, Tree<BV, D> built, const MeshUnits& units, double build_seconds,
+             double annotate_seconds)
+      : TypedBase<BV, D>(std::move(built), units, build_seconds, annotate_seconds),
+        surface(cloud),
+        coverings(sphere_coverings(this->tree.bvh, surface)) {}
+
+  [[nodiscard]] SurfaceSide side() const override { return cloud_side(surface, coverings); }
+  [[nodiscard]] std::vector<std::byte> save_bytes(const std::string& source) const override {
+    throw std::invalid_argument("cannot save '" + source +
+                                "': a tree over a point cloud; the saved-tree format records no points or "
+                                "surface (build it again from its cloud)");
+  }
+
+  PointSurface surface;
+  std::vector<SphereCovering> coverings;
+};
+
+/// The tree of `mesh` with density D.
+template <class BV, class D>
+ModelPtr build_mesh_tree(const Mesh& mesh, const MeshUnits& units, const DensitySpec& density,
+                         const BuildOptions& options) {
+  Bvh<BV> bvh = Bvh<BV>::build(mesh, options);
+  const double build_seconds = bvh.stats().build_seconds;
+  AnnotationContext context;
+  context.threads = options.threads;
+  context.progress = options.progress;  // the caller hears the annotation too (and may stop it there)
+  AnnotateStats stats;  // NoDensity annotates nothing: 0 seconds
+  Tree<BV, D> tree = annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &stats);
+  return std::make_shared<TypedModel<BV, D>>(std::move(tree), units, build_seconds, stats.seconds);
+}
+
+/// The tree of a cloud: NoDensity, or AdbDensity with counts from the points' areas (with_cloud_density
+/// refuses the others).
+template <class BV, class D>
+ModelPtr build_cloud_tree(const UnitCloud& cloud, const DensitySpec& density, const BuildOptions& options) {
+  ModelPtr out;
+  with_cloud_density<BV>(density.name, std::string(BV::name()), [&]<class Cloud>() {
+    if constexpr (std::is_same_v<Cloud, D>) {
+      double annotate_seconds = 0;
+      const auto start = Clock::now();
+      Tree<BV, D> tree = cloud_tree<BV, D>(cloud, density.values, options, annotate_seconds);
+      const double seconds = seconds_since(start);
+      out = std::make_shared<PointModel<BV, D>>(cloud, std::move(tree), cloud.units,
+                                                seconds - annotate_seconds, annotate_seconds);
+    } else {
+      throw std::logic_error("build_points: density " + density.name + " reached another density's slot");
+    }
+  });
+  return out;
+}
+
+template <class BV, class D>
+ModelPtr load_tree(std::span<const std::byte> bytes, const std::string& source, const Mesh* mesh,
+                   const MeshUnits& units) {
+  Tree<BV, D> tree = load_tree_from_buffer<BV, D>(bytes, source);
+  if (mesh) tree = attach_polygons(tree, *mesh);
+  return std::make_shared<TypedModel<BV, D>>(std::move(tree), units, 0.0, 0.0);
+}
+
+/// A copy of the plain tree `plain` (a TypedModel<BV, NoDensity>, checked by the caller) annotated with D.
+template <class BV, class D>
+ModelPtr annotate_plain(const TreeModel& plain, const DensitySpec& density, const AnnotationContext& context,
+                        AnnotateStats* stats) {
+  const auto& typed = static_cast<const TypedBase<BV, NoDensity>&>(plain);
+  AnnotateStats local;
+  Tree<BV, D> annotated =
+      annotate_tree<D>(Bvh<BV>(typed.tree.bvh), density_params<D>(density.values), context, &local);
+  if (stats) *stats = local;
+  return std::make_shared<TypedModel<BV, D>>(std::move(annotated), plain.info.units, plain.info.build_seconds,
+                                             local.seconds);
+}
+
+/// What a volume and a density that do not combine answer: a refusal naming both.
+[[noreturn]] inline void refuse(std::string_view density, std::string_view bv) {
+  throw std::invalid_argument("density " + std::string(density) + " cannot annotate " + std::string(bv) +
+                              " trees");
+}
+
+template <class BV, class D>
+const PairOps& pair_ops() {
+  if constexpr (DensityFor<D, BV>) {
+    static const PairOps ops{&build_mesh_tree<BV, D>, &build_cloud_tree<BV, D>, &load_tree<BV, D>,
+                             &annotate_plain<BV, D>};
+    return ops;
+  } else {
+    static const PairOps ops{
+        [](const Mesh&, const MeshUnits&, const DensitySpec&, const BuildOptions&) -> ModelPtr {
+          refuse(D::name(), BV::name());
+        },
+        [](const UnitCloud&, const DensitySpec&, const BuildOptions&) -> ModelPtr {
+          refuse(D::name(), BV::name());
+        },
+        [](std::span<const std::byte>, const std::string& source, const Mesh*, const MeshUnits&) -> ModelPtr {
+          throw SavedTreeError("saved tree '" + source + "': density " + std::string(D::name()) +
+                               " cannot annotate " + std::string(BV::name()) + " trees");
+        },
+        [](const TreeModel&, const DensitySpec&, const AnnotationContext&, AnnotateStats*) -> ModelPtr {
+          refuse(D::name(), BV::name());
+        }};
+    return ops;
+  }
+}
+
+/// The operations of volume V and density D of the registry; beyond either list, a stub (its slot's file
+/// compiles to nothing of substance).
+template <std::size_t V, std::size_t D>
+const PairOps& slot_ops() {
+  if constexpr (V < type_list_size(RegisteredVolumes{}) && D < type_list_size(RegisteredDensities{}))
+    return pair_ops<TypeAt<V, RegisteredVolumes>, TypeAt<D, RegisteredDensities>>();
+  else
+    throw std::logic_error("engine slot beyond the registered volumes and densities");
+}
+
+}  // namespace bvhlab::engine_detail

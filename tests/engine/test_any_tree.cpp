@@ -1,0 +1,141 @@
+// The run-time layer's tree handle: what a prepared query runs is what it times, a saved tree comes back
+// as the same tree, every check happens before a pose is queried, and every registry names an unknown
+// choice the same way.
+#include "adb/update.hpp"
+#include "engine/any_tree.hpp"
+#include "support/generated_meshes.hpp"
+#include "traversal/broad_phase/registry.hpp"
+#include "traversal/frame_budget.hpp"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+namespace {
+
+std::vector<RigidTransform> poses_along_x() {
+  std::vector<RigidTransform> poses;
+  for (int i = 0; i < 40; ++i) poses.push_back(RigidTransform::translate(Vec3(0.05 * i, 0.01 * i, 0)));
+  return poses;
+}
+
+AnyTree torus_tree(const std::string& bv, const std::string& density) {
+  return AnyTree::build(testing::make_torus(0.7, 0.25, 24, 12), MeshUnits{}, bv, density_spec(density, {}),
+                        BuildOptions{});
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(AnyTree, APreparedQueryTimesWhatItRuns) {
+  const AnyTree a = torus_tree("dop24", "adb"), b = torus_tree("dop24", "adb");
+  const auto poses = poses_along_x();
+  const auto query = a.prepare(b, strategy_variant("adb", {{"p_min", 0.9}}, Budget{}));
+  std::vector<Result> results(poses.size());
+  query->run(poses, [&](std::size_t i, const Result& r) { results[i] = r; });
+  std::vector<QueryRecord> records;
+  query->time(poses, 3, records);
+  ASSERT_EQ(records.size(), poses.size());
+  std::size_t colliding = 0;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    EXPECT_EQ(records[i].collides, results[i].collides) << i;
+    EXPECT_EQ(records[i].counters.bv_tests, results[i].counters.bv_tests) << i;
+    colliding += results[i].collides;
+  }
+  EXPECT_GT(colliding, 0u);  // the poses cover both answers
+  EXPECT_LT(colliding, poses.size());
+}
+
+TEST(AnyTree, AnAnnotatedTreeIsACopyWithTheDensity) {
+  const AnyTree plain = torus_tree("obb", "none");
+  const AnyTree annotated = plain.annotated(density_spec("adb", {{"grid", 3}}), AnnotationContext{});
+  EXPECT_EQ(plain.info().annotation, "none");
+  EXPECT_EQ(annotated.info().density, "adb");
+  EXPECT_EQ(annotated.info().annotation, density_spec("adb", {{"grid", 3}}).label());
+  EXPECT_EQ(annotated.info().nodes, plain.info().nodes);
+  EXPECT_GT(annotated.info().density_bytes, 0);
+  EXPECT_THROW((void)annotated.annotated(density_spec("adb", {}), AnnotationContext{}), std::logic_error);
+}
+
+TEST(AnyTree, SavedBytesComeBackAsTheSameTree) {
+  const Mesh mesh = testing::make_torus(0.7, 0.25, 24, 12);
+  const AnyTree built = AnyTree::build(mesh, MeshUnits{}, "aabb", density_spec("adb", {}), BuildOptions{});
+  const AnyTree loaded = AnyTree::from_bytes(built.save_bytes("torus"), "torus", &mesh);
+  EXPECT_EQ(loaded.info().bv, "aabb");
+  EXPECT_EQ(loaded.info().annotation, built.info().annotation);
+  EXPECT_EQ(loaded.info().nodes, built.info().nodes);
+  EXPECT_TRUE(loaded.info().polygons);
+  const auto poses = poses_along_x();
+  std::vector<char> from_built, from_loaded;
+  built.prepare(built, StrategyVariant{})->run(poses, [&](std::size_t, const Result& r) {
+    from_built.push_back(r.collides);
+  });
+  loaded.prepare(loaded, StrategyVariant{})->run(poses, [&](std::size_t, const Result& r) {
+    from_loaded.push_back(r.collides);
+  });
+  EXPECT_EQ(from_built, from_loaded);
+  // Without its mesh it has no polygons, and a strategy that tests triangles is refused before any pose.
+  const AnyTree bare = AnyTree::from_bytes(built.save_bytes("torus"), "torus");
+  EXPECT_NE(error_of([&] { (void)bare.prepare(bare, StrategyVariant{}); }).find("without polygons"),
+            std::string::npos);
+}
+
+TEST(AnyTree, PrepareRefusesWhatCannotRun) {
+  const AnyTree plain = torus_tree("aabb", "none"), adb = torus_tree("aabb", "adb");
+  const AnyTree obb = torus_tree("obb", "none");
+  EXPECT_EQ(
+      error_of([&] { (void)plain.prepare(plain, strategy_variant("adb", {}, Budget{})); }),
+      "strategy adb does not run on trees with density 'none' (it runs on: adb, adb_paper, adb_normal)");
+  EXPECT_NE(error_of([&] { (void)plain.prepare(obb, StrategyVariant{}); }).find("differ in BV or density"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { (void)plain.prepare(adb, StrategyVariant{}); }).find("differ in BV or density"),
+            std::string::npos);
+}
+
+TEST(AnyTree, AFrameBudgetRunsOnOneTypeOfTreesWithProbabilities) {
+  const AnyTree a = torus_tree("aabb", "adb"), b = torus_tree("aabb", "adb");
+  const AnyTree other = torus_tree("obb", "adb"), plain = torus_tree("aabb", "none");
+  FrameOptions options;
+  options.budget.max_bv_tests = 1000;
+  const RigidTransform near = RigidTransform::translate(Vec3(0.3, 0, 0));
+  const std::vector<FramePairRef> good{{&a, &b, near, 1}, {&b, &a, near, 2}};
+  const auto outcomes = AnyTree::schedule_frame(good, options);
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_TRUE(outcomes[0].collides);
+  const std::vector<FramePairRef> mixed{{&a, &b, near, 1}, {&other, &other, near, 2}};
+  EXPECT_NE(error_of([&] { (void)AnyTree::schedule_frame(mixed, options); }).find("one volume and density"),
+            std::string::npos);
+  const std::vector<FramePairRef> without{{&plain, &plain, near, 1}};
+  EXPECT_NE(error_of([&] { (void)AnyTree::schedule_frame(without, options); }).find("with probabilities"),
+            std::string::npos);
+}
+
+TEST(Registries, AnUnknownNameReadsTheSameInEveryRegistry) {
+  const auto starts = [](const std::string& message, const std::string& prefix) {
+    return message.rfind(prefix, 0) == 0 && message.back() == ')';
+  };
+  EXPECT_TRUE(starts(error_of([] { (void)torus_tree("abb", "none"); }),
+                     "unknown bounding volume 'abb' (known: aabb, "));
+  EXPECT_TRUE(
+      starts(error_of([] { (void)density_spec("adbb", {}); }), "unknown density 'adbb' (known: none, "));
+  EXPECT_TRUE(starts(error_of([] { (void)strategy_variant("fastest", {}, Budget{}); }),
+                     "unknown strategy 'fastest' (known: exact, "));
+  EXPECT_TRUE(
+      starts(error_of([] { (void)make_broad_phase("grid"); }), "unknown broad phase 'grid' (known: "));
+  EXPECT_TRUE(starts(error_of([] { with_density_update("magic", [](auto) {}); }),
+                     "unknown density update 'magic' (known: stale, "));
+  EXPECT_TRUE(
+      starts(error_of([] { (void)frame_policy("fastest"); }), "unknown frame policy 'fastest' (known: "));
+}
+
+}  // namespace
+}  // namespace bvhlab
