@@ -254,7 +254,7 @@ ModelPtr build_mesh_tree(const Mesh& mesh, const MeshUnits& units, const Density
   AnnotationContext context;
   context.threads = options.threads;
   context.progress = options.progress;  // the caller hears the annotation too (and may stop it there)
-  AnnotateStats stats;  // NoDensity annotates nothing: 0 seconds
+  AnnotateStats stats;                  // NoDensity annotates nothing: 0 seconds
   Tree<BV, D> tree = annotate_tree<D>(std::move(bvh), density_params<D>(density.values), context, &stats);
   return std::make_shared<TypedModel<BV, D>>(std::move(tree), units, build_seconds, stats.seconds);
 }
