@@ -108,30 +108,36 @@ void check_grid_box(const Box& box, std::uint32_t node) {
                                 " has an empty or non-finite bounding box but holds triangles");
 }
 
-/// pc of one node: its grid box and its triangles with their infos. Fast-path triangles first; then a
-/// clipped triangle is clipped only against candidate cells the bounds have not decided yet (most cells of a
-/// large node are decided by their fast-path area).
-std::uint8_t count_cells(const Box& box, std::span<const TrianglePoints> triangles,
-                         std::span<const TriangleInfo> infos, int g, double tau, Worker& worker) {
-  ThreadStats& stats = worker.stats;
-  const Grid grid(box, g);
-  const std::uint32_t begin = 0, end = static_cast<std::uint32_t>(triangles.size());
-
-  Bounds threshold;
-  {
-    CGAL::Protect_FPU_rounding<true> guard;
-    Interval a[3];
-    for (int k = 0; k < 3; ++k) a[k] = (Interval(box.max[k]) - Interval(box.min[k])) / Interval(g);
-    const Interval t = Interval(tau) * (a[0] * a[1] + a[1] * a[2] + a[2] * a[0]) / Interval(3);
-    threshold = to_bounds(t);
-  }
-
+/// The cells of the node being counted, by grid coordinates.
+struct NodeCells {
+  int g;
   std::array<CellState, kMaxGrid * kMaxGrid * kMaxGrid> cells{};
-  auto index = [g](const std::array<int, 3>& c) { return (c[0] * g + c[1]) * g + c[2]; };
+
+  CellState& operator[](const std::array<int, 3>& c) { return cells[(c[0] * g + c[1]) * g + c[2]]; }
+  const CellState& operator[](const std::array<int, 3>& c) const {
+    return cells[(c[0] * g + c[1]) * g + c[2]];
+  }
+};
+
+/// The area a cell needs to count, tau times a cell's mean face area, as certified bounds.
+Bounds count_threshold(const Box& box, int g, double tau) {
+  CGAL::Protect_FPU_rounding<true> guard;
+  Interval a[3];
+  for (int k = 0; k < 3; ++k) a[k] = (Interval(box.max[k]) - Interval(box.min[k])) / Interval(g);
+  const Interval t = Interval(tau) * (a[0] * a[1] + a[1] * a[2] + a[2] * a[0]) / Interval(3);
+  return to_bounds(t);
+}
+
+/// The first pass over the node's triangles: a fast-path triangle (inside one cell per axis) adds its area
+/// to its cells; any other is queued in worker.pending and adds its area bound to its cells' pending sums.
+/// Then every cell with a candidate is decided where the bounds already allow.
+void place_triangles(const Grid& grid, std::span<const TriangleInfo> infos, const Bounds& threshold,
+                     NodeCells& cells, Worker& worker) {
+  ThreadStats& stats = worker.stats;
   std::vector<std::uint32_t>& pending = worker.pending;
   pending.clear();
-
-  for (std::uint32_t t = begin; t < end; ++t) {
+  const std::uint32_t end = static_cast<std::uint32_t>(infos.size());
+  for (std::uint32_t t = 0; t < end; ++t) {
     const TriangleInfo& info = infos[t];
     if (info.degenerate) {
       ++stats.degenerate;
@@ -142,7 +148,7 @@ std::uint8_t count_cells(const Box& box, std::span<const TrianglePoints> triangl
     if (p.inside_cell) {
       ++stats.fast;
       for_each_candidate_cell(p, [&](const std::array<int, 3>& c) {
-        CellSum& s = cells[index(c)].known;
+        CellSum& s = cells[c].known;
         s.lo += info.area.lo;
         s.hi += info.area.hi;
         ++s.terms;
@@ -151,31 +157,38 @@ std::uint8_t count_cells(const Box& box, std::span<const TrianglePoints> triangl
       ++stats.clipped;
       pending.push_back(t);
       for_each_candidate_cell(p, [&](const std::array<int, 3>& c) {
-        CellState& cell = cells[index(c)];
+        CellState& cell = cells[c];
         cell.pending += info.area.hi;
         ++cell.pending_count;
         ++cell.pending_ops;
       });
     }
   }
-  for (CellState& cell : cells) {
+  for (CellState& cell : cells.cells) {
     cell.pending_total = cell.pending;
     if (cell.known.terms + cell.pending_count > 0) cell.decide(threshold);
   }
+}
 
-  // The candidate cells of a clipped triangle partition it (they overlap in cell planes only, which a
-  // triangle spanning a positive extent across them meets in segments), unless an axis has two containing
-  // cells (the triangle lies in their shared plane). So when every candidate is still open, the last one's
-  // area is the triangle's minus the others': one clip fewer per triangle.
+/// The second pass: clips each queued triangle against its candidate cells that are still open.
+///
+/// The candidate cells of a clipped triangle partition it (they overlap in cell planes only, which a
+/// triangle spanning a positive extent across them meets in segments), unless an axis has two containing
+/// cells (the triangle lies in their shared plane). So when every candidate is still open, the last one's
+/// area is the triangle's minus the others': one clip fewer per triangle.
+void clip_pending(const Grid& grid, std::span<const TrianglePoints> triangles,
+                  std::span<const TriangleInfo> infos, const Bounds& threshold, NodeCells& cells,
+                  Worker& worker) {
+  ThreadStats& stats = worker.stats;
   std::vector<std::array<int, 3>> candidates;
-  for (const std::uint32_t t : pending) {
+  for (const std::uint32_t t : worker.pending) {
     const TriangleInfo& info = infos[t];
     const Placement p = place(grid, info);
     candidates.clear();
     bool all_open = true;
     for_each_candidate_cell(p, [&](const std::array<int, 3>& c) {
       candidates.push_back(c);
-      all_open = all_open && cells[index(c)].decision == CellState::Decision::Open;
+      all_open = all_open && cells[c].decision == CellState::Decision::Open;
     });
     bool partition = all_open && candidates.size() >= 2;
     for (int a = 0; a < 3; ++a)
@@ -200,7 +213,7 @@ std::uint8_t count_cells(const Box& box, std::span<const TrianglePoints> triangl
       cell.decide(threshold);
     };
     for (std::size_t k = 0; k < candidates.size(); ++k) {
-      CellState& cell = cells[index(candidates[k])];
+      CellState& cell = cells[candidates[k]];
       if (cell.decision != CellState::Decision::Open) {
         ++stats.skipped_clips;
         continue;
@@ -219,16 +232,21 @@ std::uint8_t count_cells(const Box& box, std::span<const TrianglePoints> triangl
     }
     if (derived < candidates.size()) {
       ++stats.derived_areas;
-      add(cells[index(candidates[derived])], to_bounds(rest));
+      add(cells[candidates[derived]], to_bounds(rest));
     }
   }
+}
 
+/// pc: the cells that count; a cell the bounds left open is decided exactly.
+int tally_cells(const Grid& grid, const Box& box, double tau, std::span<const TrianglePoints> triangles,
+                std::span<const TriangleInfo> infos, const NodeCells& cells, ThreadStats& stats) {
+  const int g = cells.g;
   int count = 0;
   for (int i = 0; i < g; ++i)
     for (int j = 0; j < g; ++j)
       for (int k = 0; k < g; ++k) {
         const std::array<int, 3> c{i, j, k};
-        const CellState& cell = cells[index(c)];
+        const CellState& cell = cells[c];
         if (cell.known.terms + cell.pending_count == 0) continue;
         switch (cell.decision) {
           case CellState::Decision::Counts:
@@ -242,7 +260,20 @@ std::uint8_t count_cells(const Box& box, std::span<const TrianglePoints> triangl
             break;
         }
       }
-  return static_cast<std::uint8_t>(count);
+  return count;
+}
+
+/// pc of one node: its grid box and its triangles with their infos. Fast-path triangles first; then a
+/// clipped triangle is clipped only against candidate cells the bounds have not decided yet (most cells of a
+/// large node are decided by their fast-path area).
+std::uint8_t count_cells(const Box& box, std::span<const TrianglePoints> triangles,
+                         std::span<const TriangleInfo> infos, int g, double tau, Worker& worker) {
+  const Grid grid(box, g);
+  const Bounds threshold = count_threshold(box, g, tau);
+  NodeCells cells{g};
+  place_triangles(grid, infos, threshold, cells, worker);
+  clip_pending(grid, triangles, infos, threshold, cells, worker);
+  return static_cast<std::uint8_t>(tally_cells(grid, box, tau, triangles, infos, cells, worker.stats));
 }
 
 /// pc of node `node` on its bounding box (the triangles and infos shared by all nodes).
@@ -290,14 +321,11 @@ std::uint8_t count_node_in_frame(const FrameJob& job, std::uint32_t node, Worker
 
 namespace {
 
-/// Checks the shared arguments, then counts every node with count(worker, node) over the threads, with
-/// progress and statistics. `shared_infos`: the triangles' infos are computed first (for count_node).
-template <class CountNode>
-CellCounts count_all(std::size_t node_count,
-                     std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
-                     std::span<const TrianglePoints> triangles, int grid, const AnnotateOptions& options,
-                     std::vector<TriangleInfo>* shared_infos, CountNode&& count) {
-  const auto start = std::chrono::steady_clock::now();
+/// Checks the arguments every node shares; returns the number of (triangle, node) pairs.
+std::size_t check_arguments(std::size_t node_count,
+                            std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
+                            std::span<const TrianglePoints> triangles, int grid,
+                            const AnnotateOptions& options) {
   if (grid < 1 || grid > kMaxGrid)
     throw std::invalid_argument("annotate: grid must be 1..6 cells per axis, got " + std::to_string(grid));
   if (!std::isfinite(options.tau) || !(options.tau >= 0))  // tau = 0: every cell with some area counts
@@ -318,78 +346,41 @@ CellCounts count_all(std::size_t node_count,
     for (const auto& v : triangles[t])
       if (!v.allFinite())
         throw std::invalid_argument("annotate: triangle " + std::to_string(t) + " has a non-finite vertex");
+  return total_pairs;
+}
 
-  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, node_count / 64)));
-
-  std::vector<std::uint8_t> counts(node_count, 0);
-  std::vector<Worker> workers(threads);
-
+/// Runs body(thread id, first, last) over [0, items) in chunks of `chunk`, on `threads` threads (the
+/// calling one among them). The first exception stops the others from taking more chunks and is rethrown.
+template <class Body>
+void run_parallel(unsigned threads, std::size_t items, std::size_t chunk, Body&& body) {
   std::atomic<std::size_t> next{0};
-  std::atomic<std::size_t> done_pairs{0};
   std::atomic<bool> failed{false};
   std::exception_ptr error;
-  std::mutex mutex;  // guards `error` and the progress callback
-  std::atomic<std::size_t> reported{0};
-  const std::size_t report_step = std::max<std::size_t>(1, total_pairs / 200);
-
-  auto run_parallel = [&](auto&& body, std::size_t items, std::size_t chunk) {
-    next = 0;
-    auto worker = [&](unsigned id) {
-      try {
-        for (;;) {
-          if (failed) return;
-          const std::size_t first = next.fetch_add(chunk);
-          if (first >= items) return;
-          body(id, first, std::min(items, first + chunk));
-        }
-      } catch (...) {
-        std::lock_guard lock(mutex);
-        if (!error) error = std::current_exception();
-        failed = true;
+  std::mutex mutex;  // guards `error`
+  auto worker = [&](unsigned id) {
+    try {
+      for (;;) {
+        if (failed) return;
+        const std::size_t first = next.fetch_add(chunk);
+        if (first >= items) return;
+        body(id, first, std::min(items, first + chunk));
       }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned id = 1; id < threads; ++id) pool.emplace_back(worker, id);
-    worker(0);
-    for (auto& th : pool) th.join();
-    if (error) std::rethrow_exception(error);
+    } catch (...) {
+      std::lock_guard lock(mutex);
+      if (!error) error = std::current_exception();
+      failed = true;
+    }
   };
+  std::vector<std::thread> pool;
+  for (unsigned id = 1; id < threads; ++id) pool.emplace_back(worker, id);
+  worker(0);
+  for (auto& th : pool) th.join();
+  if (error) std::rethrow_exception(error);
+}
 
-  if (shared_infos) {
-    shared_infos->resize(triangles.size());
-    run_parallel(
-        [&](unsigned, std::size_t first, std::size_t last) {
-          for (std::size_t t = first; t < last; ++t) (*shared_infos)[t] = make_info(triangles[t]);
-        },
-        triangles.size(), 4096);
-  }
-
-  run_parallel(
-      [&](unsigned id, std::size_t first, std::size_t last) {
-        std::size_t pairs = 0;
-        for (std::size_t n = first; n < last; ++n) {
-          counts[n] = count(workers[id], static_cast<std::uint32_t>(n));
-          pairs += node_ranges[n].second - node_ranges[n].first;
-        }
-        const std::size_t done = done_pairs.fetch_add(pairs) + pairs;
-        if (options.progress && done >= reported.load() + report_step) {
-          std::lock_guard lock(mutex);
-          if (done > reported.load()) {
-            reported = done;
-            options.progress(done, total_pairs);
-          }
-        }
-      },
-      node_count, 16);
-  if (options.progress) options.progress(total_pairs, total_pairs);
-
-  CellCounts out;
-  out.counts = std::move(counts);
-  AnnotateStats& s = out.stats;
-  s.threads = threads;
-  s.nodes = node_count;
-  s.triangle_node_pairs = total_pairs;
+/// The run's statistics: the workers' counters summed.
+AnnotateStats sum_stats(const std::vector<Worker>& workers) {
+  AnnotateStats s;
   for (const Worker& w : workers) {
     const ThreadStats& t = w.stats;
     s.fast_path_triangles += t.fast;
@@ -400,6 +391,60 @@ CellCounts count_all(std::size_t node_count,
     s.degenerate_triangles += t.degenerate;
     s.exact_cells += t.exact_cells;
   }
+  return s;
+}
+
+/// Checks the shared arguments, then counts every node with count(worker, node) over the threads, with
+/// progress and statistics. `shared_infos`: the triangles' infos are computed first (for count_node).
+template <class CountNode>
+CellCounts count_all(std::size_t node_count,
+                     std::span<const std::pair<std::uint32_t, std::uint32_t>> node_ranges,
+                     std::span<const TrianglePoints> triangles, int grid, const AnnotateOptions& options,
+                     std::vector<TriangleInfo>* shared_infos, CountNode&& count) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t total_pairs = check_arguments(node_count, node_ranges, triangles, grid, options);
+
+  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, node_count / 64)));
+
+  std::vector<std::uint8_t> counts(node_count, 0);
+  std::vector<Worker> workers(threads);
+
+  if (shared_infos) {
+    shared_infos->resize(triangles.size());
+    run_parallel(threads, triangles.size(), 4096, [&](unsigned, std::size_t first, std::size_t last) {
+      for (std::size_t t = first; t < last; ++t) (*shared_infos)[t] = make_info(triangles[t]);
+    });
+  }
+
+  std::atomic<std::size_t> done_pairs{0};
+  std::atomic<std::size_t> reported{0};
+  std::mutex progress_mutex;  // one progress callback at a time, never moving backwards
+  const std::size_t report_step = std::max<std::size_t>(1, total_pairs / 200);
+  run_parallel(threads, node_count, 16, [&](unsigned id, std::size_t first, std::size_t last) {
+    std::size_t pairs = 0;
+    for (std::size_t n = first; n < last; ++n) {
+      counts[n] = count(workers[id], static_cast<std::uint32_t>(n));
+      pairs += node_ranges[n].second - node_ranges[n].first;
+    }
+    const std::size_t done = done_pairs.fetch_add(pairs) + pairs;
+    if (options.progress && done >= reported.load() + report_step) {
+      std::lock_guard lock(progress_mutex);
+      if (done > reported.load()) {
+        reported = done;
+        options.progress(done, total_pairs);
+      }
+    }
+  });
+  if (options.progress) options.progress(total_pairs, total_pairs);
+
+  CellCounts out;
+  out.counts = std::move(counts);
+  out.stats = sum_stats(workers);
+  AnnotateStats& s = out.stats;
+  s.threads = threads;
+  s.nodes = node_count;
+  s.triangle_node_pairs = total_pairs;
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

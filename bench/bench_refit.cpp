@@ -275,6 +275,54 @@ void crossover(const Mesh& rest, Deformation d) {
   }
 }
 
+// The deforming object's frames, B's pose in each and CGAL's answer, for FCL also the frames' points.
+void add_frames(Scene& scene, const Deformation& deformation, double distance, int frames) {
+  for (int f = 0; f < frames; ++f) {
+    scene.frames.push_back(deform(scene.rest, deformation, frame_time(f, frames)));
+    scene.poses.push_back(protocol_pose(distance, f, frames));
+    scene.truth.push_back(CgalGroundTruth(scene.frames.back(), scene.rest).collides(scene.poses.back()));
+#ifdef BVHLAB_HAVE_FCL
+    scene.fcl_frames.push_back(fcl_points(scene.frames.back()));
+#endif
+  }
+#ifdef BVHLAB_HAVE_FCL
+  scene.fcl_triangles = fcl_triangles(scene.rest);
+#endif
+  std::fprintf(stderr, "bench_refit: %ld of %d frames collide (CGAL)\n",
+               std::count(scene.truth.begin(), scene.truth.end(), 1), frames);
+}
+
+// Registers every series of every volume (checking each answer first); returns the wrong bvhlab answers.
+int register_series(const std::shared_ptr<const Scene>& scene, const std::vector<std::string>& volumes) {
+  int bvhlab_wrong = 0;
+  for (const auto& v : volumes) {
+    with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_bvhlab<BV>(scene, bvhlab_wrong); });
+#ifdef BVHLAB_HAVE_FCL
+    if (v == "aabb") register_fcl<fcl::AABBd>(scene, v);
+    if (v == "obb") register_fcl<fcl::OBBd>(scene, v);
+    if (v == "dop24") register_fcl<fcl::KDOPd<24>>(scene, v);
+#endif
+  }
+  return bvhlab_wrong;
+}
+
+// The table after the run: bvhlab against FCL per volume.
+void print_ratios(const RatioReporter& reporter, const std::vector<std::string>& volumes, int frames) {
+  std::printf("\nbvhlab / FCL (median CPU ms per pass of %d frames):\n", frames);
+  std::printf("%-6s %12s %12s %12s %12s %12s %12s %12s %12s %12s\n", "bv", "refit_merge", "refit_fit",
+              "fcl_refit", "merge/fcl", "fit/fcl", "rebuild", "fcl_rebuild", "refit_only", "fcl_ref_only");
+  for (const auto& v : volumes) {
+    const double merge = reporter.median("bvhlab/refit_merge/" + v),
+                 fit = reporter.median("bvhlab/refit_fit/" + v);
+    const double fcl = reporter.median("fcl/refit/" + v);
+    const double rebuild = reporter.median("bvhlab/rebuild/" + v),
+                 fcl_rebuild = reporter.median("fcl/rebuild/" + v);
+    std::printf("%-6s %12.2f %12.2f %12.2f %12.3f %12.3f %12.2f %12.2f %12.2f %12.2f\n", v.c_str(), merge,
+                fit, fcl, fcl > 0 ? merge / fcl : 0.0, fcl > 0 ? fit / fcl : 0.0, rebuild, fcl_rebuild,
+                reporter.median("bvhlab/refit_only/" + v), reporter.median("fcl/refit_only/" + v));
+  }
+}
+
 }  // namespace
 }  // namespace bvhlab
 
@@ -319,48 +367,14 @@ int main(int argc, char** argv) {
       with_volume(v, [&]<class BV>(std::type_identity<BV>) { crossover<BV>(scene->rest, deformation); });
     return 0;
   }
-  for (int f = 0; f < frames; ++f) {
-    scene->frames.push_back(deform(scene->rest, deformation, frame_time(f, frames)));
-    scene->poses.push_back(protocol_pose(distance, f, frames));
-    scene->truth.push_back(CgalGroundTruth(scene->frames.back(), scene->rest).collides(scene->poses.back()));
-#ifdef BVHLAB_HAVE_FCL
-    scene->fcl_frames.push_back(fcl_points(scene->frames.back()));
-#endif
-  }
-#ifdef BVHLAB_HAVE_FCL
-  scene->fcl_triangles = fcl_triangles(scene->rest);
-#endif
-  std::fprintf(stderr, "bench_refit: %ld of %d frames collide (CGAL)\n",
-               std::count(scene->truth.begin(), scene->truth.end(), 1), frames);
-
-  int bvhlab_wrong = 0;
-  for (const auto& v : volumes) {
-    with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_bvhlab<BV>(scene, bvhlab_wrong); });
-#ifdef BVHLAB_HAVE_FCL
-    if (v == "aabb") register_fcl<fcl::AABBd>(scene, v);
-    if (v == "obb") register_fcl<fcl::OBBd>(scene, v);
-    if (v == "dop24") register_fcl<fcl::KDOPd<24>>(scene, v);
-#endif
-  }
-  if (bvhlab_wrong > 0) {
+  add_frames(*scene, deformation, distance, frames);
+  if (const int bvhlab_wrong = register_series(scene, volumes); bvhlab_wrong > 0) {
     std::fprintf(stderr, "bench_refit: %d bvhlab answers differ from CGAL\n", bvhlab_wrong);
     return 1;
   }
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  std::printf("\nbvhlab / FCL (median CPU ms per pass of %d frames):\n", frames);
-  std::printf("%-6s %12s %12s %12s %12s %12s %12s %12s %12s %12s\n", "bv", "refit_merge", "refit_fit",
-              "fcl_refit", "merge/fcl", "fit/fcl", "rebuild", "fcl_rebuild", "refit_only", "fcl_ref_only");
-  for (const auto& v : volumes) {
-    const double merge = reporter.median("bvhlab/refit_merge/" + v),
-                 fit = reporter.median("bvhlab/refit_fit/" + v);
-    const double fcl = reporter.median("fcl/refit/" + v);
-    const double rebuild = reporter.median("bvhlab/rebuild/" + v),
-                 fcl_rebuild = reporter.median("fcl/rebuild/" + v);
-    std::printf("%-6s %12.2f %12.2f %12.2f %12.3f %12.3f %12.2f %12.2f %12.2f %12.2f\n", v.c_str(), merge,
-                fit, fcl, fcl > 0 ? merge / fcl : 0.0, fcl > 0 ? fit / fcl : 0.0, rebuild, fcl_rebuild,
-                reporter.median("bvhlab/refit_only/" + v), reporter.median("fcl/refit_only/" + v));
-  }
+  print_ratios(reporter, volumes, frames);
   benchmark::Shutdown();
   return 0;
 }

@@ -230,45 +230,43 @@ void write_calibration_csv(const RunOutput& run, const std::filesystem::path& fi
   if (!out) throw std::runtime_error(file.string() + ": write error");
 }
 
-json results_document(const RunOutput& run) {
-  const Environment& env = run.environment;
-  const RunStats& s = run.stats;
-  json doc;
-  doc["scene"] = {{"name", run.scene_name}, {"file", run.scene_file.string()}};
-  doc["environment"] = {{"machine", env.machine},
-                        {"compiler", env.compiler},
-                        {"build_type", env.build_type},
-                        {"git_commit", env.git_commit},
-                        {"timestamp", env.timestamp}};
-  doc["stats"] = {{"meshes_loaded", s.meshes_loaded},
-                  {"trees_built", s.trees_built},
-                  {"trees_annotated", s.trees_annotated},
-                  {"annotation_clip_calls", s.annotation_clip_calls},
-                  {"tree_cache_hits", s.tree_cache_hits},
-                  {"tree_cache_rejected", s.tree_cache_rejected},
-                  {"tree_cache_stored", s.tree_cache_stored},
-                  {"fcl_models_built", s.fcl_models_built},
-                  {"truth_computed", s.truth_computed},
-                  {"truth_cache_hits", s.truth_cache_hits},
-                  {"truth_cache_rejected", s.truth_cache_rejected},
-                  {"calibration_fitted", s.calibration_fitted},
-                  {"calibration_cache_hits", s.calibration_cache_hits},
-                  {"cgal_checked", s.cgal_checked},
-                  {"cgal_mismatches", s.cgal_mismatches},
-                  {"queries", s.queries},
-                  {"preprocess_seconds", s.preprocess_seconds},
-                  {"truth_seconds", s.truth_seconds},
-                  {"query_seconds", s.query_seconds},
-                  {"wall_seconds", s.wall_seconds},
-                  {"clock_overhead_us", s.clock_overhead_us},
-                  {"timing_repeats", s.timing_repeats},
-                  {"timing_statistic", s.timing_statistic},
-                  {"timed_samples", s.timed_samples},
-                  {"stalled_samples", s.stalled_samples},
-                  {"sampled_seconds", s.sampled_seconds},
-                  {"stall_lost_seconds", s.stall_lost_seconds},
-                  {"involuntary_switches", s.involuntary_switches},
-                  {"skipped", s.skipped}};
+namespace {
+
+/// results.json's "stats": the run's counters and times.
+json stats_json(const RunStats& s) {
+  return {{"meshes_loaded", s.meshes_loaded},
+          {"trees_built", s.trees_built},
+          {"trees_annotated", s.trees_annotated},
+          {"annotation_clip_calls", s.annotation_clip_calls},
+          {"tree_cache_hits", s.tree_cache_hits},
+          {"tree_cache_rejected", s.tree_cache_rejected},
+          {"tree_cache_stored", s.tree_cache_stored},
+          {"fcl_models_built", s.fcl_models_built},
+          {"truth_computed", s.truth_computed},
+          {"truth_cache_hits", s.truth_cache_hits},
+          {"truth_cache_rejected", s.truth_cache_rejected},
+          {"calibration_fitted", s.calibration_fitted},
+          {"calibration_cache_hits", s.calibration_cache_hits},
+          {"cgal_checked", s.cgal_checked},
+          {"cgal_mismatches", s.cgal_mismatches},
+          {"queries", s.queries},
+          {"preprocess_seconds", s.preprocess_seconds},
+          {"truth_seconds", s.truth_seconds},
+          {"query_seconds", s.query_seconds},
+          {"wall_seconds", s.wall_seconds},
+          {"clock_overhead_us", s.clock_overhead_us},
+          {"timing_repeats", s.timing_repeats},
+          {"timing_statistic", s.timing_statistic},
+          {"timed_samples", s.timed_samples},
+          {"stalled_samples", s.stalled_samples},
+          {"sampled_seconds", s.sampled_seconds},
+          {"stall_lost_seconds", s.stall_lost_seconds},
+          {"involuntary_switches", s.involuntary_switches},
+          {"skipped", s.skipped}};
+}
+
+/// results.json's "models": one entry per tree the run built or loaded.
+json models_json(const RunOutput& run) {
   json models = json::array();
   for (const ModelInfo& m : run.models)
     models.push_back({{"object", m.object},
@@ -283,19 +281,11 @@ json results_document(const RunOutput& run) {
                       {"build_seconds", m.build_seconds},
                       {"annotate_seconds", m.annotate_seconds},
                       {"from_cache", m.from_cache}});
-  doc["models"] = models;
-  json truth = json::array();
-  for (const TruthSummary& t : run.truth)
-    truth.push_back(
-        {{"mesh", t.mesh}, {"distance", t.distance}, {"poses", t.poses}, {"colliding", t.colliding}});
-  doc["ground_truth"] = truth;
-  json rows = json::array();
-  for (const ResultRow& r : run.rows) {
-    json row = json::object();
-    for (const RowField& f : row_fields()) row[f.name] = f.value(r);
-    rows.push_back(std::move(row));
-  }
-  doc["rows"] = rows;
+  return models;
+}
+
+/// results.json's "calibration": calibration.csv's bins, with null for a missing p_min or number.
+json calibration_json(const RunOutput& run) {
   json cal = json::array();
   for (const CalibrationBin& c : run.calibration)
     cal.push_back({{"mesh", c.mesh},
@@ -309,7 +299,35 @@ json results_document(const RunOutput& run) {
                    {"count", c.count},
                    {"mean_probability", optional_number(c.mean_probability)},
                    {"collision_frequency", optional_number(c.collision_frequency)}});
-  doc["calibration"] = cal;
+  return cal;
+}
+
+}  // namespace
+
+json results_document(const RunOutput& run) {
+  const Environment& env = run.environment;
+  json doc;
+  doc["scene"] = {{"name", run.scene_name}, {"file", run.scene_file.string()}};
+  doc["environment"] = {{"machine", env.machine},
+                        {"compiler", env.compiler},
+                        {"build_type", env.build_type},
+                        {"git_commit", env.git_commit},
+                        {"timestamp", env.timestamp}};
+  doc["stats"] = stats_json(run.stats);
+  doc["models"] = models_json(run);
+  json truth = json::array();
+  for (const TruthSummary& t : run.truth)
+    truth.push_back(
+        {{"mesh", t.mesh}, {"distance", t.distance}, {"poses", t.poses}, {"colliding", t.colliding}});
+  doc["ground_truth"] = truth;
+  json rows = json::array();
+  for (const ResultRow& r : run.rows) {
+    json row = json::object();
+    for (const RowField& f : row_fields()) row[f.name] = f.value(r);
+    rows.push_back(std::move(row));
+  }
+  doc["rows"] = rows;
+  doc["calibration"] = calibration_json(run);
   doc["policies"] = policies_json();
   return doc;
 }
