@@ -212,14 +212,6 @@ struct SavedTreeInfo {
 /// Reads a saved tree (adb/saved_tree.hpp) and describes it. Throws SavedTreeError naming the file for
 /// anything that is not one, or names a BV or density this build does not know.
 SavedTreeInfo peek_saved_tree(const std::filesystem::path& file);
-/// A saved-tree file's bytes and its checked header.
-struct SavedTreeFile {
-  std::vector<std::byte> bytes;
-  saved_tree_detail::Header header;
-};
-/// Reads a saved-tree file and checks its header; a BV or density this build does not know is refused by
-/// name. Throws SavedTreeError naming the file.
-SavedTreeFile read_saved_tree(const std::filesystem::path& file);
 /// Whether `file` starts like a saved tree (so the CLI can take trees and meshes alike).
 bool is_saved_tree(const std::filesystem::path& file);
 

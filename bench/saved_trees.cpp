@@ -19,19 +19,6 @@ bool is_saved_tree(const std::filesystem::path& file) {
   return in.read(magic, 8) && std::string_view(magic, 8) == "BVHLTREE";
 }
 
-SavedTreeFile read_saved_tree(const std::filesystem::path& file) {
-  SavedTreeFile out;
-  out.bytes = saved_tree_detail::read_file(file);
-  out.header = saved_tree_detail::read_header(out.bytes, file.string());
-  try {
-    check_volume_name(out.header.bv_name);
-    (void)density_info(out.header.density_name);
-  } catch (const std::invalid_argument& e) {
-    throw SavedTreeError("saved tree '" + file.string() + "': " + e.what());
-  }
-  return out;
-}
-
 SavedTreeInfo peek_saved_tree(const std::filesystem::path& file) {
   const AnyTree tree = AnyTree::load(file);
   SavedTreeInfo info;

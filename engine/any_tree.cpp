@@ -70,26 +70,37 @@ AnyTree AnyTree::build_points(const UnitCloud& cloud, const std::string& bv, con
   return AnyTree(ops_of(bv, density.name).build_points(cloud, density, options));
 }
 
-AnyTree AnyTree::from_bytes(std::span<const std::byte> bytes, const std::string& source, const Mesh* mesh) {
-  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, source);
-  const PairOps* ops = nullptr;
+namespace {
+
+/// The operations of the volume and density a saved tree's header names; SavedTreeError naming `source`
+/// for names this build does not know.
+const PairOps& saved_ops(const saved_tree_detail::Header& header, const std::string& source) {
   try {
-    ops = &ops_of(header.bv_name, header.density_name);
+    return ops_of(header.bv_name, header.density_name);
   } catch (const std::invalid_argument& e) {
     throw SavedTreeError("saved tree '" + source + "': " + e.what());
   }
-  return AnyTree(ops->load(bytes, source, mesh, MeshUnits{header.units, 1}));
+}
+
+}  // namespace
+
+AnyTree AnyTree::from_bytes(std::span<const std::byte> bytes, const std::string& source, const Mesh* mesh) {
+  const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, source);
+  return AnyTree(saved_ops(header, source).load(bytes, source, mesh, MeshUnits{header.units, 1}));
 }
 
 AnyTree AnyTree::load(const fs::path& file, const UnitMesh* mesh) {
   const std::vector<std::byte> bytes = saved_tree_detail::read_file(file);
   const saved_tree_detail::Header header = saved_tree_detail::read_header(bytes, file.string());
-  if (mesh) check_mesh_units(MeshUnits{header.units, 1}, *mesh, file);
+  const PairOps& ops = saved_ops(header, file.string());
+  const MeshUnits units{header.units, 1};
+  if (mesh) check_mesh_units(units, *mesh, file);
   try {
-    return from_bytes(bytes, file.string(), mesh);
+    return AnyTree(ops.load(bytes, file.string(), mesh, units));
   } catch (const SavedTreeError&) {
     throw;
   } catch (const std::runtime_error& e) {  // the structural checks of the mesh's fit
+    if (!mesh) throw;
     throw std::invalid_argument("saved tree '" + file.string() + "' does not fit mesh '" + mesh->name +
                                 "': " + e.what());
   }
