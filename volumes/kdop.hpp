@@ -138,118 +138,147 @@ struct Tables {
   }
 };
 
+/// The convex polytope clipped_box_volume cuts down: its faces as point lists, in two buffers that swap at
+/// every cut. Fixed sizes, no allocation: a face gains at most one vertex per cut, so it never has more than
+/// 4 + kPlanes vertices, and there are at most kPlanes faces.
+template <std::size_t Axes>
+class BoxClip {
+ public:
+  static constexpr std::size_t kPlanes = 2 * Axes;
+
+  /// The box [lo, hi]: for each axis a and side, the face's four corners in cyclic order, on plane a (the
+  /// upper side) or a + Axes (the lower).
+  void start(const Vec3& lo, const Vec3& hi) {
+    current_ = 0;
+    point_count_ = face_count_ = 0;
+    for (std::size_t a = 0; a < 3; ++a)
+      for (int side = 0; side < 2; ++side) {
+        const std::size_t b = (a + 1) % 3, c = (a + 2) % 3;
+        const double uv[4][2] = {{lo[b], lo[c]}, {hi[b], lo[c]}, {hi[b], hi[c]}, {lo[b], hi[c]}};
+        faces_[0][face_count_++] = {side == 0 ? a : a + Axes, point_count_, 4};
+        for (const auto& corner : uv) {
+          Vec3& x = points_[0][point_count_++];
+          x[a] = side == 0 ? hi[a] : lo[a];
+          x[b] = corner[0];
+          x[c] = corner[1];
+        }
+      }
+  }
+
+  /// Keeps the part with n . x <= offset (plane `plane`), points within `tol` counting as on it. Returns
+  /// false when nothing is left.
+  bool cut(const Vec3& n, double offset, std::size_t plane, double tol) {
+    double farthest = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < point_count_; ++k) {
+      distance_[k] = n.dot(points_[current_][k]) - offset;
+      farthest = std::max(farthest, distance_[k]);
+    }
+    if (farthest <= tol) return true;  // the plane does not cut
+    clip_faces(tol);
+    if (cap_count_ >= 3 && next_count_ + cap_count_ <= kMaxPoints && next_face_count_ < kPlanes)
+      close_cut(n, plane);
+    current_ = 1 - current_;
+    point_count_ = next_count_;
+    face_count_ = next_face_count_;
+    return face_count_ != 0;
+  }
+
+  /// sum over the faces of offset_m * area_m / 3 (divergence theorem).
+  double volume(const std::array<Vec3, kPlanes>& normals, const std::array<double, kPlanes>& offsets) const {
+    double volume = 0;
+    for (std::size_t f = 0; f < face_count_; ++f) {
+      const Face& face = faces_[current_][f];
+      const Vec3* p = points_[current_].data() + face.begin;
+      Vec3 twice_area = Vec3::Zero();
+      for (std::size_t k = 1; k + 1 < face.count; ++k) twice_area += (p[k] - p[0]).cross(p[k + 1] - p[0]);
+      volume += offsets[face.plane] * std::abs(normals[face.plane].dot(twice_area)) / 6;
+    }
+    return volume;
+  }
+
+ private:
+  static constexpr std::size_t kMaxPoints = kPlanes * (kPlanes + 4);
+  struct Face {
+    std::size_t plane, begin, count;
+  };
+
+  /// Each face clipped into the other buffer (faces left with fewer than 3 points dropped); the points on
+  /// the cut collected in cap_.
+  void clip_faces(double tol) {
+    const Vec3* points = points_[current_].data();
+    Vec3* next = points_[1 - current_].data();
+    next_count_ = next_face_count_ = cap_count_ = 0;
+    for (std::size_t f = 0; f < face_count_; ++f) {
+      const Face& face = faces_[current_][f];
+      const std::size_t begin = next_count_;
+      for (std::size_t k = 0; k < face.count; ++k) {
+        const std::size_t i = face.begin + k, j = face.begin + (k + 1 == face.count ? 0 : k + 1);
+        const double dp = distance_[i], dq = distance_[j];
+        if (dp <= tol) {
+          next[next_count_++] = points[i];
+          if (dp >= -tol) cap_[cap_count_++] = points[i];
+        }
+        if ((dp < -tol && dq > tol) || (dp > tol && dq < -tol)) {
+          const Vec3 x = points[i] + (points[j] - points[i]) * (dp / (dp - dq));
+          next[next_count_++] = x;
+          cap_[cap_count_++] = x;
+        }
+      }
+      if (next_count_ - begin >= 3)
+        faces_[1 - current_][next_face_count_++] = {face.plane, begin, next_count_ - begin};
+      else
+        next_count_ = begin;
+    }
+  }
+
+  /// The cut face: its points lie on a convex polygon; ordered by (pseudo-)angle about their mean.
+  void close_cut(const Vec3& n, std::size_t plane) {
+    const Vec3 e1 = n.unitOrthogonal(), e2 = n.cross(e1);
+    Vec3 mean = Vec3::Zero();
+    for (std::size_t k = 0; k < cap_count_; ++k) mean += cap_[k];
+    mean /= double(cap_count_);
+    for (std::size_t k = 0; k < cap_count_; ++k) {
+      const double u = e1.dot(cap_[k] - mean), v = e2.dot(cap_[k] - mean);
+      // Monotone in the angle, without atan2: position on the unit diamond's perimeter, in [0, 4).
+      const double r = std::abs(u) + std::abs(v);
+      const double p = r > 0 ? v / r : 0;
+      order_[k] = {u >= 0 ? (v >= 0 ? p : 4 + p) : 2 - p, k};
+    }
+    std::sort(order_.begin(), order_.begin() + cap_count_);
+    faces_[1 - current_][next_face_count_++] = {plane, next_count_, cap_count_};
+    Vec3* next = points_[1 - current_].data();
+    for (std::size_t k = 0; k < cap_count_; ++k) next[next_count_++] = cap_[order_[k].second];
+  }
+
+  std::array<Vec3, kMaxPoints> points_[2], cap_;
+  std::array<double, kMaxPoints> distance_;
+  std::array<std::pair<double, std::size_t>, kMaxPoints> order_;
+  std::array<Face, kPlanes> faces_[2];
+  int current_ = 0;
+  std::size_t point_count_ = 0, face_count_ = 0, next_count_ = 0, next_face_count_ = 0, cap_count_ = 0;
+};
+
 /// Lebesgue measure of {x : n_m . x <= d_m for all m}, where planes a and a + Axes (a < 3) are the
 /// bounding box's. Clips the box by the other planes one at a time (each face polygon clipped, the cut
-/// closed by a new face), then sums d_m * area(face m) / 3 (divergence theorem). Bvh computes it for every
-/// node at build time, so it works in fixed per-thread buffers: no allocation.
+/// closed by a new face), then sums d_m * area(face m) / 3. Bvh computes it for every node at build time,
+/// so it works in a per-thread BoxClip: no allocation.
 template <std::size_t Axes>
 double clipped_box_volume(const std::array<Vec3, 2 * Axes>& normals,
                           const std::array<double, 2 * Axes>& world_offsets, const Box& world_box) {
   constexpr std::size_t kPlanes = 2 * Axes;
-  // A face is a convex polygon; each clip adds at most one vertex to it, so it never has more than
-  // 4 + kPlanes vertices, and there are at most kPlanes faces.
-  constexpr std::size_t kMaxPoints = kPlanes * (kPlanes + 4);
-  struct Face {
-    std::size_t plane, begin, count;
-  };
-  struct Scratch {
-    std::array<Vec3, kMaxPoints> points[2], cap;
-    std::array<double, kMaxPoints> distance;
-    std::array<std::pair<double, std::size_t>, kMaxPoints> order;
-    std::array<Face, kPlanes> faces[2];
-  };
-  thread_local Scratch scratch;
-  Scratch& s = scratch;
-
+  thread_local BoxClip<Axes> clip;
   // Work about the box's centre: sum d_m * area_m cancels badly for a small polytope far from the origin.
   const Vec3 center = world_box.center();
-  const Vec3 lo = world_box.min - center, hi = world_box.max - center;
   std::array<double, kPlanes> offsets;
   for (std::size_t m = 0; m < kPlanes; ++m) offsets[m] = world_offsets[m] - normals[m].dot(center);
   const double tol = 1e-12 * (world_box.extent().maxCoeff() + world_box.min.cwiseAbs().maxCoeff() +
                               world_box.max.cwiseAbs().maxCoeff());
-
-  int current = 0;
-  std::size_t point_count = 0, face_count = 0;
-  // The box: for each axis a and side, the face's four corners in cyclic order.
-  for (std::size_t a = 0; a < 3; ++a)
-    for (int side = 0; side < 2; ++side) {
-      const std::size_t b = (a + 1) % 3, c = (a + 2) % 3;
-      const double uv[4][2] = {{lo[b], lo[c]}, {hi[b], lo[c]}, {hi[b], hi[c]}, {lo[b], hi[c]}};
-      s.faces[0][face_count++] = {side == 0 ? a : a + Axes, point_count, 4};
-      for (const auto& corner : uv) {
-        Vec3& x = s.points[0][point_count++];
-        x[a] = side == 0 ? hi[a] : lo[a];
-        x[b] = corner[0];
-        x[c] = corner[1];
-      }
-    }
+  clip.start(world_box.min - center, world_box.max - center);
   for (std::size_t m = 3; m < kPlanes; ++m) {
     if (m >= Axes && m < Axes + 3) continue;  // the box's own planes
-    const Vec3& n = normals[m];
-    const double offset = offsets[m];
-    const Vec3* points = s.points[current].data();
-    double farthest = -std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < point_count; ++k) {
-      s.distance[k] = n.dot(points[k]) - offset;
-      farthest = std::max(farthest, s.distance[k]);
-    }
-    if (farthest <= tol) continue;  // the plane does not cut
-    Vec3* next = s.points[1 - current].data();
-    Face* next_faces = s.faces[1 - current].data();
-    std::size_t next_count = 0, next_face_count = 0, cap_count = 0;
-    for (std::size_t f = 0; f < face_count; ++f) {
-      const Face& face = s.faces[current][f];
-      const std::size_t begin = next_count;
-      for (std::size_t k = 0; k < face.count; ++k) {
-        const std::size_t i = face.begin + k, j = face.begin + (k + 1 == face.count ? 0 : k + 1);
-        const double dp = s.distance[i], dq = s.distance[j];
-        if (dp <= tol) {
-          next[next_count++] = points[i];
-          if (dp >= -tol) s.cap[cap_count++] = points[i];
-        }
-        if ((dp < -tol && dq > tol) || (dp > tol && dq < -tol)) {
-          const Vec3 x = points[i] + (points[j] - points[i]) * (dp / (dp - dq));
-          next[next_count++] = x;
-          s.cap[cap_count++] = x;
-        }
-      }
-      if (next_count - begin >= 3)
-        next_faces[next_face_count++] = {face.plane, begin, next_count - begin};
-      else
-        next_count = begin;
-    }
-    if (cap_count >= 3 && next_count + cap_count <= kMaxPoints && next_face_count < kPlanes) {
-      // The cut face: its points are on a convex polygon; order them by (pseudo-)angle about their mean.
-      const Vec3 e1 = n.unitOrthogonal(), e2 = n.cross(e1);
-      Vec3 mean = Vec3::Zero();
-      for (std::size_t k = 0; k < cap_count; ++k) mean += s.cap[k];
-      mean /= double(cap_count);
-      for (std::size_t k = 0; k < cap_count; ++k) {
-        const double u = e1.dot(s.cap[k] - mean), v = e2.dot(s.cap[k] - mean);
-        // Monotone in the angle, without atan2: position on the unit diamond's perimeter, in [0, 4).
-        const double r = std::abs(u) + std::abs(v);
-        const double p = r > 0 ? v / r : 0;
-        s.order[k] = {u >= 0 ? (v >= 0 ? p : 4 + p) : 2 - p, k};
-      }
-      std::sort(s.order.begin(), s.order.begin() + cap_count);
-      next_faces[next_face_count++] = {m, next_count, cap_count};
-      for (std::size_t k = 0; k < cap_count; ++k) next[next_count++] = s.cap[s.order[k].second];
-    }
-    current = 1 - current;
-    point_count = next_count;
-    face_count = next_face_count;
-    if (face_count == 0) return 0;
+    if (!clip.cut(normals[m], offsets[m], m, tol)) return 0;
   }
-  double volume = 0;
-  for (std::size_t f = 0; f < face_count; ++f) {
-    const Face& face = s.faces[current][f];
-    const Vec3* p = s.points[current].data() + face.begin;
-    Vec3 twice_area = Vec3::Zero();
-    for (std::size_t k = 1; k + 1 < face.count; ++k) twice_area += (p[k] - p[0]).cross(p[k + 1] - p[0]);
-    volume += offsets[face.plane] * std::abs(normals[face.plane].dot(twice_area)) / 6;
-  }
-  return volume;
+  return clip.volume(normals, offsets);
 }
 
 inline bool all_finite(std::span<const Vec3> points) {
