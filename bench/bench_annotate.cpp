@@ -14,7 +14,7 @@
 #include "adb/saved_tree.hpp"
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/generators.hpp"
-#include "bench/core/mesh_catalog.hpp"
+#include "engine/mesh_catalog.hpp"
 #include "volumes/aabb.hpp"
 
 #include <benchmark/benchmark.h>

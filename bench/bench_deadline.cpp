@@ -14,8 +14,8 @@
 //                  [benchmark flags]
 #include "adb/adb_density.hpp"
 #include "bench/core/bench_flags.hpp"
-#include "bench/core/mesh_catalog.hpp"
-#include "bench/core/protocol.hpp"
+#include "engine/mesh_catalog.hpp"
+#include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/adb.hpp"
 

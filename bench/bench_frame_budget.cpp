@@ -15,7 +15,7 @@
 // set it to p_min for the strict rule).
 #include "adb/adb_density.hpp"
 #include "bench/core/bench_flags.hpp"
-#include "bench/core/mesh_catalog.hpp"
+#include "engine/mesh_catalog.hpp"
 #include "traversal/exact.hpp"
 #include "traversal/frame_budget.hpp"
 #include "volumes/aabb.hpp"

@@ -1,13 +1,13 @@
 // Point clouds on the tumbling protocol, as tables on stdout: each mesh against a copy of itself, clouds
-// sampled from it at several densities. The measuring is bench/points.cpp (its header says what is counted
-// and timed), the one `bvhlab report` runs on a scene with "points" (bench/scenes/points.json); this
+// sampled from it at several densities. The measuring is bench/points/run.cpp (its header says what is
+// counted and timed), the one `bvhlab report` runs on a scene with "points" (bench/scenes/points.json); this
 // program takes its parameters as flags instead of a scene.
 //
 //   bench_points [--meshes=pinion.off] [--points=5000,20000] [--steps=200] [--band=1]
 //                [--p-min=0.5,0.7,0.9,0.95,0.99] [--distances=0.4,...,2.0] [--leaf=16] [--octree-res=1,2]
 #include "bench/core/bench_flags.hpp"
-#include "bench/core/mesh_catalog.hpp"
-#include "bench/points.hpp"
+#include "bench/points/points.hpp"
+#include "engine/mesh_catalog.hpp"
 
 #include <cmath>
 #include <cstdio>

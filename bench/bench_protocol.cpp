@@ -6,8 +6,8 @@
 // Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
 // protocol's mean time per query. Counters: BV tests and triangle tests per query, bytes per triangle.
 #include "bench/core/bench_flags.hpp"
-#include "bench/core/mesh_catalog.hpp"
-#include "bench/core/protocol.hpp"
+#include "engine/mesh_catalog.hpp"
+#include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/exact.hpp"
 

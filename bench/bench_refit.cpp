@@ -25,10 +25,10 @@
 // exact query time over protocol poses on both trees; that is how kRebuildDegradation was chosen.
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/ground_truth.hpp"
-#include "bench/core/mesh_catalog.hpp"
-#include "bench/core/protocol.hpp"
 #include "bvh/deform.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/mesh_catalog.hpp"
+#include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/exact.hpp"
 

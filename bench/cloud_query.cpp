@@ -1,7 +1,7 @@
 #include "bench/cloud_query.hpp"
 
-#include "bench/measure.hpp"
-#include "bench/prepare.hpp"
+#include "bench/pairs/measure.hpp"
+#include "bench/pairs/prepare.hpp"
 #include "bvh/mesh_io.hpp"
 #include "engine/any_tree.hpp"
 

@@ -1,10 +1,10 @@
 #include "bench/experiment.hpp"
 
-#include "bench/deform.hpp"
-#include "bench/points.hpp"
-#include "bench/report.hpp"
-#include "bench/world.hpp"
-#include "bench/write.hpp"
+#include "bench/deform/deform.hpp"
+#include "bench/pairs/report.hpp"
+#include "bench/pairs/write.hpp"
+#include "bench/points/points.hpp"
+#include "bench/world/world.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -78,7 +78,7 @@ class PairsExperiment final : public Experiment {
   std::optional<RunOutput> output_;
 };
 
-/// Many moving objects, the broad phase and one budget per frame (bench/world.hpp).
+/// Many moving objects, the broad phase and one budget per frame (bench/world/world.hpp).
 class WorldExperiment final : public Experiment {
  public:
   explicit WorldExperiment(const Scene& scene) : scene_(scene) {}
@@ -97,7 +97,7 @@ class WorldExperiment final : public Experiment {
   std::optional<WorldOutput> output_;
 };
 
-/// A deforming object, refitted or rebuilt frame by frame (bench/deform.hpp).
+/// A deforming object, refitted or rebuilt frame by frame (bench/deform/deform.hpp).
 class DeformExperiment final : public Experiment {
  public:
   explicit DeformExperiment(const Scene& scene) : scene_(scene) {}
@@ -116,7 +116,7 @@ class DeformExperiment final : public Experiment {
   std::optional<DeformOutput> output_;
 };
 
-/// Point clouds sampled from meshes on the tumbling protocol (bench/points.hpp).
+/// Point clouds sampled from meshes on the tumbling protocol (bench/points/points.hpp).
 class PointsExperiment final : public Experiment {
  public:
   explicit PointsExperiment(const Scene& scene) : scene_(scene) {}

@@ -1,6 +1,6 @@
 #include "bench/report_folder.hpp"
 
-#include "bench/report.hpp"
+#include "bench/pairs/report.hpp"
 
 #include <fstream>
 #include <stdexcept>

@@ -57,8 +57,8 @@ struct RunStats {
   /// How they were timed (the scene's "timing"): passes over the poses, and the per-pose statistic.
   int timing_repeats = 1;
   std::string timing_statistic = "min";
-  /// Every timed sample of every pass, and those that were stalls (bench/timing_stats.hpp), with the time
-  /// they lost beyond their pose's median; context switches forced on the timing thread meanwhile.
+  /// Every timed sample of every pass, and those that were stalls (bench/pairs/timing_stats.hpp), with the
+  /// time they lost beyond their pose's median; context switches forced on the timing thread meanwhile.
   std::size_t timed_samples = 0, stalled_samples = 0;
   double sampled_seconds = 0, stall_lost_seconds = 0;
   long involuntary_switches = 0;
@@ -88,7 +88,7 @@ struct ResultRow {
   double inexact_rate = 0, budget_exhausted_rate = 0;
   double bv_tests_per_query = 0, triangle_tests_per_query = 0, nodes_visited_per_query = 0;
   double estimates_per_query = 0;  ///< probability evaluations (ADB-type strategies)
-  bool in_summary = false;         ///< inside its pair's summary band (bench/summary_band.hpp)
+  bool in_summary = false;         ///< inside its pair's summary band (bench/pairs/summary_band.hpp)
   /// The per-pose times in pose order, the same poses for every series of the pair and distance: the
   /// report's bootstrap intervals resample them (not written to results.csv).
   std::vector<double> pose_times_us;
@@ -162,10 +162,6 @@ struct RunOutput {
 /// Runs a parsed scene. Throws for I/O and model errors; an optional object whose mesh is missing is
 /// skipped (recorded in stats.skipped).
 RunOutput run_scene(const Scene& scene, const RunOptions& options);
-
-/// Applies the protocol normalisation to `mesh` (normalize_to_unit_cube) and returns the units it is then in,
-/// as saved trees record them. Throws MeshError as normalize_to_unit_cube does.
-TreeUnits normalize_mesh(Mesh& mesh);
 /// An object's mesh as a run loads it: normalised (if asked), scaled and placed. Throws MeshError.
 Mesh load_scene_object(const SceneObject& object);
 

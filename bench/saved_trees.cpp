@@ -3,8 +3,8 @@
 #include "bench/run.hpp"
 
 #include "adb/saved_tree.hpp"
-#include "bench/measure.hpp"
-#include "bench/prepare.hpp"
+#include "bench/pairs/measure.hpp"
+#include "bench/pairs/prepare.hpp"
 #include "engine/any_tree.hpp"
 #include "engine/policies.hpp"
 

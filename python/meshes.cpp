@@ -1,7 +1,6 @@
 // bvhlab.Mesh: from numpy arrays (checked here) or from a file (the library's loader and its checks).
-#include "bench/core/mesh_catalog.hpp"
-#include "bench/run.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/mesh_catalog.hpp"
 #include "python/bindings.hpp"
 
 #include <algorithm>

@@ -2,7 +2,7 @@
 // bvhlab command line. Errors of the library become Python exceptions: MeshError, SavedTreeError,
 // SceneError and PointCloudError (all ValueError), std::invalid_argument as ValueError.
 #include "adb/saved_tree.hpp"
-#include "bench/core/scene.hpp"
+#include "bench/run_scene.hpp"
 #include "bvh/mesh_io.hpp"
 #include "bvh/point_cloud.hpp"
 #include "python/bindings.hpp"

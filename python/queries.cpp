@@ -1,7 +1,7 @@
 // bvhlab.query and bvhlab.query_batch: one strategy variant between two trees, at one pose or over an array
 // of poses (checked first, then queried without the GIL, answered as numpy arrays); the protocol's poses.
-#include "bench/core/protocol.hpp"
 #include "engine/any_tree.hpp"
+#include "engine/protocol.hpp"
 #include "python/bindings.hpp"
 
 #include <algorithm>

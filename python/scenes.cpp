@@ -1,6 +1,6 @@
-// bvhlab.run_scene: the scene runner (bench/run.hpp) with its results as results.json holds them; the
-// policies' tables.
-#include "bench/experiment.hpp"
+// bvhlab.run_scene: the scene runner's one entry (bench/run_scene.hpp), its results as results.json holds
+// them; the policies' tables.
+#include "bench/run_scene.hpp"
 #include "engine/policies.hpp"
 #include "python/bindings.hpp"
 
@@ -13,46 +13,35 @@ namespace bvhlab::python {
 
 namespace {
 
+py::object from_json_text(const std::string& text) {
+  return py::module_::import("json").attr("loads")(text);
+}
+
 py::object from_json(const nlohmann::json& document) {
-  return py::module_::import("json").attr("loads")(document.dump());
+  return from_json_text(document.dump());
 }
 
 /// A scene file's path, or a dict in the scene format (its relative paths taken from the working folder).
-Scene scene_from(const py::object& scene) {
-  if (py::isinstance<py::dict>(scene)) {
-    const std::string text = py::str(py::module_::import("json").attr("dumps")(scene));
-    return parse_scene(text, std::filesystem::current_path(), "<dict>");
-  }
-  const std::filesystem::path file = path_argument(scene, "run_scene (a scene file or a dict)");
-  require_file(file, "run_scene");
-  return load_scene(file);
-}
-
-py::object run(const py::object& scene_argument, const py::object& cache, int threads, bool quiet,
+py::object run(const py::object& scene, const py::object& cache, int threads, bool quiet,
                const std::string& per_pose) {
   if (threads < 0) throw py::value_error("threads must be >= 0 (0: all cores)");
-  RunOptions options;
-  try {
-    options.per_pose = parse_per_pose(per_pose);
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(std::string("per_pose: ") + e.what());
-  }
-  const Scene scene = scene_from(scene_argument);
-  if (!cache.is_none()) options.cache_dir = path_argument(cache, "cache");
-  options.threads = static_cast<unsigned>(threads);
-  options.log = [quiet](const std::string& line) {
-    if (!quiet) std::cerr << line << '\n';
-  };
-  const auto experiment = make_experiment(scene);
-  if (const auto option = experiment->refused_option(options, false))
-    throw py::value_error(*option + ": does not apply to a " + std::string(experiment->kind()) + " scene");
-  nlohmann::json document;
-  {
+  SceneRunRequest request;
+  request.per_pose = per_pose;
+  if (!cache.is_none()) request.cache_dir = path_argument(cache, "cache");
+  request.threads = static_cast<unsigned>(threads);
+  if (!quiet) request.log = [](const std::string& line) { std::cerr << line << '\n'; };
+  std::string document;
+  if (py::isinstance<py::dict>(scene)) {
+    const std::string text = py::str(py::module_::import("json").attr("dumps")(scene));
     py::gil_scoped_release release;
-    experiment->run(options);
-    document = experiment->document();
+    document = run_scene_text(text, std::filesystem::current_path(), request);
+  } else {
+    const std::filesystem::path file = path_argument(scene, "run_scene (a scene file or a dict)");
+    require_file(file, "run_scene");
+    py::gil_scoped_release release;
+    document = run_scene_file(file, request);
   }
-  return from_json(document);
+  return from_json_text(document);
 }
 
 }  // namespace

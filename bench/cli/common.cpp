@@ -1,6 +1,6 @@
 // What the bvhlab subcommands share: mesh arguments, the cache, the policies' parameter options.
 #include "bench/cli/cli.hpp"
-#include "bench/core/mesh_catalog.hpp"
+#include "engine/mesh_catalog.hpp"
 
 #include <algorithm>
 #include <cstdlib>

@@ -2,8 +2,8 @@
 // full result.
 #include "bench/cli/cli.hpp"
 #include "bench/cloud_query.hpp"
-#include "bench/core/protocol.hpp"
 #include "bvh/point_cloud.hpp"
+#include "engine/protocol.hpp"
 #include "engine/specs.hpp"
 #include "traversal/strategies.hpp"
 

@@ -1,7 +1,7 @@
 // bvhlab run, report and demo: run a scene and write its results, or its report folder.
 #include "bench/cli/cli.hpp"
 #include "bench/experiment.hpp"
-#include "bench/report.hpp"
+#include "bench/pairs/report.hpp"
 
 #include <chrono>
 #include <cstdio>

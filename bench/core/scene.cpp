@@ -5,7 +5,7 @@
 #include "bench/core/scene_json.hpp"
 #include "bench/core/scene_workload.hpp"
 
-#include "bench/core/mesh_catalog.hpp"
+#include "engine/mesh_catalog.hpp"
 #include "engine/policies.hpp"
 #include "traversal/strategies.hpp"
 

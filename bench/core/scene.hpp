@@ -35,6 +35,7 @@
 #pragma once
 
 #include "adb/parameters.hpp"
+#include "bench/run_scene.hpp"  // SceneError
 #include "bvh/topology.hpp"
 #include "engine/specs.hpp"
 #include "traversal/adb.hpp"
@@ -52,13 +53,6 @@
 #include <vector>
 
 namespace bvhlab {
-
-/// A refused scene or pose file. what() starts with the file, then the JSON pointer of the bad field:
-/// "demo.json: /hierarchies/1/bv: expected one of aabb, fcl_obb, fcl_obbrss; got \"abb\"".
-class SceneError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct SceneObject {
   std::string name;            ///< label in reports; default: the mesh file's stem
@@ -103,7 +97,7 @@ struct WorkloadSpec {
 struct ReportSpec {
   double quality_min = 0, quality_max = 0;  ///< distances the time-versus-quality summary uses, if given
   /// Given in the scene. When not, each mesh pair is summarised over the band of distances where its ground
-  /// truth has between 5% and 95% colliding poses, found from the run (bench/summary_band.hpp).
+  /// truth has between 5% and 95% colliding poses, found from the run (bench/pairs/summary_band.hpp).
   bool quality_given = false;
   int cgal_sample = 64;                     ///< poses per object pair cross-checked against CGAL
   std::string operating_hierarchy;          ///< default: the first hierarchy the operating strategy runs on
@@ -186,7 +180,7 @@ struct DeformSpec {
 };
 
 /// Point clouds sampled from each pair's meshes, B tumbling about A on the protocol ("points" in the file;
-/// format: bench/scenes/README.md; the series and the measuring: bench/points.hpp).
+/// format: bench/scenes/README.md; the series and the measuring: bench/points/points.hpp).
 struct PointsSpec {
   std::vector<double> densities{5000, 20000};  ///< points per cloud (whole numbers), one cloud per value
   std::uint64_t seed = 1;                      ///< sampling seed (B's cloud of another object: seed + 1)
@@ -206,7 +200,7 @@ struct PointsSpec {
 };
 
 /// How each (series, pose) is timed ("timing" in the file): `repeats` warm passes over the poses, each pose
-/// timed once per pass, reduced to one time per pose by `statistic` (bench/timing_stats.hpp).
+/// timed once per pass, reduced to one time per pose by `statistic` (bench/pairs/timing_stats.hpp).
 struct TimingSpec {
   enum class Statistic { Median, Min } statistic = Statistic::Min;
   int repeats = 3;

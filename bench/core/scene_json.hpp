@@ -127,14 +127,14 @@ RigidTransform parse_transform(const Node& node, const std::vector<std::string>&
 /// A non-empty list of {"bv_tests": N, "deadline_us": T} (either or both), each checked against limits.
 std::vector<Budget> parse_budgets(const Node& budgets);
 
-/// The "world" section (bench/core/world.cpp): instances, their motion, broad phases and frame budgets.
+/// The "world" section (bench/world/scene.cpp): instances, their motion, broad phases and frame budgets.
 void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene& scene);
 
-/// The "deform" section (bench/core/deform.cpp): the deforming object, its frames, B's poses, the refit and
+/// The "deform" section (bench/deform/scene.cpp): the deforming object, its frames, B's poses, the refit and
 /// the density updates.
 void parse_deform(const Node& root, const std::filesystem::path& base_dir, Scene& scene);
 
-/// The "points" section (bench/core/points_scene.cpp): densities, sampling, the protocol, the series'
+/// The "points" section (bench/points/scene.cpp): densities, sampling, the protocol, the series'
 /// parameters. `fcl`: whether this build has FCL (its octree series).
 void parse_points(const Node& root, Scene& scene, bool fcl);
 

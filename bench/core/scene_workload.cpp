@@ -3,8 +3,8 @@
 // (scene.cpp); messages name the field or the file's line.
 #include "bench/core/scene_workload.hpp"
 
-#include "bench/core/protocol.hpp"
 #include "engine/content_hash.hpp"
+#include "engine/protocol.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -3,7 +3,7 @@
 // exact recount of the density matches, while stale counts drift.
 #include "adb/update.hpp"
 #include "bench/core/ground_truth.hpp"
-#include "bench/deform.hpp"
+#include "bench/deform/deform.hpp"
 #include "bvh/deform.hpp"
 #include "bvh/mesh_io.hpp"
 #include "scene_fixtures.hpp"

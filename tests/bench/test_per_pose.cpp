@@ -2,9 +2,9 @@
 // aggregated rows, and a pose column that reads back into the very pose the run queried, with the same
 // answer from the library.
 #include "bench/core/scene.hpp"
-#include "bench/plan.hpp"
+#include "bench/pairs/plan.hpp"
+#include "bench/pairs/write.hpp"
 #include "bench/run.hpp"
-#include "bench/write.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 

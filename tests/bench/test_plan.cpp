@@ -1,6 +1,6 @@
 // The plan decides what a run loads, builds, annotates and runs: "only what the scene needs", tested here
 // without building a tree.
-#include "bench/plan.hpp"
+#include "bench/pairs/plan.hpp"
 
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"

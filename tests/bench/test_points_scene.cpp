@@ -1,6 +1,6 @@
 // The points scene: its section is parsed with every refusal named, and a report run on the small shipped
 // scene writes rows that agree with the scene (every density, distance and series) and with each other.
-#include "bench/points.hpp"
+#include "bench/points/points.hpp"
 #include "bench/run.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"

@@ -2,7 +2,7 @@
 // bench: they are added by their header and one registry line each, and this binary is built with
 // BVHLAB_TEST_POLICIES. Everything below reaches them by name only: the tables, a scene, the runner, saved
 // trees and the report.
-#include "bench/report.hpp"
+#include "bench/pairs/report.hpp"
 #include "bench/run.hpp"
 #include "engine/policies.hpp"
 #include "scene_fixtures.hpp"

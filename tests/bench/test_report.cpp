@@ -1,7 +1,7 @@
 // The report follows its scene: the distances it summarises are the ones the run has, a pose file is
 // summarised over all its poses unless the scene says otherwise, the workload text names the scene's
 // objects and units, and a strategy that reads no density is sized without one.
-#include "bench/report.hpp"
+#include "bench/pairs/report.hpp"
 #include "bench/run.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"

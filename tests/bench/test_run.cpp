@@ -1,9 +1,9 @@
 // The scene runner: only what a scene names is built; the cache is used, and a damaged entry is rebuilt,
 // never trusted; the CSV keeps its schema; the report is written.
-#include "bench/core/protocol.hpp"
-#include "bench/report.hpp"
+#include "bench/pairs/report.hpp"
+#include "bench/pairs/write.hpp"
 #include "bench/run.hpp"
-#include "bench/write.hpp"
+#include "engine/protocol.hpp"
 #include "engine/tree_cache.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"

@@ -2,11 +2,11 @@
 // the truth and say "no difference" when there is none, work compared beside time, summary bands that follow
 // the ground truth, calibration verdicts only with spread, and the scene fields that set it all, refused when
 // they make no sense.
-#include "bench/report.hpp"
+#include "bench/pairs/report.hpp"
+#include "bench/pairs/slices.hpp"
+#include "bench/pairs/summary_band.hpp"
+#include "bench/pairs/timing_stats.hpp"
 #include "bench/run.hpp"
-#include "bench/slices.hpp"
-#include "bench/summary_band.hpp"
-#include "bench/timing_stats.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 

@@ -2,9 +2,9 @@
 // bad field (a missing pose, a pose that is no rotation, an option that does not apply) is refused by name.
 #include "bench/core/ground_truth.hpp"
 #include "bench/core/scene.hpp"
-#include "bench/core/world_motion.hpp"
-#include "bench/prepare.hpp"
-#include "bench/world.hpp"
+#include "bench/pairs/prepare.hpp"
+#include "bench/world/motion.hpp"
+#include "bench/world/world.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
 

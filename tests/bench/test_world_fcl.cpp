@@ -5,7 +5,7 @@
 #include "bench/core/fcl_model.hpp"
 #include "bench/core/fcl_octree.hpp"
 #include "bench/core/ground_truth.hpp"
-#include "bench/world.hpp"
+#include "bench/world/world.hpp"
 #include "scene_fixtures.hpp"
 #include "traversal/exact.hpp"
 #include "volumes/aabb.hpp"

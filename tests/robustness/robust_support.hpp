@@ -3,8 +3,8 @@
 
 #include "adb/adb_density.hpp"
 #include "adb/tree.hpp"
-#include "bench/core/protocol.hpp"
 #include "bvh/bvh.hpp"
+#include "engine/protocol.hpp"
 #include "traversal/adb.hpp"
 #include "traversal/exact.hpp"
 #include "volumes/aabb.hpp"

@@ -5,8 +5,8 @@
 // registered BV and both exact strategies (exact traversal, guided exact) must agree on that; the ADB
 // strategies may answer either way for a touching pair but must never claim an exact "no".
 #include "bench/core/ground_truth.hpp"
-#include "bench/core/mesh_catalog.hpp"
-#include "bench/core/protocol.hpp"
+#include "engine/mesh_catalog.hpp"
+#include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "robust_support.hpp"
 #include "support/generated_meshes.hpp"

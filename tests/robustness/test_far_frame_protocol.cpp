@@ -5,7 +5,7 @@
 // `protocol` (built and run by Release; the sanitizer presets leave it out). The ADB strategies and the
 // loader in far frames are in test_far_frames.cpp.
 #include "bench/core/ground_truth.hpp"
-#include "bench/core/mesh_catalog.hpp"
+#include "engine/mesh_catalog.hpp"
 #include "engine/registry.hpp"
 #include "robust_support.hpp"
 #include "support/generated_meshes.hpp"

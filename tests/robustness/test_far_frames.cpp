@@ -2,8 +2,8 @@
 // refuses where a file's coordinates lose the model. The exact protocol in far and rescaled frames, for every
 // volume, is test_far_frame_protocol.cpp (label `protocol`).
 #include "bench/core/ground_truth.hpp"
-#include "bench/core/mesh_catalog.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/mesh_catalog.hpp"
 #include "robust_support.hpp"
 #include "support/generated_meshes.hpp"
 

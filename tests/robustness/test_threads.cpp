@@ -3,9 +3,9 @@
 // guided exact; no deadlines, whose answers depend on timing). Loading, building and annotating concurrently
 // give the same meshes and trees as doing it alone. Run under ThreadSanitizer by the tsan preset (label
 // threads), which also catches races that happen not to change an answer.
-#include "bench/core/mesh_catalog.hpp"
-#include "bench/core/protocol.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/mesh_catalog.hpp"
+#include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "robust_support.hpp"
 #include "support/meshes.hpp"

@@ -1,9 +1,9 @@
 // Transforms a caller gives: a matrix that is not a rotation (non-orthonormal, a reflection, NaN or infinite)
 // is refused with an error naming the defect, wherever it enters -- the API's checked constructor, a scene's
 // placement, a pose file, a mesh file's node transform. Never a silent wrong answer.
-#include "bench/core/protocol.hpp"
 #include "bench/core/scene.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/protocol.hpp"
 #include "robust_support.hpp"
 
 #include <gtest/gtest.h>

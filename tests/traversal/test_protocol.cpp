@@ -2,8 +2,8 @@
 // and the colliding fractions match the reference table measured with FCL (adb/README.md, section 4).
 #include "adb/adb_density.hpp"
 #include "bench/core/ground_truth.hpp"
-#include "bench/core/protocol.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "support/meshes.hpp"
 #include "traversal/adb.hpp"
