@@ -29,8 +29,11 @@ namespace {
 const PairOps& ops_of(std::string_view bv, std::string_view density) {
   return *with_volume(bv, [&]<class BV>(std::type_identity<BV>) {
     return with_density(density, []<class D>(std::type_identity<D>) {
-      return &engine_detail::slot_ops<type_index<BV>(RegisteredVolumes{}),
-                                      type_index<D>(RegisteredDensities{})>();
+      constexpr std::size_t v = type_index<BV>(RegisteredVolumes{}), d = type_index<D>(RegisteredDensities{});
+      if constexpr (engine_detail::slot_compiled(v, d))
+        return &engine_detail::slot_ops<v, d>();
+      else
+        return &engine_detail::left_out_ops<v, d>();
     });
   });
 }

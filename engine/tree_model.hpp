@@ -51,4 +51,22 @@ struct PairOps {
 template <std::size_t V, std::size_t D>
 const PairOps& slot_ops();
 
+/// Whether this engine compiles the slots of the V-th registered volume and of the D-th density: every one,
+/// unless the target defines BVHLAB_ENGINE_VOLUME_MASK and BVHLAB_ENGINE_DENSITY_MASK (a bit per volume or
+/// density: the demo's engine, engine/CMakeLists.txt).
+constexpr bool slot_compiled(std::size_t v, std::size_t d) {
+#if defined(BVHLAB_ENGINE_VOLUME_MASK) && defined(BVHLAB_ENGINE_DENSITY_MASK)
+  return v < 64 && d < 64 && ((BVHLAB_ENGINE_VOLUME_MASK >> v) & 1u) != 0 &&
+         ((BVHLAB_ENGINE_DENSITY_MASK >> d) & 1u) != 0;
+#else
+  (void)v;
+  (void)d;
+  return true;
+#endif
+}
+
+/// The operations of a volume and density this engine leaves out: refusals naming them (engine/left_out.hpp).
+template <std::size_t V, std::size_t D>
+const PairOps& left_out_ops();
+
 }  // namespace bvhlab::engine_detail
