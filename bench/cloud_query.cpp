@@ -12,10 +12,7 @@ namespace {
 /// One side's tree: a cloud's (with k-NN areas when it is annotated, as files carry none) or a mesh's.
 AnyTree side_tree(const QueryObject& object, const std::string& bv, const DensitySpec& density) {
   if (!object.cloud) {
-    if (density.name != "none" && density.name != "adb")
-      throw std::invalid_argument("density " + density.name +
-                                  " does not annotate trees over points; they take 'none' or 'adb' (cell "
-                                  "counts from the points' areas)");
+    check_cloud_density(density.name);  // before the mesh's tree is built
     return AnyTree::build(load_mesh(object.file).mesh, MeshUnits{}, bv, density, BuildOptions{});
   }
   UnitCloud cloud;

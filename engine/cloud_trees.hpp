@@ -3,6 +3,7 @@
 #pragma once
 
 #include "adb/point_density.hpp"
+#include "engine/specs.hpp"
 #include "engine/timing.hpp"
 #include "traversal/point_leaves.hpp"
 
@@ -61,12 +62,9 @@ std::string cloud_query_refusal(const typename S::Options& options, std::string_
 /// adb on a volume it cannot annotate (`bv` names the volume).
 template <TreeVolume BV, class F>
 void with_cloud_density(const std::string& density, const std::string& bv, F&& f) {
+  check_cloud_density(density);
   if (density == NoDensity::name()) {
     f.template operator()<NoDensity>();
-  } else if (density != AdbDensity::name()) {
-    throw std::invalid_argument("density " + density +
-                                " does not annotate trees over points; they take 'none' or 'adb' (cell "
-                                "counts from the points' areas)");
   } else if constexpr (DensityFor<AdbDensity, BV>) {
     f.template operator()<AdbDensity>();
   } else {

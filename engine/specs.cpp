@@ -60,6 +60,13 @@ void check_volume_name(std::string_view name) {
   with_volume(name, [](auto) {});
 }
 
+void check_cloud_density(std::string_view density) {
+  if (density == NoDensity::name() || density == AdbDensity::name()) return;
+  throw std::invalid_argument("density " + std::string(density) +
+                              " does not annotate trees over points; they take 'none' or 'adb' (cell counts "
+                              "from the points' areas)");
+}
+
 DensitySpec density_spec(const std::string& name, const ParamValues& given) {
   DensitySpec density;
   density.name = name;

@@ -61,6 +61,9 @@ std::vector<std::string> strategy_names();
 
 /// Throws std::invalid_argument naming the registered volumes when none is called `name`.
 void check_volume_name(std::string_view name);
+/// Throws std::invalid_argument unless `density` is one a tree over points takes: none, or adb (cell counts
+/// from the points' areas).
+void check_cloud_density(std::string_view density);
 
 /// `given` checked against the density's parameter table and its own checks, defaults filled in. Throws
 /// std::invalid_argument naming an unknown density or a refused value.

@@ -65,7 +65,7 @@ constexpr bool slot_compiled(std::size_t v, std::size_t d) {
 #endif
 }
 
-/// The operations of a volume and density this engine leaves out: refusals naming them (engine/left_out.hpp).
+/// The operations of a volume and density this engine leaves out: refusals naming them (engine/refusals.hpp).
 template <std::size_t V, std::size_t D>
 const PairOps& left_out_ops();
 

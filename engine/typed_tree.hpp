@@ -6,6 +6,7 @@
 #include "adb/saved_tree.hpp"
 #include "engine/cloud_trees.hpp"
 #include "engine/policies.hpp"
+#include "engine/refusals.hpp"
 #include "engine/registry.hpp"
 #include "engine/tree_model.hpp"
 #include "traversal/frame_budget.hpp"
@@ -300,12 +301,6 @@ ModelPtr annotate_plain(const TreeModel& plain, const DensitySpec& density, cons
                                              local.seconds);
 }
 
-/// What a volume and a density that do not combine answer: a refusal naming both.
-[[noreturn]] inline void refuse(std::string_view density, std::string_view bv) {
-  throw std::invalid_argument("density " + std::string(density) + " cannot annotate " + std::string(bv) +
-                              " trees");
-}
-
 template <class BV, class D>
 const PairOps& pair_ops() {
   if constexpr (DensityFor<D, BV>) {
@@ -313,21 +308,7 @@ const PairOps& pair_ops() {
                              &annotate_plain<BV, D>};
     return ops;
   } else {
-    static const PairOps ops{
-        [](const Mesh&, const MeshUnits&, const DensitySpec&, const BuildOptions&) -> ModelPtr {
-          refuse(D::name(), BV::name());
-        },
-        [](const UnitCloud&, const DensitySpec&, const BuildOptions&) -> ModelPtr {
-          refuse(D::name(), BV::name());
-        },
-        [](std::span<const std::byte>, const std::string& source, const Mesh*, const MeshUnits&) -> ModelPtr {
-          throw SavedTreeError("saved tree '" + source + "': density " + std::string(D::name()) +
-                               " cannot annotate " + std::string(BV::name()) + " trees");
-        },
-        [](const TreeModel&, const DensitySpec&, const AnnotationContext&, AnnotateStats*) -> ModelPtr {
-          refuse(D::name(), BV::name());
-        }};
-    return ops;
+    return refusing_ops<CannotAnnotate<BV, D>>();
   }
 }
 
