@@ -151,6 +151,12 @@ struct DensityUpdateStats {
   AnnotateStats annotate;           ///< the exact recount's counters, when one ran
 };
 
+/// How far a policy's counts are from an exact recount of the same tree (count_error, adb/update.hpp).
+struct CountError {
+  double mean_difference = 0;  ///< mean |count - exact| per node
+  double under_counted = 0;    ///< share of nodes counted below the exact count
+};
+
 template <class U, class D>
 concept DensityUpdate = Density<D> && std::equality_comparable<typename U::Params> &&
     std::copyable<typename U::State> && requires(const ParamValues& values) {

@@ -42,6 +42,10 @@ static_assert(all_update_adb(DensityUpdates{}));
 
 }  // namespace density_update
 
+/// `counts` against an exact recount of the same tree (AdbDensity::annotate), node by node. Throws
+/// std::invalid_argument when they differ in node count.
+CountError count_error(const AdbStorage& counts, const AdbStorage& exact);
+
 /// The policies' names, in registration order.
 inline std::vector<std::string> density_update_names() {
   return type_names(DensityUpdates{});

@@ -1,9 +1,30 @@
 #include "adb/update_common.hpp"
 
+#include "adb/update.hpp"
+
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
-namespace bvhlab::density_update {
+namespace bvhlab {
+
+CountError count_error(const AdbStorage& counts, const AdbStorage& exact) {
+  const auto& c = counts.possible_collision_cells;
+  const auto& e = exact.possible_collision_cells;
+  if (c.size() != e.size())
+    throw std::invalid_argument("count_error: " + std::to_string(c.size()) + " counts against " +
+                                std::to_string(e.size()) + " exact ones");
+  if (c.empty()) return {};
+  double sum = 0;
+  std::size_t under = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    sum += std::abs(int(c[i]) - int(e[i]));
+    under += c[i] < e[i];
+  }
+  return {sum / double(c.size()), double(under) / double(c.size())};
+}
+
+namespace density_update {
 
 void check_tree(std::string_view policy, std::size_t state_nodes, std::size_t tree_nodes,
                 std::size_t storage_counts) {
@@ -45,4 +66,5 @@ AnnotateStats recount(std::span<const Box> boxes, const NodeRanges& ranges,
   return result.stats;
 }
 
-}  // namespace bvhlab::density_update
+}  // namespace density_update
+}  // namespace bvhlab

@@ -1,5 +1,6 @@
 #include "engine/specs.hpp"
 
+#include "adb/update.hpp"
 #include "engine/policies.hpp"
 #include "engine/registry.hpp"
 
@@ -17,6 +18,14 @@ std::vector<std::string> strategy_names() {
 
 std::string DensitySpec::label() const {
   return density_label(name, values);
+}
+
+std::string DensityUpdateSpec::label() const {
+  return with_density_update(name, [&]<class U>(std::type_identity<U>) {
+    const std::string params =
+        describe_parameters(U::parameters(), values, [](const ParamSpec&) { return true; });
+    return name + (params.empty() ? "" : " " + params);
+  });
 }
 
 std::string StrategyVariant::budget_label() const {

@@ -22,6 +22,14 @@ struct DensitySpec {
   [[nodiscard]] std::string label() const;  ///< "none", "adb grid=2 tau=0.25"
 };
 
+/// A density-update policy (adb/update.hpp) with its resolved parameters: how a deform scene's ADB counts
+/// follow a refitted tree (FollowingDensity, engine/deforming.hpp).
+struct DensityUpdateSpec {
+  std::string name;
+  ParamValues values;
+  [[nodiscard]] std::string label() const;  ///< "recount_moved fraction=0.25 ignore_translation=0"
+};
+
 struct HierarchySpec {
   std::string name;  ///< label in reports; default: the BV name
   std::string bv;    ///< a registered BV name, or fcl_obb / fcl_obbrss

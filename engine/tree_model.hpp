@@ -14,6 +14,8 @@
 
 namespace bvhlab::engine_detail {
 
+struct FollowerModel;
+
 /// The typed tree behind a handle: every operation that needs the tree's type is a virtual here.
 struct TreeModel {
   virtual ~TreeModel() = default;
@@ -27,10 +29,28 @@ struct TreeModel {
   [[nodiscard]] virtual std::vector<PairOutcome> schedule(std::span<const FramePairRef> pairs,
                                                           const FrameOptions& options,
                                                           FrameMemory* memory) const = 0;
+  /// A plain tree of a mesh refitted in place; its degradation() after (DeformingTree). Others refuse.
+  virtual double refit(const Mesh& deformed, RefitMethod method) = 0;
+  /// Policy `spec` started on this adb tree of a mesh (FollowingDensity). Others refuse.
+  [[nodiscard]] virtual std::unique_ptr<FollowerModel> follow(const DensityUpdateSpec& spec) const = 0;
   TreeInfo info;
 };
 
 using ModelPtr = std::shared_ptr<const TreeModel>;
+
+/// Behind FollowingDensity (engine/deforming.hpp): an adb tree and a density-update policy's state.
+struct FollowerModel {
+  virtual ~FollowerModel() = default;
+  /// The volumes and polygons of `plain`, a plain tree of the same volume, copied in.
+  virtual void take_volumes(const TreeModel& plain) = 0;
+  virtual DensityUpdateStats update() = 0;
+  /// The counts annotated anew and the policy started again (after the plain tree was rebuilt).
+  virtual void restart() = 0;
+  /// The counts against `exact`, an adb tree of the same volume (adb/update.hpp).
+  [[nodiscard]] virtual CountError count_error(const TreeModel& exact) const = 0;
+  /// The tree, shared: the follower changes it only while nothing else holds it.
+  [[nodiscard]] virtual std::shared_ptr<TreeModel> model() const = 0;
+};
 
 /// The constructors of trees of one registered volume and density.
 struct PairOps {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "adb/saved_tree.hpp"
+#include "adb/update.hpp"
 #include "engine/cloud_trees.hpp"
 #include "engine/policies.hpp"
 #include "engine/refusals.hpp"
@@ -13,6 +14,7 @@
 #include "traversal/strategies.hpp"
 
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -149,7 +151,9 @@ struct TypedBase : TreeModel {
   }
 
   [[nodiscard]] Box world_box(const RigidTransform& pose) const override {
-    return bvhlab::world_box(tree.bvh, pose, bounds);
+    // A refitted tree's bounds are not derived again: that would add a pass over its vertices to a refit.
+    return bounds ? bvhlab::world_box(tree.bvh, pose, *bounds)
+                  : bvhlab::world_box(tree.bvh, pose, root_bounds(tree.bvh));
   }
 
   [[nodiscard]] std::vector<PairOutcome> schedule(std::span<const FramePairRef> pairs,
@@ -173,8 +177,12 @@ struct TypedBase : TreeModel {
     }
   }
 
+  double refit(const Mesh& deformed, RefitMethod method) override;
+  [[nodiscard]] std::unique_ptr<FollowerModel> follow(const DensityUpdateSpec& spec) const override;
+
   Tree<BV, D> tree;
-  RootBounds bounds;  ///< the root's bounding ball and DOP vertices (traversal/broad_phase/world_box.hpp)
+  /// The root's bounding ball and DOP vertices (traversal/broad_phase/world_box.hpp); none after a refit.
+  std::optional<RootBounds> bounds;
 
  private:
   /// S configured, checked against both trees, with the surface test when either is a cloud's.
@@ -245,6 +253,74 @@ struct PointModel final : TypedBase<BV, D> {
   PointSurface surface;
   std::vector<SphereCovering> coverings;
 };
+
+/// An adb tree of a mesh whose counts follow a refitted plain tree by density-update policy U.
+template <class BV, class U>
+class TypedFollower final : public FollowerModel {
+ public:
+  TypedFollower(const TypedBase<BV, AdbDensity>& rest, const ParamValues& values)
+      : params_(update_params<U>(values)),
+        state_(U::start(rest.tree.bvh, rest.tree.density, params_)),
+        model_(std::make_shared<TypedModel<BV, AdbDensity>>(rest.tree, rest.info.units, 0.0, 0.0)) {}
+
+  void take_volumes(const TreeModel& plain) override {
+    const auto* typed = dynamic_cast<const TypedBase<BV, NoDensity>*>(&plain);
+    if (!typed)
+      throw std::invalid_argument("take_volumes: a plain " + std::string(BV::name()) +
+                                  " tree is needed, not " + plain.info.bv + ", " + plain.info.annotation);
+    model_->tree.bvh = typed->tree.bvh;
+    model_->bounds.reset();
+  }
+  DensityUpdateStats update() override {
+    DensityUpdateStats stats;
+    U::update(model_->tree.bvh, model_->tree.density, state_, AnnotationContext{1, {}}, &stats);
+    return stats;
+  }
+  void restart() override {
+    Tree<BV, AdbDensity>& t = model_->tree;
+    t.density = AdbDensity::annotate(t.bvh, t.density.params, AnnotationContext{1, {}}, nullptr);
+    state_ = U::start(t.bvh, t.density, params_);
+  }
+  [[nodiscard]] CountError count_error(const TreeModel& exact) const override {
+    const auto* typed = dynamic_cast<const TypedBase<BV, AdbDensity>*>(&exact);
+    if (!typed)
+      throw std::invalid_argument("count_error: the exact counts are not of an adb " +
+                                  std::string(BV::name()) + " tree");
+    return bvhlab::count_error(model_->tree.density, typed->tree.density);
+  }
+  [[nodiscard]] std::shared_ptr<TreeModel> model() const override { return model_; }
+
+ private:
+  typename U::Params params_;
+  typename U::State state_;
+  std::shared_ptr<TypedModel<BV, AdbDensity>> model_;
+};
+
+template <class BV, class D>
+double TypedBase<BV, D>::refit(const Mesh& deformed, RefitMethod method) {
+  if constexpr (std::is_same_v<D, NoDensity>) {
+    tree.bvh.refit(deformed, method);
+    bounds.reset();
+    return tree.bvh.degradation();
+  } else {
+    throw std::invalid_argument("refit: a tree with density " + info.density +
+                                "; refit its plain tree and keep the counts with a density update "
+                                "(FollowingDensity)");
+  }
+}
+
+template <class BV, class D>
+std::unique_ptr<FollowerModel> TypedBase<BV, D>::follow(const DensityUpdateSpec& spec) const {
+  if constexpr (std::is_same_v<D, AdbDensity>) {
+    if (!info.polygons) throw std::invalid_argument("a density update needs a tree of a mesh, with polygons");
+    return with_density_update(spec.name,
+                               [&]<class U>(std::type_identity<U>) -> std::unique_ptr<FollowerModel> {
+                                 return std::make_unique<TypedFollower<BV, U>>(*this, spec.values);
+                               });
+  } else {
+    throw std::invalid_argument("density updates keep adb counts; this tree carries " + info.density);
+  }
+}
 
 /// The tree of `mesh` with density D.
 template <class BV, class D>

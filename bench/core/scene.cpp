@@ -212,14 +212,6 @@ std::vector<std::string> hierarchy_bv_names() {
   return names;
 }
 
-std::string DensityUpdateSpec::label() const {
-  return with_density_update(name, [&]<class U>(std::type_identity<U>) {
-    const std::string params =
-        describe_parameters(U::parameters(), values, [](const ParamSpec&) { return true; });
-    return name + (params.empty() ? "" : " " + params);
-  });
-}
-
 const SceneObject* Scene::object(std::string_view name) const {
   for (const auto& o : objects)
     if (o.name == name) return &o;

@@ -159,13 +159,6 @@ struct WorldSpec {
   std::string identity;
 };
 
-/// One density-update policy of a deform scene, with its resolved parameters (adb/update.hpp).
-struct DensityUpdateSpec {
-  std::string name;
-  ParamValues values;
-  [[nodiscard]] std::string label() const;  ///< "recount_moved fraction=0.25 ignore_translation=0"
-};
-
 /// A deforming object against a rigid one over frames ("deform" in the file; format: bench/scenes/README.md).
 struct DeformSpec {
   std::string object;       ///< the deforming scene object (A)

@@ -1,13 +1,11 @@
 #include "bench/deform/deform.hpp"
 
-#include "adb/update.hpp"
-#include "bench/pairs/measure.hpp"
 #include "bench/pairs/prepare.hpp"
 #include "bench/report_tables.hpp"
 #include "bvh/deform.hpp"
 #include "bvh/mesh_sequence.hpp"
+#include "engine/deforming.hpp"
 #include "engine/policies.hpp"
-#include "engine/registry.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
 #include <fcl/narrowphase/collision.h>
@@ -16,6 +14,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 
 namespace bvhlab {
 
@@ -77,35 +76,12 @@ std::vector<StrategyVariant> variants_on(const Scene& scene, const HierarchySpec
   return out;
 }
 
-/// Times `variant` on trees a and b over the frame's poses.
-template <class TreeA, class TreeB>
-std::vector<QueryRecord> answer(const StrategyVariant& variant, const TreeA& a, const TreeB& b,
+/// Times `variant` with `a` fixed and `b` moved over the frame's poses.
+std::vector<QueryRecord> answer(const StrategyVariant& variant, const AnyTree& a, const AnyTree& b,
                                 const FrameTruth& truth, int warmup) {
-  using D = typename TreeA::DensityType;
   std::vector<QueryRecord> out;
-  with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
-    if constexpr (S::template accepts<D>) {
-      const auto options = strategy_options<S>(variant.values, variant.budget);
-      timed_series(truth.poses, warmup, out,
-                   [&](const RigidTransform& p) { return S::query(a, b, p, options); });
-    } else {
-      throw std::invalid_argument(strategy_info(variant.strategy).refusal(D::name()));
-    }
-  });
+  a.prepare(b, variant)->time(truth.poses, warmup, out);
   return out;
-}
-
-/// Count error of `counts` against the exact recount: mean |difference| and the share counted below it.
-std::pair<double, double> count_error(const AdbStorage& counts, const AdbStorage& exact) {
-  const auto& c = counts.possible_collision_cells;
-  const auto& e = exact.possible_collision_cells;
-  double sum = 0;
-  std::size_t under = 0;
-  for (std::size_t i = 0; i < c.size(); ++i) {
-    sum += std::abs(int(c[i]) - int(e[i]));
-    under += c[i] < e[i];
-  }
-  return {c.empty() ? 0 : sum / double(c.size()), c.empty() ? 0 : double(under) / double(c.size())};
 }
 
 /// One hierarchy of the scene, following the deforming object frame by frame.
@@ -127,66 +103,47 @@ DeformRow row_of(const FrameTruth& truth, const HierarchySpec& h, std::string up
   return row;
 }
 
-/// An ADB tree kept up to date by one density-update policy; the policy's state is held by `update`.
-template <class BV>
-struct UpdatedTree {
+/// An ADB tree kept up to date by one density-update policy.
+struct UpdatedCounts {
   std::string label;
-  Tree<BV, AdbDensity> tree;
-  std::function<DensityUpdateStats(Tree<BV, AdbDensity>&)> update;  ///< after the tree was refitted
-  std::function<void(Tree<BV, AdbDensity>&)> restart;               ///< after the tree was rebuilt
+  FollowingDensity counts;
 };
 
-template <class BV>
-UpdatedTree<BV> make_updated(const DensityUpdateSpec& spec, const Tree<BV, AdbDensity>& rest) {
-  return with_density_update(spec.name, [&]<class U>(std::type_identity<U>) {
-    const auto params = U::make_params(spec.values);
-    auto state = std::make_shared<typename U::State>(U::start(rest.bvh, rest.density, params));
-    UpdatedTree<BV> out{spec.label(), rest, {}, {}};
-    out.update = [state](Tree<BV, AdbDensity>& t) {
-      DensityUpdateStats stats;
-      U::update(t.bvh, t.density, *state, AnnotationContext{1, {}}, &stats);
-      return stats;
-    };
-    out.restart = [state, params](Tree<BV, AdbDensity>& t) { *state = U::start(t.bvh, t.density, params); };
-    return out;
-  });
-}
-
-template <class BV>
+/// Trees of a registered volume (engine/deforming.hpp): refitted, rebuilt, and with ADB counts, updated.
 class BvhDeform final : public DeformHierarchy {
  public:
   BvhDeform(const Scene& scene, const HierarchySpec& h, const Mesh& rest, const Mesh& other, int warmup)
       : scene_(scene),
         h_(h),
         warmup_(warmup),
-        refit_{Bvh<BV>::build(rest, h.build), {}},
-        other_{Bvh<BV>::build(other, h.build), {}},
+        refit_(rest, h.bv, h.build),
+        other_(AnyTree::build(other, {}, h.bv, {}, h.build)),
         exact_(variants_on(scene, h, false)),
         adb_(variants_on(scene, h, true)) {
     if (adb_.empty()) return;
-    params_ = density_params<AdbDensity>(scene.density_of(h).values);
-    const auto annotated_rest = annotate_tree<AdbDensity>(refit_.bvh, params_, {1, {}});
-    other_adb_ = annotate_tree<AdbDensity>(other_.bvh, params_, {1, {}});
+    density_ = scene.density_of(h);
+    const AnyTree annotated_rest = refit_.tree().annotated(density_, one_thread());
+    other_adb_ = other_.annotated(density_, one_thread());
     for (const DensityUpdateSpec& spec : scene.deform->density_updates)
-      updated_.push_back(make_updated<BV>(spec, annotated_rest));
+      updated_.push_back({spec.label(), FollowingDensity(spec, annotated_rest)});
   }
 
   void frame(const FrameTruth& truth, std::vector<DeformRow>& rows) override {
     const auto start = Clock::now();
-    refit_.bvh.refit(*truth.mesh, scene_.deform->refit_by_fit ? RefitMethod::Fit : RefitMethod::Merge);
-    const double degradation = refit_.bvh.degradation();
+    const double degradation =
+        refit_.refit(*truth.mesh, scene_.deform->refit_by_fit ? RefitMethod::Fit : RefitMethod::Merge);
     const bool rebuilt = degradation > scene_.deform->rebuild_degradation;
-    if (rebuilt) refit_.bvh = Bvh<BV>::build(*truth.mesh, h_.build);
+    if (rebuilt) refit_.rebuild(*truth.mesh);
     const double refit_micros = micros_since(start);
     const auto rebuild_start = Clock::now();
-    const Tree<BV, NoDensity> rebuilt_tree{Bvh<BV>::build(*truth.mesh, h_.build), {}};
+    const AnyTree rebuilt_tree = AnyTree::build(*truth.mesh, {}, h_.bv, {}, h_.build);
     const double rebuild_micros = micros_since(rebuild_start);
     for (const StrategyVariant& v : exact_) {
       DeformRow refit_row = row_of(truth, h_, "refit", v);
       refit_row.degradation = degradation;
       refit_row.rebuilt = rebuilt;
       refit_row.tree_micros = refit_micros;
-      score(refit_row, truth, answer(v, refit_, other_, truth, warmup_));
+      score(refit_row, truth, answer(v, refit_.tree(), other_, truth, warmup_));
       rows.push_back(std::move(refit_row));
       DeformRow rebuild_row = row_of(truth, h_, "rebuild", v);
       rebuild_row.tree_micros = rebuild_micros;
@@ -194,46 +151,57 @@ class BvhDeform final : public DeformHierarchy {
       rows.push_back(std::move(rebuild_row));
     }
     if (!adb_.empty())
-      adb_frame(truth, rebuilt, degradation, refit_micros, rebuilt_tree, rebuild_micros, rows);
+      adb_frame(truth, {degradation, rebuilt, refit_micros}, rebuilt_tree, rebuild_micros, rows);
   }
 
  private:
-  void adb_frame(const FrameTruth& truth, bool rebuilt, double degradation, double refit_micros,
-                 const Tree<BV, NoDensity>& rebuilt_tree, double rebuild_micros,
-                 std::vector<DeformRow>& rows) {
+  /// The runner annotates on one thread, so that the density's times compare with the updates'.
+  static AnnotationContext one_thread() { return {1, {}}; }
+
+  /// What the frame's refit did.
+  struct Refit {
+    double degradation = 1;
+    bool rebuilt = false;
+    double micros = 0;
+  };
+
+  void adb_frame(const FrameTruth& truth, const Refit& refit, const AnyTree& rebuilt_tree,
+                 double rebuild_micros, std::vector<DeformRow>& rows) {
     const auto annotate_start = Clock::now();
-    const auto fresh = annotate_tree<AdbDensity>(rebuilt_tree.bvh, params_, {1, {}});
+    const AnyTree fresh = rebuilt_tree.annotated(density_, one_thread());
     const double annotate_micros = micros_since(annotate_start);
-    add_adb_rows(truth, "rebuild + annotate", fresh, rebuild_micros, annotate_micros, 1, false, nullptr,
-                 rows);
-    const AdbStorage recount = AdbDensity::annotate(refit_.bvh, params_, {1, {}}, nullptr);
-    for (UpdatedTree<BV>& u : updated_) {
-      u.tree.bvh = refit_.bvh;
+    add_adb_rows(truth, "rebuild + annotate", fresh, {1, false, rebuild_micros}, annotate_micros,
+                 std::nullopt, rows);
+    const AnyTree recount = refit_.tree().annotated(density_, one_thread());
+    for (UpdatedCounts& u : updated_) {
+      u.counts.take_volumes(refit_.tree());
       const auto update_start = Clock::now();
-      if (rebuilt) {
-        u.tree.density = AdbDensity::annotate(u.tree.bvh, params_, {1, {}}, nullptr);
-        u.restart(u.tree);
-      } else {
-        u.update(u.tree);
-      }
+      if (refit.rebuilt)
+        u.counts.restart();
+      else
+        u.counts.update();
       const double update_micros = micros_since(update_start);
-      add_adb_rows(truth, "refit + " + u.label, u.tree, refit_micros, update_micros, degradation, rebuilt,
-                   &recount, rows);
+      add_adb_rows(truth, "refit + " + u.label, u.counts.tree(), refit, update_micros,
+                   u.counts.count_error(recount), rows);
     }
   }
 
-  void add_adb_rows(const FrameTruth& truth, const std::string& update, const Tree<BV, AdbDensity>& tree,
-                    double tree_micros, double density_micros, double degradation, bool rebuilt,
-                    const AdbStorage* recount, std::vector<DeformRow>& rows) {
+  void add_adb_rows(const FrameTruth& truth, const std::string& update, const AnyTree& tree,
+                    const Refit& refit, double density_micros, std::optional<CountError> error,
+                    std::vector<DeformRow>& rows) {
     for (const StrategyVariant& v : adb_) {
       DeformRow row = row_of(truth, h_, update, v);
-      row.tree_micros = tree_micros;
+      row.tree_micros = refit.micros;
       row.density_micros = density_micros;
-      row.degradation = degradation;
-      row.rebuilt = rebuilt;
-      std::tie(row.count_error, row.under_counted) =
-          recount ? count_error(tree.density, *recount) : std::pair<double, double>{0, 0};
-      score(row, truth, answer(v, tree, other_adb_, truth, warmup_));
+      row.degradation = refit.degradation;
+      row.rebuilt = refit.rebuilt;
+      if (error) {
+        row.count_error = error->mean_difference;
+        row.under_counted = error->under_counted;
+      } else {
+        row.count_error = row.under_counted = 0;
+      }
+      score(row, truth, answer(v, tree, *other_adb_, truth, warmup_));
       rows.push_back(std::move(row));
     }
   }
@@ -241,11 +209,12 @@ class BvhDeform final : public DeformHierarchy {
   const Scene& scene_;
   const HierarchySpec& h_;
   int warmup_;
-  Tree<BV, NoDensity> refit_, other_;
+  DeformingTree refit_;
+  AnyTree other_;
   std::vector<StrategyVariant> exact_, adb_;
-  AdbParams params_;
-  Tree<BV, AdbDensity> other_adb_;
-  std::vector<UpdatedTree<BV>> updated_;
+  DensitySpec density_;
+  std::optional<AnyTree> other_adb_;
+  std::vector<UpdatedCounts> updated_;
 };
 
 #ifdef BVHLAB_HAVE_FCL
@@ -307,11 +276,7 @@ std::unique_ptr<DeformHierarchy> make_hierarchy(const Scene& scene, const Hierar
     throw std::invalid_argument("hierarchy " + h.name + ": this build has no FCL");
 #endif
   }
-  std::unique_ptr<DeformHierarchy> out;
-  with_volume(h.bv, [&]<class BV>(std::type_identity<BV>) {
-    out = std::make_unique<BvhDeform<BV>>(scene, h, rest, other, warmup);
-  });
-  return out;
+  return std::make_unique<BvhDeform>(scene, h, rest, other, warmup);
 }
 
 std::vector<RigidTransform> all_poses(const DeformSpec& spec) {
@@ -321,12 +286,12 @@ std::vector<RigidTransform> all_poses(const DeformSpec& spec) {
 }
 
 /// The truth of one frame: a fresh AABB tree of the deformed mesh, exact traversal against B's.
-FrameTruth frame_truth(int frame, const Mesh& mesh, const Bvh<Aabb>& other,
-                       std::vector<RigidTransform> poses) {
-  FrameTruth truth{frame, &mesh, std::move(poses), {}};
-  const Bvh<Aabb> tree = Bvh<Aabb>::build(mesh);
-  for (const RigidTransform& pose : truth.poses)
-    truth.collides.push_back(query_exact(tree, other, pose).collides);
+FrameTruth frame_truth(int frame, const Mesh& mesh, const AnyTree& other, std::vector<RigidTransform> poses) {
+  const std::size_t count = poses.size();
+  FrameTruth truth{frame, &mesh, std::move(poses), std::vector<bool>(count)};
+  const AnyTree tree = AnyTree::build(mesh, {}, "aabb", {}, {});
+  tree.prepare(other, strategy_variant("exact", {}, {}))
+      ->run(truth.poses, [&](std::size_t k, const Result& r) { truth.collides[k] = r.collides; });
   return truth;
 }
 
@@ -351,7 +316,7 @@ DeformOutput run_deform(const Scene& scene, const RunOptions& options) {
   std::vector<std::unique_ptr<DeformHierarchy>> hierarchies;
   for (const HierarchySpec& h : scene.hierarchies)
     hierarchies.push_back(make_hierarchy(scene, h, rest, other.mesh, options.warmup_queries));
-  const Bvh<Aabb> other_tree = Bvh<Aabb>::build(other.mesh);
+  const AnyTree other_tree = AnyTree::build(other.mesh, {}, "aabb", {}, {});
   const std::vector<RigidTransform> poses = all_poses(spec);
   out.poses = poses.size();
   for (int f = 1; f <= out.frames; ++f) {
