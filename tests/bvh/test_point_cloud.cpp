@@ -3,6 +3,7 @@
 #include "bvh/bvh.hpp"
 #include "bvh/mesh_io.hpp"
 #include "bvh/point_cloud.hpp"
+#include "support/errors.hpp"
 #include "support/meshes.hpp"
 #include "support/volume_lists.hpp"
 
@@ -18,18 +19,10 @@
 namespace bvhlab {
 namespace {
 
+using testing::error_of;
+
 PointCloud from_text(const std::string& text, std::string_view format) {
   return load_point_cloud_from_memory(std::as_bytes(std::span(text.data(), text.size())), format, "test");
-}
-
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 Mesh pinion() {

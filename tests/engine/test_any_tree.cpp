@@ -3,18 +3,20 @@
 // choice the same way.
 #include "adb/update.hpp"
 #include "engine/any_tree.hpp"
+#include "support/errors.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/broad_phase/registry.hpp"
 #include "traversal/frame_budget.hpp"
 
 #include <gtest/gtest.h>
 
-#include <functional>
 #include <string>
 #include <vector>
 
 namespace bvhlab {
 namespace {
+
+using testing::error_of;
 
 std::vector<RigidTransform> poses_along_x() {
   std::vector<RigidTransform> poses;
@@ -25,15 +27,6 @@ std::vector<RigidTransform> poses_along_x() {
 AnyTree torus_tree(const std::string& bv, const std::string& density) {
   return AnyTree::build(testing::make_torus(0.7, 0.25, 24, 12), MeshUnits{}, bv, density_spec(density, {}),
                         BuildOptions{});
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 TEST(AnyTree, APreparedQueryTimesWhatItRuns) {

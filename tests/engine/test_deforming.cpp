@@ -4,17 +4,19 @@
 #include "adb/update.hpp"
 #include "bvh/deform.hpp"
 #include "engine/deforming.hpp"
+#include "support/errors.hpp"
 #include "support/generated_meshes.hpp"
 #include "volumes/aabb.hpp"
 
 #include <gtest/gtest.h>
 
-#include <functional>
 #include <string>
 #include <vector>
 
 namespace bvhlab {
 namespace {
+
+using testing::error_of;
 
 const Mesh& rest_torus() {
   static const Mesh mesh = testing::make_torus(0.7, 0.25, 24, 12);
@@ -42,15 +44,6 @@ std::vector<bool> collides(const std::vector<Result>& results) {
   std::vector<bool> out;
   for (const Result& r : results) out.push_back(r.collides);
   return out;
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 const StrategyVariant kExact = strategy_variant("exact", {}, {});
