@@ -59,9 +59,10 @@ class FollowingDensity {
   /// Copies in the volumes and polygons of `refitted`, a plain tree of the same volume: not part of an
   /// update's cost. Throws std::invalid_argument for another tree, std::logic_error while tree() is held.
   void take_volumes(const AnyTree& refitted);
-  /// The policy's update of the counts to the volumes taken.
+  /// The policy's update of the counts to the volumes taken, on one thread (as restart() annotates), so
+  /// that the policies' times compare.
   DensityUpdateStats update();
-  /// After the plain tree was rebuilt: the counts annotated anew, the policy started again.
+  /// After the plain tree was rebuilt: the counts annotated anew on one thread, the policy started again.
   void restart();
   /// The counts against `exact`, this tree's volumes annotated anew (AnyTree::annotated of the plain tree).
   [[nodiscard]] CountError count_error(const AnyTree& exact) const;

@@ -170,8 +170,9 @@ class BvhDeform final : public DeformHierarchy {
     const auto annotate_start = Clock::now();
     const AnyTree fresh = rebuilt_tree.annotated(density_, one_thread());
     const double annotate_micros = micros_since(annotate_start);
+    // Counted anew: no error against an exact count.
     add_adb_rows(truth, "rebuild + annotate", fresh, {1, false, rebuild_micros}, annotate_micros,
-                 std::nullopt, rows);
+                 CountError{}, rows);
     const AnyTree recount = refit_.tree().annotated(density_, one_thread());
     for (UpdatedCounts& u : updated_) {
       u.counts.take_volumes(refit_.tree());
@@ -187,7 +188,7 @@ class BvhDeform final : public DeformHierarchy {
   }
 
   void add_adb_rows(const FrameTruth& truth, const std::string& update, const AnyTree& tree,
-                    const Refit& refit, double density_micros, std::optional<CountError> error,
+                    const Refit& refit, double density_micros, const CountError& error,
                     std::vector<DeformRow>& rows) {
     for (const StrategyVariant& v : adb_) {
       DeformRow row = row_of(truth, h_, update, v);
@@ -195,12 +196,8 @@ class BvhDeform final : public DeformHierarchy {
       row.density_micros = density_micros;
       row.degradation = refit.degradation;
       row.rebuilt = refit.rebuilt;
-      if (error) {
-        row.count_error = error->mean_difference;
-        row.under_counted = error->under_counted;
-      } else {
-        row.count_error = row.under_counted = 0;
-      }
+      row.count_error = error.mean_difference;
+      row.under_counted = error.under_counted;
       score(row, truth, answer(v, tree, *other_adb_, truth, warmup_));
       rows.push_back(std::move(row));
     }
