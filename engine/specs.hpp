@@ -5,7 +5,7 @@
 
 #include "adb/parameters.hpp"
 #include "bvh/topology.hpp"
-#include "traversal/adb.hpp"
+#include "traversal/budget.hpp"
 
 #include <map>
 #include <optional>

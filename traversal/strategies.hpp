@@ -6,6 +6,7 @@
 #include "adb.hpp"
 #include "exact.hpp"
 #include "strategy.hpp"
+#include "strategy_names.hpp"
 
 #include <span>
 
@@ -52,7 +53,7 @@ inline constexpr ParamSpec kTimeCritical[] = {
 /// Exact first contact: depth-first simultaneous descent, exact triangle tests at the leaves.
 struct ExactStrategy {
   using Options = ContactMode;
-  static constexpr std::string_view name() { return "exact"; }
+  static constexpr std::string_view name() { return kExactStrategyName; }
   static constexpr std::string_view description() { return "exact first contact, depth first"; }
   static constexpr bool exact = true;
   static constexpr BudgetUse budget = BudgetUse::None;
@@ -70,7 +71,7 @@ struct ExactStrategy {
 
 /// Every intersecting triangle pair (Result::contacts), exactly.
 struct AllContactsStrategy : ExactStrategy {
-  static constexpr std::string_view name() { return "all_contacts"; }
+  static constexpr std::string_view name() { return kAllContactsStrategyName; }
   static constexpr std::string_view description() { return "every intersecting triangle pair, exactly"; }
   static Options configure(const ParamValues&, const Budget&) { return ContactMode::All; }
 };

@@ -28,7 +28,8 @@
 #pragma once
 
 #include "../adb/parameters.hpp"
-#include "adb.hpp"
+#include "../adb/tree.hpp"
+#include "budget.hpp"
 #include "result.hpp"
 
 #include <concepts>

@@ -5,6 +5,7 @@
 
 #include "../bvh/bvh.hpp"
 #include "../bvh/triangle_intersection.hpp"
+#include "budget.hpp"
 #include "result.hpp"
 #include "tree_access.hpp"
 
@@ -15,13 +16,6 @@
 #include <vector>
 
 namespace bvhlab {
-
-/// Limits for time-critical queries. Zero means "no limit".
-struct Budget {
-  std::uint64_t max_bv_tests = 0;  ///< hard cap on BV-pair tests (never exceeded)
-  double deadline_us = 0;          ///< wall-clock limit from the query's start (see BudgetLimit)
-  [[nodiscard]] bool unlimited() const { return max_bv_tests == 0 && deadline_us <= 0; }
-};
 
 struct NoKey {};
 struct NoTag {};

@@ -5,7 +5,7 @@
 #include "bvh/point_cloud.hpp"
 #include "engine/protocol.hpp"
 #include "engine/specs.hpp"
-#include "traversal/strategies.hpp"
+#include "traversal/strategy_names.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -132,10 +132,10 @@ struct QueryPolicies {
 QueryPolicies query_policies(const QueryArgs& args) {
   QueryPolicies out{args.strategy, args.density};
   if (args.all) {
-    if (out.strategy != ExactStrategy::name() && out.strategy != AllContactsStrategy::name())
+    if (out.strategy != kExactStrategyName && out.strategy != kAllContactsStrategyName)
       throw CLI::ValidationError("--all-contacts",
                                  "lists exact contacts; it does not apply to strategy " + out.strategy);
-    out.strategy = AllContactsStrategy::name();
+    out.strategy = kAllContactsStrategyName;
   }
   const StrategyInfo& strategy = strategy_info(out.strategy);
   if (out.density.empty())  // the first density the strategy runs on: none when it needs none
@@ -380,7 +380,7 @@ int query_command(const QueryArgs& given) {
   const QueryRun run = execute_query(args, trees, request, std::move(poses));
   const bool batch = !args.poses_file.empty();
   // The contacts are listed whether the strategy was named or given by --all-contacts.
-  const bool all_contacts = request.strategy.strategy == AllContactsStrategy::name();
+  const bool all_contacts = request.strategy.strategy == kAllContactsStrategyName;
   if (args.json)
     print_json(run, all_contacts, batch);
   else

@@ -7,7 +7,7 @@
 
 #include "engine/mesh_catalog.hpp"
 #include "engine/policies.hpp"
-#include "traversal/strategies.hpp"
+#include "traversal/strategy_names.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -58,7 +58,7 @@ bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec&
   for (std::size_t k = 0, m = hs.array_size(); k < m; ++k) {
     if (skipped(hs.child(k).string())) continue;
     const std::string name = hs.child(k).choice(names);
-    if (scene.hierarchy(name)->is_fcl() && spec.name != ExactStrategy::name())
+    if (scene.hierarchy(name)->is_fcl() && spec.name != kExactStrategyName)
       hs.child(k).fail("\"" + spec.name + "\" needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only");
     spec.hierarchies.push_back(name);
   }
@@ -228,7 +228,7 @@ bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
   if (!s.hierarchies.empty() &&
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
-  return !h.is_fcl() || s.name == ExactStrategy::name();
+  return !h.is_fcl() || s.name == kExactStrategyName;
 }
 
 const DensitySpec& Scene::density_of(const HierarchySpec& h) const {

@@ -38,7 +38,7 @@
 #include "bench/run_scene.hpp"  // SceneError
 #include "bvh/topology.hpp"
 #include "engine/specs.hpp"
-#include "traversal/adb.hpp"
+#include "traversal/budget.hpp"
 #include "volumes/geometry.hpp"
 
 #include <algorithm>

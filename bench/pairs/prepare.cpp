@@ -5,7 +5,7 @@
 #include "engine/content_hash.hpp"
 #include "engine/mesh_catalog.hpp"
 #include "engine/tree_cache.hpp"
-#include "traversal/strategies.hpp"
+#include "traversal/strategy_names.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
 #include <fcl/narrowphase/collision.h>
@@ -78,7 +78,7 @@ class FclHierarchy final : public PreparedHierarchy {
 
   void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
            std::vector<QueryRecord>& out) const override {
-    if (variant.strategy != ExactStrategy::name())
+    if (variant.strategy != kExactStrategyName)
       throw std::logic_error("runner: FCL hierarchies run the exact strategy only");
     timed_series(poses, warmup, out, [&](const RigidTransform& p) { return query(p); });
   }
@@ -91,7 +91,7 @@ class FclHierarchy final : public PreparedHierarchy {
         "FCL models give no world boxes here (bench_broad_phase times FCL's managers)");
   }
   [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
-    if (variant.strategy != ExactStrategy::name())
+    if (variant.strategy != kExactStrategyName)
       throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only");
     return query(pose);
   }
