@@ -61,8 +61,9 @@ std::optional<int> initialize_benchmark(const char* program, std::initializer_li
   }
   std::vector<std::string> rest = app.remaining();
   add_robust_timing_defaults(rest);
-  rest.insert(rest.begin(), argv[0]);
-  std::vector<char*> rest_argv;
+  // argv[0] itself, not a copy: Google Benchmark keeps the pointer as the executable's name for its JSON
+  // context, which a local copy would leave dangling.
+  std::vector<char*> rest_argv{argv[0]};
   for (std::string& arg : rest) rest_argv.push_back(arg.data());
   int rest_argc = static_cast<int>(rest_argv.size());
   benchmark::Initialize(&rest_argc, rest_argv.data());
