@@ -52,4 +52,16 @@ using TraversalTestVolumes = ::testing::Types<Aabb, Dop24, Obb, Sphere, Restrict
 using TraversalTestVolumes = AllShippedVolumes;
 #endif
 
+/// Every other type of a ::testing::Types list, from position `First` (0 or 1): the two halves of a typed
+/// suite instantiated in two files, so that both cores compile it.
+template <int First, class List>
+struct AlternateTypes {
+  using type = ::testing::Types<>;
+};
+template <class A, class... Rest>
+struct AlternateTypes<0, ::testing::Types<A, Rest...>>
+    : ConcatTypes<::testing::Types<A>, typename AlternateTypes<1, ::testing::Types<Rest...>>::type> {};
+template <class A, class... Rest>
+struct AlternateTypes<1, ::testing::Types<A, Rest...>> : AlternateTypes<0, ::testing::Types<Rest...>> {};
+
 }  // namespace bvhlab::testing

@@ -1,0 +1,187 @@
+// Coherent against cold exact queries on the protocol (traversal/coherent.hpp): B turns by one step of
+// `--steps` per query at each distance, and every `--strides`-th pose is asked, in order.
+//
+//   bench_coherence [--meshes=a.stl,b.obj] [--volumes=aabb,dop24] [--steps=2000] [--strides=1,8,64]
+//                   [--distances=0.6,1.0,1.4] [benchmark flags]
+//
+// One iteration is one cold pass and one coherent pass over the same poses (a fresh state), in alternating
+// order, each timed on its own: the ratio of each iteration's two passes is what is compared, so a stall
+// of the machine touches both sides of one ratio or neither. Counters (over the iterations): the median
+// speed-up cold/coherent and its interquartile range, each side's median microseconds per query, BV and
+// triangle tests per query, the share of queries the remembered contact answered, pose jumps, and the
+// disagreements with the cold answers (the run fails unless 0).
+#include "bench/core/bench_flags.hpp"
+#include "engine/mesh_catalog.hpp"
+#include "engine/protocol.hpp"
+#include "engine/registry.hpp"
+#include "traversal/coherent.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace bvhlab {
+namespace {
+
+struct PoseSet {
+  std::string label;
+  std::vector<RigidTransform> poses;
+};
+
+std::vector<PoseSet> make_pose_sets(const std::vector<double>& distances, int steps,
+                                    const std::vector<double>& strides) {
+  std::vector<PoseSet> sets;
+  for (double stride : strides)
+    for (double d : distances) {
+      PoseSet set;
+      set.label =
+          "d:" + std::to_string(d).substr(0, 3) + "/stride:" + std::to_string(static_cast<int>(stride));
+      for (int k = 0; k < steps; k += static_cast<int>(stride))
+        set.poses.push_back(protocol_pose(d, k, steps));
+      sets.push_back(std::move(set));
+    }
+  return sets;
+}
+
+/// The p-quantile (nearest rank) of `v`.
+double quantile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5)];
+}
+
+/// One pass over the poses: its seconds, work and answers.
+struct Pass {
+  double seconds = 0;
+  Counters work;
+  std::vector<bool> answers;
+};
+
+template <class Query>
+Pass timed_pass(const std::vector<RigidTransform>& poses, Query&& query) {
+  Pass pass;
+  pass.answers.reserve(poses.size());
+  const auto start = std::chrono::steady_clock::now();
+  for (const RigidTransform& pose : poses) {
+    const Result r = query(pose);
+    pass.work += r.counters;
+    pass.answers.push_back(r.collides);
+  }
+  pass.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return pass;
+}
+
+struct Series {
+  std::vector<double> cold_us, coherent_us, ratios;
+  Counters cold_work, coherent_work;
+  std::uint64_t witness_hits = 0, jumps = 0, disagreements = 0;
+};
+
+void set_counters(benchmark::State& state, const Series& s, std::size_t queries) {
+  const double n = static_cast<double>(queries);
+  const double passes = static_cast<double>(s.ratios.size());
+  state.counters["speedup"] = quantile(s.ratios, 0.5);
+  state.counters["speedup_q1"] = quantile(s.ratios, 0.25);
+  state.counters["speedup_q3"] = quantile(s.ratios, 0.75);
+  state.counters["cold_us"] = quantile(s.cold_us, 0.5);
+  state.counters["coherent_us"] = quantile(s.coherent_us, 0.5);
+  state.counters["cold_bv"] = static_cast<double>(s.cold_work.bv_tests) / (n * passes);
+  state.counters["coherent_bv"] = static_cast<double>(s.coherent_work.bv_tests) / (n * passes);
+  state.counters["cold_tri"] = static_cast<double>(s.cold_work.triangle_tests) / (n * passes);
+  state.counters["coherent_tri"] = static_cast<double>(s.coherent_work.triangle_tests) / (n * passes);
+  state.counters["witness_share"] = static_cast<double>(s.witness_hits) / (n * passes);
+  state.counters["jumps"] = static_cast<double>(s.jumps) / passes;
+  state.counters["disagreements"] = static_cast<double>(s.disagreements);
+}
+
+/// One iteration's two passes, added to the series.
+void record(Series& s, const Pass& cold, const Pass& coherent, const CoherentState& state, double per_query) {
+  s.cold_us.push_back(cold.seconds * per_query);
+  s.coherent_us.push_back(coherent.seconds * per_query);
+  s.ratios.push_back(cold.seconds / coherent.seconds);
+  s.cold_work += cold.work;
+  s.coherent_work += coherent.work;
+  s.witness_hits += state.witness_hits();
+  s.jumps += state.jumps();
+  for (std::size_t k = 0; k < cold.answers.size(); ++k)
+    s.disagreements += cold.answers[k] != coherent.answers[k];
+}
+
+/// Cold and coherent passes over `poses`, alternating which goes first.
+template <class BV>
+void run_series(benchmark::State& state, const Bvh<BV>& tree, const std::vector<RigidTransform>& poses) {
+  Series s;
+  bool cold_first = true;
+  for (auto _ : state) {
+    CoherentState coherence;
+    auto cold = [&] { return timed_pass(poses, [&](const auto& p) { return query_exact(tree, tree, p); }); };
+    auto coherent = [&] {
+      return timed_pass(poses, [&](const auto& p) { return query_exact_coherent(tree, tree, p, coherence); });
+    };
+    Pass c, h;
+    if (cold_first)
+      c = cold(), h = coherent();
+    else
+      h = coherent(), c = cold();
+    cold_first = !cold_first;
+    record(s, c, h, coherence, 1e6 / static_cast<double>(poses.size()));
+  }
+  set_counters(state, s, poses.size());
+  if (s.disagreements) state.SkipWithError("coherent answers differ from the cold ones");
+}
+
+template <class BV>
+void register_volume(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
+                     const std::vector<PoseSet>& sets) {
+  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
+  for (const auto& set : sets) {
+    const std::string name = mesh_name + "/" + std::string(BV::name()) + "/" + set.label;
+    benchmark::RegisterBenchmark(name.c_str(), [tree, &set](benchmark::State& state) {
+      run_series(state, *tree, set.poses);
+    })->Unit(benchmark::kMillisecond);
+  }
+}
+
+}  // namespace
+}  // namespace bvhlab
+
+int main(int argc, char** argv) {
+  using namespace bvhlab;
+  std::vector<std::string> meshes{"jeep1.ms3d", "injector_pipes.stl"};
+  std::vector<std::string> volumes{"aabb", "dop24", "obb", "rbox"};
+  std::vector<double> distances{0.6, 1.0, 1.4};
+  std::vector<double> strides{1, 8, 64};
+  int steps = 2000;
+  if (auto exit = initialize_benchmark("bench_coherence",
+                                       {{"meshes", &meshes, "meshes to run"},
+                                        {"volumes", &volumes, "bounding volumes"},
+                                        {"distances", &distances, "protocol distances"},
+                                        {"strides", &strides, "ask every m-th pose of the turn (step size)"},
+                                        {"steps", &steps, "poses per full turn"}},
+                                       argc, argv))
+    return *exit;
+  if (steps < 1 || std::any_of(strides.begin(), strides.end(), [](double m) { return !(m >= 1); })) {
+    std::fprintf(stderr, "bench_coherence: --steps and every stride must be at least 1\n");
+    return 2;
+  }
+  static const std::vector<PoseSet> sets = make_pose_sets(distances, steps, strides);
+  for (const auto& file : meshes) {
+    if (!find_mesh(file)) {
+      std::fprintf(stderr, "bench_coherence: skipping %s (not found; run meshes/fetch.sh)\n", file.c_str());
+      continue;
+    }
+    const auto mesh = std::make_shared<const Mesh>(load_protocol_mesh(file));
+    const std::string label = std::filesystem::path(file).stem().string();
+    for (const auto& v : volumes)
+      with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_volume<BV>(label, mesh, sets); });
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,130 @@
+// The coherent queries' tests on every shipped volume (tests/traversal/test_coherent.cpp): the typed
+// suite, instantiated for half of the volumes in each of two files, so that both cores compile it.
+#pragma once
+
+#include "bench/core/ground_truth.hpp"
+#include "support/generated_meshes.hpp"
+#include "support/volume_lists.hpp"
+#include "traversal/coherent.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace bvhlab::coherent_tests {
+
+inline const Mesh& torus() {
+  static const Mesh mesh = testing::make_torus(0.7, 0.25, 40, 20);
+  return mesh;
+}
+inline const Mesh& soup() {
+  static const Mesh mesh = testing::make_random_soup(600, 0.08, 11);
+  return mesh;
+}
+
+/// B approaches A along x, through contact and out again, turning a little each step: `steps` poses.
+inline std::vector<RigidTransform> path(int steps, double turn_per_step = 0.004) {
+  std::vector<RigidTransform> poses;
+  for (int k = 0; k < steps; ++k) {
+    const double t = static_cast<double>(k) / (steps - 1);
+    RigidTransform pose;
+    pose.rotation = Eigen::AngleAxisd(turn_per_step * k, Vec3(1, 2, 3).normalized()).matrix();
+    pose.translation = Vec3(3.0 - 1.7 * std::sin(3.14159265358979 * t), 0.1, 0.05);
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
+inline const std::vector<bool>& path_truth() {
+  static const std::vector<bool> truth = [] {
+    const CgalGroundTruth cgal(torus(), soup());
+    std::vector<bool> out;
+    for (const RigidTransform& pose : path(240)) out.push_back(cgal.collides(pose));
+    return out;
+  }();
+  return truth;
+}
+
+inline bool witness_intersects(const Result& r, const RigidTransform& pose) {
+  const auto ta = torus().triangle(r.witness->a), tb = soup().triangle(r.witness->b);
+  return triangles_intersect_exact(ta, {pose.apply(tb[0]), pose.apply(tb[1]), pose.apply(tb[2])});
+}
+
+template <class BV>
+class Coherent : public ::testing::Test {
+ protected:
+  Bvh<BV> a = Bvh<BV>::build(torus());
+  Bvh<BV> b = Bvh<BV>::build(soup());
+};
+TYPED_TEST_SUITE_P(Coherent);
+
+TYPED_TEST_P(Coherent, FirstContactAlongAPathIsExactWithLessWork) {
+  const std::vector<RigidTransform> poses = path(240);
+  CoherentState state;
+  Counters cold_work, coherent_work;
+  int colliding = 0;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const Result cold = query_exact(this->a, this->b, poses[k]);
+    const Result r = query_exact_coherent(this->a, this->b, poses[k], state);
+    ASSERT_EQ(r.collides, path_truth()[k]) << "pose " << k;
+    ASSERT_EQ(cold.collides, r.collides) << "pose " << k;
+    EXPECT_TRUE(r.exact);
+    if (r.collides) {
+      ++colliding;
+      ASSERT_TRUE(r.witness.has_value());
+      ASSERT_TRUE(witness_intersects(r, poses[k])) << "pose " << k;
+    }
+    cold_work += cold.counters;
+    coherent_work += r.counters;
+  }
+  EXPECT_GT(colliding, 40);  // both answers, or the comparison shows little
+  EXPECT_LT(colliding, 200);
+  EXPECT_GT(state.witness_hits(), 0u);
+  // Small steps: the front spares most of the tests the cold query repeats from the root.
+  EXPECT_LT(coherent_work.bv_tests, cold_work.bv_tests / 2);
+}
+
+TYPED_TEST_P(Coherent, AllContactsAlongAPathAreTheColdQuerys) {
+  const std::vector<RigidTransform> poses = path(60, 0.02);
+  CoherentState state;
+  int with_contacts = 0;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    Result cold = query_exact(this->a, this->b, poses[k], ContactMode::All);
+    Result r = query_exact_coherent(this->a, this->b, poses[k], state, ContactMode::All);
+    std::sort(cold.contacts.begin(), cold.contacts.end());
+    std::sort(r.contacts.begin(), r.contacts.end());
+    ASSERT_EQ(r.contacts, cold.contacts) << "pose " << k;
+    ASSERT_EQ(r.collides, cold.collides);
+    with_contacts += !r.contacts.empty();
+  }
+  EXPECT_GT(with_contacts, 5);
+}
+
+TYPED_TEST_P(Coherent, UnrelatedPosesStayExact) {
+  // No jump limit: the front of one pose is walked at the next, however far apart they are.
+  CoherentState state(CoherenceOptions{.max_jump = 1e9});
+  std::mt19937_64 rng(3);
+  int colliding = 0;
+  for (int k = 0; k < 150; ++k) {
+    const RigidTransform pose = testing::random_pose(rng, 2.2);
+    const Result cold = query_exact(this->a, this->b, pose);
+    const Result r = query_exact_coherent(this->a, this->b, pose, state);
+    ASSERT_EQ(r.collides, cold.collides) << "pose " << k;
+    if (r.collides) {
+      ASSERT_TRUE(witness_intersects(r, pose)) << "pose " << k;
+    }
+    colliding += r.collides;
+  }
+  EXPECT_GT(colliding, 10);
+  EXPECT_LT(colliding, 140);
+}
+
+REGISTER_TYPED_TEST_SUITE_P(Coherent, FirstContactAlongAPathIsExactWithLessWork,
+                            AllContactsAlongAPathAreTheColdQuerys, UnrelatedPosesStayExact);
+
+}  // namespace bvhlab::coherent_tests

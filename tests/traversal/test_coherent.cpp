@@ -1,0 +1,107 @@
+// Coherent exact queries (traversal/coherent.hpp) on every shipped volume: along paths through contact and
+// across unrelated poses they answer as CGAL's exact predicates do and as the cold query does, list the same
+// contacts, do less work than the cold query on small steps, raise their front back to the root, keep their
+// bounds, and refuse what they cannot serve.
+#include "coherent_suite.hpp"
+#include "support/errors.hpp"
+
+namespace bvhlab::coherent_tests {
+namespace {
+
+using EvenVolumes = testing::AlternateTypes<0, testing::TraversalTestVolumes>::type;
+INSTANTIATE_TYPED_TEST_SUITE_P(EvenVolumes, Coherent, EvenVolumes);
+
+/// B moved along x from 1.0 to the first pose without contact, 0.01 at a time.
+RigidTransform first_clear_pose(const Bvh<Aabb>& a, const Bvh<Aabb>& b) {
+  RigidTransform pose = RigidTransform::translate(Vec3(1.0, 0.1, 0.05));
+  while (query_exact(a, b, pose).collides && pose.translation.x() < 3) pose.translation.x() += 0.01;
+  return pose;
+}
+
+TEST(Coherent, MovingApartRaisesTheFrontToTheRoot) {
+  const auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  CoherentState state;
+  RigidTransform pose = first_clear_pose(a, b);
+  ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
+  ASSERT_GT(state.front_size(), 10u);
+  for (int k = 0; k < 250; ++k) {  // 0.01 per step: 2.5 units away, the boxes far apart
+    pose.translation.x() += 0.01;
+    ASSERT_EQ(query_exact_coherent(a, b, pose, state).collides, query_exact(a, b, pose).collides) << k;
+  }
+  EXPECT_EQ(state.front_size(), 1u);
+  EXPECT_EQ(query_exact_coherent(a, b, pose, state).counters.bv_tests, 1u);
+}
+
+TEST(Coherent, TheStoredTreeStaysWithinMaxPairs) {
+  const auto a = Bvh<Obb>::build(torus());
+  const auto b = Bvh<Obb>::build(soup());
+  CoherentState state(CoherenceOptions{.max_pairs = 16});
+  std::size_t most = 0;
+  for (const RigidTransform& pose : path(80, 0.01)) {
+    ASSERT_EQ(query_exact_coherent(a, b, pose, state).collides, query_exact(a, b, pose).collides);
+    most = std::max(most, state.stored_pairs());
+  }
+  EXPECT_LE(most, 16u);
+  EXPECT_GT(most, 0u);
+}
+
+TEST(Coherent, APoseJumpStartsFromTheRoot) {
+  const auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  CoherentState state;
+  RigidTransform pose = first_clear_pose(a, b);
+  ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
+  pose.translation.x() += 0.01;
+  ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
+  EXPECT_EQ(state.jumps(), 0u);
+  pose.translation.x() =
+      -pose.translation.x();  // to the other side of A: B's box moves by far more than its radius
+  const Result far = query_exact_coherent(a, b, pose, state);
+  EXPECT_EQ(state.jumps(), 1u);
+  CoherentState fresh;  // the query from the root: the same work
+  EXPECT_EQ(far.counters.bv_tests, query_exact_coherent(a, b, pose, fresh).counters.bv_tests);
+}
+
+TEST(Coherent, ARepeatedContactIsAnsweredByItsWitness) {
+  const auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  CoherentState state;
+  const RigidTransform pose = RigidTransform::translate(Vec3(0.7, 0, 0));
+  const Result first = query_exact_coherent(a, b, pose, state);
+  ASSERT_TRUE(first.collides);
+  const Result again = query_exact_coherent(a, b, pose, state);
+  EXPECT_TRUE(again.collides);
+  EXPECT_EQ(again.witness, first.witness);
+  EXPECT_EQ(again.counters.bv_tests, 0u);
+  EXPECT_EQ(state.witness_hits(), 1u);
+}
+
+TEST(Coherent, RefusesWhatItCannotServe) {
+  const auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  const auto other = Bvh<Aabb>::build(testing::make_torus(0.5, 0.2, 12, 8));
+  CoherentState state;
+  query_exact_coherent(a, b, RigidTransform::identity(), state);
+  EXPECT_NE(testing::error_of([&] {
+              query_exact_coherent(a, other, RigidTransform::identity(), state);
+            }).find("made for other trees"),
+            std::string::npos);
+  RigidTransform scaled;
+  scaled.rotation *= 2;
+  EXPECT_THROW(query_exact_coherent(a, b, scaled, state), std::invalid_argument);
+  {
+    const CoherentState::InUse held(state);  // as another thread's query would
+    EXPECT_NE(testing::error_of([&] {
+                query_exact_coherent(a, b, RigidTransform::identity(), state);
+              }).find("in use by another query"),
+              std::string::npos);
+  }
+  EXPECT_NO_THROW(query_exact_coherent(a, b, RigidTransform::identity(), state));
+  EXPECT_THROW(CoherentState(CoherenceOptions{.max_pairs = 0}), std::invalid_argument);
+  EXPECT_THROW(CoherentState(CoherenceOptions{.max_jump = std::nan("")}), std::invalid_argument);
+  EXPECT_THROW(CoherentState(CoherenceOptions{.max_jump = -1}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace bvhlab::coherent_tests

@@ -1,0 +1,223 @@
+// Coherent exact queries: one pair of trees asked again and again while B moves a little (a simulation step,
+// a haptic loop, the protocol's turn) starts each query where the last one ended, in the manner of Ehmann and
+// Lin's front tracking.
+//
+// The state (traversal/coherent_state.hpp) stores the traversal tree of the last query: every node pair it
+// reached, in the exact strategy's order (depth first, the larger node split). Its front pairs (those not
+// split: volumes disjoint, or a leaf pair without contact) are a cut: every triangle pair lies below exactly
+// one of them. The next query
+//   1. tests the remembered contact's leaf pair first (first contact only): if its triangles still intersect,
+//      that is the answer;
+//   2. otherwise walks the stored tree from its root without testing its inner pairs, and tests each front
+//      pair again at the new pose: a pair still disjoint stays; one that overlaps now is descended as the
+//      exact strategy would (it may find a contact); a leaf pair is tested by its triangles;
+//   3. raises: an inner pair whose children are all disjoint again is tested itself, and if disjoint becomes
+//      one front pair (so objects moving apart end up with their root pair alone). A parent that still
+//      overlaps is not tested again for CoherenceOptions::raise_hold queries.
+// The answer is exact whatever the state holds: "no contact" only when every front pair was found disjoint
+// or without contact at the current pose, "contact" only with a triangle pair intersecting at it. The state
+// starts from the root when it is new, after a pose jump or when its tree grew past max_pairs.
+#pragma once
+
+#include "coherent_state.hpp"
+#include "exact.hpp"
+
+#include <optional>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+namespace bvhlab {
+
+namespace coherent_detail {
+
+inline constexpr std::uint32_t kCold = ~std::uint32_t{0};
+using LeafPair = std::pair<std::uint32_t, std::uint32_t>;
+
+/// B's root box in its own frame: what a pose jump is measured against.
+template <TreeVolume BV>
+Box root_box(const Bvh<BV>& tree) {
+  if constexpr (HierarchicalVolume<BV>)
+    return tree.root_volume().bounding_box();
+  else
+    return tree.volume(0).bounding_box();
+}
+
+/// One walk over the stored traversal tree (`stored`, possibly empty: from the root), writing the new one
+/// into `next`. Iterative: a stack of items, each a pair to visit or an inner pair to try to raise.
+template <TreeVolume BV, class Leaves>
+class FrontWalk {
+ public:
+  using Pair = QueuedPair<BV>;
+  using Hooks = ExactHooks<BV, Pair, Leaves>;
+
+  FrontWalk(const TreePair<BV, Leaves>& trees, const std::vector<FrontPair>& stored,
+            std::vector<FrontPair>& next, Hooks& hooks, std::uint8_t raise_hold)
+      : trees_(trees), stored_(stored), next_(next), hooks_(hooks), raise_hold_(raise_hold) {}
+
+  /// The leaf pair of the first contact (the hooks stop there in first-contact mode), or nullopt once the
+  /// whole tree was walked.
+  std::optional<LeafPair> run() {
+    next_.clear();
+    next_.push_back(FrontPair{});
+    items_.clear();
+    items_.push_back({trees_.template root<Pair>(), 0, stored_.empty() ? kCold : 0, false});
+    while (!items_.empty()) {
+      const Item item = items_.back();
+      items_.pop_back();
+      if (item.raise) {
+        try_raise(item);
+        continue;
+      }
+      ++trees_.counters.nodes_visited;
+      if (item.stored != kCold && stored_[item.stored].count > 0) {
+        reuse(item);
+        continue;
+      }
+      if (auto hit = test(item)) return hit;
+    }
+    return std::nullopt;
+  }
+
+ private:
+  struct Item {
+    Pair pair;             ///< the nodes and their walkers' state at the current pose
+    std::uint32_t out;     ///< its entry in next_
+    std::uint32_t stored;  ///< its entry in stored_, or kCold below a pair that overlaps now
+    bool raise;            ///< after its children: try to make it a front pair again
+  };
+  /// Collects the exact strategy's child pairs of one pair (SplitLarger: two, right then left).
+  struct Children {
+    std::optional<Pair> at[2];
+    int count = 0;
+    bool child(Pair&& p) {
+      at[count++].emplace(p);
+      return true;
+    }
+  };
+
+  /// A front pair, or a pair below one that overlaps: tested as the exact strategy tests it.
+  std::optional<LeafPair> test(const Item& item) {
+    const Pair& p = item.pair;
+    if (!trees_.overlap(p)) {
+      next_[item.out].separated = 1;
+      return std::nullopt;
+    }
+    if (trees_.is_leaf_pair(p)) {
+      if (hooks_.leaf_pair(p) == Step::Decided) return LeafPair{p.a, p.b};
+      return std::nullopt;
+    }
+    Children children;
+    SplitLarger::expand(trees_, p, children);
+    const auto first = static_cast<std::uint32_t>(next_.size());
+    next_[item.out].first = first;
+    next_[item.out].count = static_cast<std::uint8_t>(children.count);
+    for (int c = 0; c < children.count; ++c) {
+      const Pair& child = *children.at[c];
+      next_.push_back(FrontPair{child.a, child.b});
+      items_.push_back({child, first + static_cast<std::uint32_t>(c), kCold, false});
+    }
+    return std::nullopt;
+  }
+
+  /// An inner pair of the stored tree: not tested; its children are visited, then raising is tried.
+  void reuse(const Item& item) {
+    const FrontPair& old = stored_[item.stored];
+    const auto first = static_cast<std::uint32_t>(next_.size());
+    FrontPair& pair = next_[item.out];
+    pair.first = first;
+    pair.count = old.count;
+    pair.hold = old.hold > 0 ? static_cast<std::uint8_t>(old.hold - 1) : std::uint8_t{0};
+    if (pair.hold == 0) items_.push_back({item.pair, item.out, item.stored, true});
+    for (std::uint32_t c = 0; c < old.count; ++c) {
+      const FrontPair& child = stored_[old.first + c];
+      next_.push_back(FrontPair{child.a, child.b});
+      items_.push_back({child_pair(item.pair, child.a, child.b), first + c, old.first + c, false});
+    }
+  }
+
+  /// The walkers' state of a stored child pair, derived from its parent's at the current pose.
+  Pair child_pair(const Pair& p, std::uint32_t a, std::uint32_t b) const {
+    using Walker = VolumeWalker<BV>;
+    using Working = typename Walker::Working;
+    const Working wa = a == p.a ? Working(p.wa) : Walker::child_a(trees_.a, p.wa, a, trees_.context);
+    const Working wb = b == p.b ? Working(p.wb) : Walker::child_b(trees_.b, p.wb, b, trees_.context);
+    return Pair{{}, a, b, wa, wb, {}};
+  }
+
+  /// After the children of an inner pair: if all are disjoint front pairs, the pair itself is tested, and
+  /// becomes a front pair when disjoint too.
+  void try_raise(const Item& item) {
+    FrontPair& pair = next_[item.out];
+    for (std::uint32_t c = 0; c < pair.count; ++c) {
+      const FrontPair& child = next_[pair.first + c];
+      if (child.count != 0 || !child.separated) return;
+    }
+    if (trees_.overlap(item.pair)) {
+      pair.hold = raise_hold_;
+      return;
+    }
+    pair.count = 0;
+    pair.separated = 1;
+  }
+
+  const TreePair<BV, Leaves>& trees_;
+  const std::vector<FrontPair>& stored_;
+  std::vector<FrontPair>& next_;
+  Hooks& hooks_;
+  std::uint8_t raise_hold_;
+  /// The stack, kept by the thread between queries: a walk is never re-entered, and a query that allocated
+  /// its stack each time cost as much as a short front's tests.
+  static std::vector<Item>& thread_stack() {
+    thread_local std::vector<Item> items;
+    return items;
+  }
+  std::vector<Item>& items_ = thread_stack();
+};
+
+}  // namespace coherent_detail
+
+/// Exact first-contact (or all-contacts) query that starts from `state`, the memory of the previous queries
+/// on the same two trees (traversal/coherent_state.hpp), and leaves its own there. Answers, witnesses and
+/// contacts are those of query_exact; the counters say what this query tested. Throws std::invalid_argument
+/// for a non-rigid pose or a state made for other trees, std::logic_error for a state another query is
+/// using. The trees are read only: any number of states may share them, one per caller.
+template <TreeVolume BV, class Leaves = TriangleLeaves>
+Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
+                            CoherentState& state, ContactMode mode = ContactMode::First,
+                            const Leaves& leaves = kTriangleLeaves) {
+  b_to_a.validate();
+  if constexpr (!Leaves::kTriangles)
+    if (mode == ContactMode::All)
+      throw std::invalid_argument("all contacts: point surfaces have no triangle pairs to list");
+  const CoherentState::InUse in_use(state);
+  if (!state.bound() && !b.empty()) {
+    const Box box = coherent_detail::root_box(b);
+    state.bind(&a, a.nodes().size(), &b, b.nodes().size(), box.center(), box.extent().norm() / 2);
+  }
+  state.check_trees(&a, a.nodes().size(), &b, b.nodes().size());
+  Result result;
+  result.exact = true;
+  if (a.empty() || b.empty()) return result;
+  if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "coherent exact query");
+  const auto context = VolumeWalker<BV>::make_context(b_to_a);
+  const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
+  using Walk = coherent_detail::FrontWalk<BV, Leaves>;
+  typename Walk::Hooks hooks(trees, result, mode);
+  if (mode == ContactMode::First && state.witness) {
+    const auto [i, j] = *state.witness;
+    if (hooks.leaf_pair(typename Walk::Pair{{}, i, j, {}, {}, {}}) == Step::Decided) {
+      state.count_witness_hit();
+      return result;
+    }
+  }
+  if (!state.front_usable(b_to_a)) state.pairs().clear();
+  std::vector<FrontPair>& next = state.spare();
+  Walk walk(trees, state.pairs(), next, hooks, state.options().raise_hold);
+  state.witness = walk.run();
+  // A contact ends the walk early: the stored tree (a cut, from an earlier pose) stays for the next query.
+  if (!state.witness) state.store(next, b_to_a);
+  return result;
+}
+
+}  // namespace bvhlab

@@ -1,0 +1,112 @@
+#include "coherent_state.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace bvhlab {
+
+void CoherenceOptions::validate() const {
+  if (max_pairs == 0) throw std::invalid_argument("coherence: max_pairs must be at least 1");
+  if (!(max_jump >= 0) || !std::isfinite(max_jump))
+    throw std::invalid_argument("coherence: max_jump must be a finite number >= 0");
+}
+
+CoherentState::CoherentState(CoherenceOptions options) : options_(options) {
+  options_.validate();
+}
+
+CoherentState::CoherentState(const CoherentState& other)
+    : witness(other.witness),
+      options_(other.options_),
+      a_(other.a_),
+      b_(other.b_),
+      a_nodes_(other.a_nodes_),
+      b_nodes_(other.b_nodes_),
+      b_centre_(other.b_centre_),
+      b_radius_(other.b_radius_),
+      pairs_(other.pairs_),
+      pose_(other.pose_),
+      jumps_(other.jumps_),
+      witness_hits_(other.witness_hits_) {}
+
+CoherentState& CoherentState::operator=(const CoherentState& other) {
+  if (this == &other) return *this;
+  const InUse guard(*this);
+  witness = other.witness;
+  options_ = other.options_;
+  a_ = other.a_;
+  b_ = other.b_;
+  a_nodes_ = other.a_nodes_;
+  b_nodes_ = other.b_nodes_;
+  b_centre_ = other.b_centre_;
+  b_radius_ = other.b_radius_;
+  pairs_ = other.pairs_;
+  pose_ = other.pose_;
+  jumps_ = other.jumps_;
+  witness_hits_ = other.witness_hits_;
+  return *this;
+}
+
+void CoherentState::reset() {
+  pairs_.clear();
+  witness.reset();
+}
+
+std::size_t CoherentState::front_size() const {
+  return static_cast<std::size_t>(
+      std::count_if(pairs_.begin(), pairs_.end(), [](const FrontPair& p) { return p.count == 0; }));
+}
+
+void CoherentState::bind(const void* a, std::size_t a_nodes, const void* b, std::size_t b_nodes,
+                         const Vec3& centre, double radius) {
+  check_trees(a, a_nodes, b, b_nodes);
+  a_ = a, b_ = b, a_nodes_ = a_nodes, b_nodes_ = b_nodes;
+  b_centre_ = centre;
+  b_radius_ = radius;
+}
+
+void CoherentState::check_trees(const void* a, std::size_t a_nodes, const void* b,
+                                std::size_t b_nodes) const {
+  if (a_ == nullptr) return;
+  if (a != a_ || b != b_ || a_nodes != a_nodes_ || b_nodes != b_nodes_)
+    throw std::invalid_argument(
+        "coherent query: the state was made for other trees (one state per pair of trees; reset() does not "
+        "rebind it)");
+}
+
+CoherentState::InUse::InUse(CoherentState& state) : state_(state) {
+  if (state_.busy_.exchange(true, std::memory_order_acquire))
+    throw std::logic_error(
+        "coherent query: the state is in use by another query (a state belongs to one caller; give each "
+        "thread its own)");
+}
+
+CoherentState::InUse::~InUse() {
+  state_.busy_.store(false, std::memory_order_release);
+}
+
+bool CoherentState::front_usable(const RigidTransform& pose) {
+  if (pairs_.empty()) return false;
+  // Every point p of B's root sphere moves by (R - R0) p + (t - t0). |R - R0| = 2 sin(angle / 2), which is
+  // sqrt(3 - trace(R R0^T)); the trace is the entrywise product of R and R0.
+  const Mat3 turn = pose.rotation - pose_.rotation;
+  const double trace = pose.rotation.cwiseProduct(pose_.rotation).sum();
+  const double spread = std::sqrt(std::max(0.0, 3 - trace));
+  const double moved = (turn * b_centre_ + pose.translation - pose_.translation).norm() + spread * b_radius_;
+  if (moved <= options_.max_jump * b_radius_) return true;
+  ++jumps_;
+  return false;
+}
+
+void CoherentState::store(std::vector<FrontPair>& next, const RigidTransform& pose) {
+  if (next.size() > options_.max_pairs) {
+    pairs_.clear();
+    next = {};  // give the memory back: the bound is on what the state holds
+    return;
+  }
+  pairs_.swap(next);
+  pose_ = pose;
+}
+
+}  // namespace bvhlab

@@ -1,0 +1,110 @@
+// What a coherent query keeps between the queries of one pair of trees (traversal/coherent.hpp): the front
+// where the last traversal stopped, the colliding leaf pair it found, and the pose it was computed at.
+// No templates: the same state serves every volume, so callers above the typed layer can hold one.
+#pragma once
+
+#include "../volumes/geometry.hpp"
+#include "result.hpp"
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace bvhlab {
+
+/// When a coherent query starts from the root instead of the stored front.
+struct CoherenceOptions {
+  /// A stored traversal tree of more pairs than this is dropped after the query that made it; the next
+  /// query starts from the root. 16 bytes a pair: the default holds 4 MiB.
+  std::size_t max_pairs = std::size_t{1} << 18;
+  /// The pose jumps when some point of B's root box moves (relative to A) by more than this many of the
+  /// box's radii since the stored query: the front is dropped and the query starts from the root.
+  double max_jump = 0.5;
+  /// A front pair whose parent pair was tested for raising and still overlapped waits this many queries
+  /// before its parent is tested again (so pairs close to contact do not pay a useless test every query).
+  std::uint8_t raise_hold = 8;
+
+  /// Throws std::invalid_argument for nonsense values (max_pairs 0, a NaN or negative max_jump).
+  void validate() const;
+};
+
+/// One pair of the stored traversal tree: the node pairs the last query reached, each either a front pair
+/// (count 0: tested again by the next query) or an inner pair whose `count` children follow at `first`.
+struct FrontPair {
+  std::uint32_t a = 0, b = 0;
+  std::uint32_t first = 0;
+  std::uint8_t count = 0;
+  std::uint8_t separated = 0;  ///< a front pair whose volumes were disjoint when last tested
+  std::uint8_t hold = 0;       ///< queries before raising this pair's children is tried again
+};
+
+/// The memory of one pair of trees across queries. Belongs to one caller: a state used by two queries at
+/// once is refused (std::logic_error), and a state made for other trees too (std::invalid_argument).
+/// Whatever it holds, an exact query stays exact: the front is a cut of every triangle pair, re-tested at the
+/// current pose, and a remembered contact counts only if its triangles intersect at the current pose.
+class CoherentState {
+ public:
+  explicit CoherentState(CoherenceOptions options = {});
+  CoherentState(const CoherentState& other);
+  CoherentState& operator=(const CoherentState& other);
+
+  /// Forgets everything: the next query starts from the root (as the first one does).
+  void reset();
+  [[nodiscard]] const CoherenceOptions& options() const { return options_; }
+  /// Front pairs of the stored traversal tree (0 before the first query).
+  [[nodiscard]] std::size_t front_size() const;
+  /// Pairs stored (front and inner).
+  [[nodiscard]] std::size_t stored_pairs() const { return pairs_.size(); }
+  /// Queries that started from the root although a front was stored (the pose jumped).
+  [[nodiscard]] std::uint64_t jumps() const { return jumps_; }
+  /// Queries answered by the remembered contact alone.
+  [[nodiscard]] std::uint64_t witness_hits() const { return witness_hits_; }
+
+  // ---- For the coherent queries (traversal/coherent.hpp) ----------------------------------------------
+  /// Binds the state to its trees (their addresses and sizes) and B's root box (its centre and radius in
+  /// B's frame: what a pose jump is measured against).
+  void bind(const void* a, std::size_t a_nodes, const void* b, std::size_t b_nodes, const Vec3& centre,
+            double radius);
+  [[nodiscard]] bool bound() const { return a_ != nullptr; }
+  /// Throws std::invalid_argument unless the state is unbound or bound to these trees.
+  void check_trees(const void* a, std::size_t a_nodes, const void* b, std::size_t b_nodes) const;
+  /// Marks the state in use for one query; throws std::logic_error when another query holds it.
+  class InUse {
+   public:
+    explicit InUse(CoherentState& state);
+    ~InUse();
+    InUse(const InUse&) = delete;
+    InUse& operator=(const InUse&) = delete;
+
+   private:
+    CoherentState& state_;
+  };
+
+  /// True when a front is stored and `pose` is close enough to its pose (CoherenceOptions::max_jump);
+  /// counts a jump otherwise.
+  [[nodiscard]] bool front_usable(const RigidTransform& pose);
+  std::vector<FrontPair>& pairs() { return pairs_; }
+  std::vector<FrontPair>& spare() { return spare_; }
+  /// Keeps `next` (built for `pose`) as the stored tree, or drops it when larger than max_pairs.
+  void store(std::vector<FrontPair>& next, const RigidTransform& pose);
+  /// The leaf pair of the last contact found, if any.
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> witness;
+  void count_witness_hit() { ++witness_hits_; }
+
+ private:
+  CoherenceOptions options_;
+  const void* a_ = nullptr;
+  const void* b_ = nullptr;
+  std::size_t a_nodes_ = 0, b_nodes_ = 0;
+  Vec3 b_centre_ = Vec3::Zero();
+  double b_radius_ = 0;
+  std::vector<FrontPair> pairs_;  ///< the stored traversal tree; pairs_[0] is the root pair
+  std::vector<FrontPair> spare_;  ///< the next tree is built here, then swapped in (no allocation per query)
+  RigidTransform pose_;           ///< the pose pairs_ was computed at
+  std::uint64_t jumps_ = 0, witness_hits_ = 0;
+  std::atomic<bool> busy_{false};
+};
+
+}  // namespace bvhlab
