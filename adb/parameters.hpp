@@ -62,7 +62,9 @@ std::string describe_parameters(std::span<const ParamSpec> specs, const ParamVal
   for (const ParamSpec& spec : specs) {
     const auto it = values.find(spec.name);
     if (it == values.end() || !include(spec)) continue;
-    out += (out.empty() ? "" : " ") + std::string(spec.name) + "=" + parameter_text(it->second);
+    // Appended in place: GCC 12 warns (-Wrestrict, falsely) on the temporaries of a concatenation here.
+    if (!out.empty()) out.push_back(' ');
+    out.append(spec.name).append("=").append(parameter_text(it->second));
   }
   return out;
 }
