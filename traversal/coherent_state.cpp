@@ -16,38 +16,6 @@ CoherentState::CoherentState(CoherenceOptions options) : options_(options) {
   options_.validate();
 }
 
-CoherentState::CoherentState(const CoherentState& other)
-    : witness(other.witness),
-      options_(other.options_),
-      a_(other.a_),
-      b_(other.b_),
-      a_nodes_(other.a_nodes_),
-      b_nodes_(other.b_nodes_),
-      b_centre_(other.b_centre_),
-      b_radius_(other.b_radius_),
-      pairs_(other.pairs_),
-      pose_(other.pose_),
-      jumps_(other.jumps_),
-      witness_hits_(other.witness_hits_) {}
-
-CoherentState& CoherentState::operator=(const CoherentState& other) {
-  if (this == &other) return *this;
-  const InUse guard(*this);
-  witness = other.witness;
-  options_ = other.options_;
-  a_ = other.a_;
-  b_ = other.b_;
-  a_nodes_ = other.a_nodes_;
-  b_nodes_ = other.b_nodes_;
-  b_centre_ = other.b_centre_;
-  b_radius_ = other.b_radius_;
-  pairs_ = other.pairs_;
-  pose_ = other.pose_;
-  jumps_ = other.jumps_;
-  witness_hits_ = other.witness_hits_;
-  return *this;
-}
-
 void CoherentState::reset() {
   pairs_.clear();
   witness.reset();
@@ -76,14 +44,14 @@ void CoherentState::check_trees(const void* a, std::size_t a_nodes, const void* 
 }
 
 CoherentState::InUse::InUse(CoherentState& state) : state_(state) {
-  if (state_.busy_.exchange(true, std::memory_order_acquire))
+  if (state_.busy_.busy.exchange(true, std::memory_order_acquire))
     throw std::logic_error(
         "coherent query: the state is in use by another query (a state belongs to one caller; give each "
         "thread its own)");
 }
 
 CoherentState::InUse::~InUse() {
-  state_.busy_.store(false, std::memory_order_release);
+  state_.busy_.busy.store(false, std::memory_order_release);
 }
 
 bool CoherentState::front_usable(const RigidTransform& pose) {

@@ -47,8 +47,6 @@ struct FrontPair {
 class CoherentState {
  public:
   explicit CoherentState(CoherenceOptions options = {});
-  CoherentState(const CoherentState& other);
-  CoherentState& operator=(const CoherentState& other);
 
   /// Forgets everything: the next query starts from the root (as the first one does).
   void reset();
@@ -104,7 +102,13 @@ class CoherentState {
   std::vector<FrontPair> spare_;  ///< the next tree is built here, then swapped in (no allocation per query)
   RigidTransform pose_;           ///< the pose pairs_ was computed at
   std::uint64_t jumps_ = 0, witness_hits_ = 0;
-  std::atomic<bool> busy_{false};
+  /// Set while a query uses the state; a copy of the state is not in use.
+  struct BusyFlag {
+    std::atomic<bool> busy{false};
+    BusyFlag() = default;
+    BusyFlag(const BusyFlag&) {}
+    BusyFlag& operator=(const BusyFlag&) { return *this; }
+  } busy_;
 };
 
 }  // namespace bvhlab

@@ -11,19 +11,21 @@ namespace {
 using EvenVolumes = testing::AlternateTypes<0, testing::TraversalTestVolumes>::type;
 INSTANTIATE_TYPED_TEST_SUITE_P(EvenVolumes, Coherent, EvenVolumes);
 
-/// B moved along x from 1.0 to the first pose without contact, 0.01 at a time.
-RigidTransform first_clear_pose(const Bvh<Aabb>& a, const Bvh<Aabb>& b) {
-  RigidTransform pose = RigidTransform::translate(Vec3(1.0, 0.1, 0.05));
-  while (query_exact(a, b, pose).collides && pose.translation.x() < 3) pose.translation.x() += 0.01;
-  return pose;
-}
-
-TEST(Coherent, MovingApartRaisesTheFrontToTheRoot) {
-  const auto a = Bvh<Aabb>::build(torus());
-  const auto b = Bvh<Aabb>::build(soup());
+/// AABB trees, and a state whose first query found no contact close to it: B moved along x from 1.0 to the
+/// first pose without contact, 0.01 at a time.
+class ClearOfContact : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    while (query_exact(a, b, pose).collides && pose.translation.x() < 3) pose.translation.x() += 0.01;
+    ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
+  }
+  const Bvh<Aabb> a = Bvh<Aabb>::build(torus());
+  const Bvh<Aabb> b = Bvh<Aabb>::build(soup());
   CoherentState state;
-  RigidTransform pose = first_clear_pose(a, b);
-  ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
+  RigidTransform pose = RigidTransform::translate(Vec3(1.0, 0.1, 0.05));
+};
+
+TEST_F(ClearOfContact, MovingApartRaisesTheFrontToTheRoot) {
   ASSERT_GT(state.front_size(), 10u);
   for (int k = 0; k < 250; ++k) {  // 0.01 per step: 2.5 units away, the boxes far apart
     pose.translation.x() += 0.01;
@@ -46,12 +48,7 @@ TEST(Coherent, TheStoredTreeStaysWithinMaxPairs) {
   EXPECT_GT(most, 0u);
 }
 
-TEST(Coherent, APoseJumpStartsFromTheRoot) {
-  const auto a = Bvh<Aabb>::build(torus());
-  const auto b = Bvh<Aabb>::build(soup());
-  CoherentState state;
-  RigidTransform pose = first_clear_pose(a, b);
-  ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
+TEST_F(ClearOfContact, APoseJumpStartsFromTheRoot) {
   pose.translation.x() += 0.01;
   ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
   EXPECT_EQ(state.jumps(), 0u);
@@ -96,6 +93,8 @@ TEST(Coherent, RefusesWhatItCannotServe) {
                 query_exact_coherent(a, b, RigidTransform::identity(), state);
               }).find("in use by another query"),
               std::string::npos);
+    CoherentState copy = state;  // a copy is a state of its own, not in use
+    EXPECT_NO_THROW(query_exact_coherent(a, b, RigidTransform::identity(), copy));
   }
   EXPECT_NO_THROW(query_exact_coherent(a, b, RigidTransform::identity(), state));
   EXPECT_THROW(CoherentState(CoherenceOptions{.max_pairs = 0}), std::invalid_argument);
