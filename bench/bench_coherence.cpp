@@ -11,6 +11,7 @@
 // triangle tests per query, the share of queries the remembered contact answered, pose jumps, and the
 // disagreements with the cold answers (the run fails unless 0).
 #include "bench/core/bench_flags.hpp"
+#include "bench/report_tables.hpp"
 #include "engine/mesh_catalog.hpp"
 #include "engine/protocol.hpp"
 #include "engine/registry.hpp"
@@ -49,13 +50,6 @@ std::vector<PoseSet> make_pose_sets(const std::vector<double>& distances, int st
   return sets;
 }
 
-/// The p-quantile (nearest rank) of `v`.
-double quantile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5)];
-}
-
 /// One pass over the poses: its seconds, work and answers.
 struct Pass {
   double seconds = 0;
@@ -84,6 +78,7 @@ struct Series {
 };
 
 void set_counters(benchmark::State& state, const Series& s, std::size_t queries) {
+  using report_tables::quantile;
   const double n = static_cast<double>(queries);
   const double passes = static_cast<double>(s.ratios.size());
   state.counters["speedup"] = quantile(s.ratios, 0.5);

@@ -34,15 +34,6 @@ namespace coherent_detail {
 inline constexpr std::uint32_t kCold = ~std::uint32_t{0};
 using LeafPair = std::pair<std::uint32_t, std::uint32_t>;
 
-/// B's root box in its own frame: what a pose jump is measured against.
-template <TreeVolume BV>
-Box root_box(const Bvh<BV>& tree) {
-  if constexpr (HierarchicalVolume<BV>)
-    return tree.root_volume().bounding_box();
-  else
-    return tree.volume(0).bounding_box();
-}
-
 /// One walk over the stored traversal tree (`stored`, possibly empty: from the root), writing the new one
 /// into `next`. Iterative: a stack of items, each a pair to visit or an inner pair to try to raise.
 template <TreeVolume BV, class Leaves>
@@ -186,13 +177,10 @@ template <TreeVolume BV, class Leaves = TriangleLeaves>
 Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
                             CoherentState& state, ContactMode mode = ContactMode::First,
                             const Leaves& leaves = kTriangleLeaves) {
-  b_to_a.validate();
-  if constexpr (!Leaves::kTriangles)
-    if (mode == ContactMode::All)
-      throw std::invalid_argument("all contacts: point surfaces have no triangle pairs to list");
+  check_exact_query<Leaves>(b_to_a, mode);
   const CoherentState::InUse in_use(state);
   if (!state.bound() && !b.empty()) {
-    const Box box = coherent_detail::root_box(b);
+    const Box box = b.root_volume().bounding_box();  // B's frame: what a pose jump is measured against
     state.bind(&a, a.nodes().size(), &b, b.nodes().size(), box.center(), box.extent().norm() / 2);
   }
   state.check_trees(&a, a.nodes().size(), &b, b.nodes().size());

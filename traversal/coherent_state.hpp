@@ -48,7 +48,8 @@ class CoherentState {
  public:
   explicit CoherentState(CoherenceOptions options = {});
 
-  /// Forgets everything: the next query starts from the root (as the first one does).
+  /// Forgets the stored front and the remembered contact: the next query starts from the root. The trees
+  /// it is bound to and its counters (jumps, witness hits) stay.
   void reset();
   [[nodiscard]] const CoherenceOptions& options() const { return options_; }
   /// Front pairs of the stored traversal tree (0 before the first query).

@@ -44,6 +44,16 @@ class ExactHooks {
   ContactMode mode_;
 };
 
+/// What every exact query checks first: a rigid pose (RigidTransform::validate), and a contact mode its
+/// leaf test can serve. Throws std::invalid_argument.
+template <class Leaves>
+void check_exact_query(const RigidTransform& b_to_a, ContactMode mode) {
+  b_to_a.validate();
+  if constexpr (!Leaves::kTriangles)
+    if (mode == ContactMode::All)
+      throw std::invalid_argument("all contacts: point surfaces have no triangle pairs to list");
+}
+
 /// Exact first-contact (or all-contacts) query. `b_to_a` maps B's local frame into A's. `leaves` is the
 /// leaf test (TreePair's Leaves); the default tests triangles, and traversal/point_leaves.hpp passes the
 /// surfaces of point clouds (query_exact_points). Const and thread-safe on shared trees: all traversal
@@ -51,10 +61,7 @@ class ExactHooks {
 template <TreeVolume BV, class Leaves = TriangleLeaves>
 Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
                    ContactMode mode = ContactMode::First, const Leaves& leaves = kTriangleLeaves) {
-  b_to_a.validate();
-  if constexpr (!Leaves::kTriangles)
-    if (mode == ContactMode::All)
-      throw std::invalid_argument("all contacts: point surfaces have no triangle pairs to list");
+  check_exact_query<Leaves>(b_to_a, mode);
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;
