@@ -23,8 +23,12 @@ demo: configure
 test: build
 	ctest --preset $(PRESET) -j $(JOBS)
 
+# ASan + UBSan on the tests declared SANITIZED and the fuzz corpora: the build holds only what they need
+# (tests/README.md, "Sanitizers and fuzzing"); every test runs in `make test`.
 asan-test:
-	$(MAKE) test PRESET=asan
+	$(MAKE) configure PRESET=asan
+	cmake --build --preset asan --target bvhlab_sanitized_tests -j $(JOBS)
+	ctest --preset asan -j $(JOBS)
 
 # ThreadSanitizer on the multi-threaded query tests (ctest label `threads`), built alone.
 tsan-test:

@@ -26,11 +26,13 @@ function(bvhlab_folder_includes target scope)
     $<INSTALL_INTERFACE:include>)
 endfunction()
 
-# bvhlab_add_test(NAME name SOURCES a.cpp ... [LIBS ...] [LABELS ...] [TIMEOUT s] [NEEDS_MESHES])
+# bvhlab_add_test(NAME name SOURCES a.cpp ... [LIBS ...] [LABELS ...] [TIMEOUT s] [NEEDS_MESHES] [SANITIZED])
 # One GoogleTest executable; each TEST is a separate ctest entry so ctest -j spreads them.
 # NEEDS_MESHES: the tests read fetched meshes, so they require the ctest fixture `meshes` (cmake/Meshes.cmake).
+# SANITIZED: the ASan stage builds and runs it too (label `sanitized`, target bvhlab_sanitized_tests; which
+# tests and why: tests/README.md, "Sanitizers and fuzzing"). Every test runs in the Release stage.
 function(bvhlab_add_test)
-  cmake_parse_arguments(T "NEEDS_MESHES" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(T "NEEDS_MESHES;SANITIZED" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main bvhlab_warnings)
   target_include_directories(${T_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
@@ -41,6 +43,10 @@ function(bvhlab_add_test)
   # The properties go into a script ctest includes after the discovered tests, not into
   # gtest_discover_tests(PROPERTIES): that flattens list values ("unit;bvh", two ENVIRONMENT entries) into the
   # name/value pairs, so labels, timeout and environment were silently lost.
+  if(T_SANITIZED)
+    list(APPEND T_LABELS sanitized)
+    add_dependencies(bvhlab_sanitized_tests ${T_NAME})
+  endif()
   string(JOIN ";" labels unit ${T_LABELS})
   set(properties "LABELS [==[${labels}]==] TIMEOUT ${T_TIMEOUT} ENVIRONMENT [==[BVHLAB_SOURCE_DIR=")
   string(APPEND properties "${PROJECT_SOURCE_DIR};BVHLAB_MESH_CACHE=${BVHLAB_MESH_CACHE}]==]")
