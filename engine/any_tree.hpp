@@ -24,6 +24,7 @@
 
 namespace bvhlab {
 
+class CoherentState;  // traversal/coherent_state.hpp
 // traversal/frame_budget.hpp
 struct FrameOptions;
 struct PairOutcome;
@@ -68,14 +69,22 @@ struct TreeInfo {
 using ResultSink = std::function<void(std::size_t, const Result&)>;
 
 /// A query between two trees with one strategy variant, checked and configured: running it cannot fail.
+/// A coherent variant (StrategyVariant::coherent) starts each pose where the previous one ended: run and
+/// time keep one state of their own over the poses of a call; run with a state continues the caller's.
 class PreparedQuery {
  public:
   virtual ~PreparedQuery() = default;
   /// Queries every pose in order (poses already validated as rigid), handing each result to `sink`.
   virtual void run(std::span<const RigidTransform> poses, const ResultSink& sink) const = 0;
+  /// The same, starting from `state` and leaving the last pose's front there, so that the next call
+  /// continues the sequence. Throws std::logic_error when the variant is not coherent or another query is
+  /// using the state, std::invalid_argument for a state used with other trees before.
+  virtual void run(std::span<const RigidTransform> poses, const ResultSink& sink,
+                   CoherentState& state) const = 0;
   /// Times every pose once after `warmup` untimed queries (timed_series, engine/timing.hpp).
   virtual void time(std::span<const RigidTransform> poses, int warmup,
                     std::vector<QueryRecord>& out) const = 0;
+  [[nodiscard]] virtual bool coherent() const = 0;
 };
 
 class AnyTree;

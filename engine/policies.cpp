@@ -26,6 +26,7 @@ StrategyInfo strategy_row() {
   info.budget = S::budget;
   info.needs_polygons = S::needs_polygons;
   info.needs_density = !S::template accepts<NoDensity>;
+  info.coherent = kRunsCoherent<S>;
   with_each_density([&]<class D>(std::type_identity<D>) {
     if constexpr (S::template accepts<D>) info.densities.emplace_back(D::name());
   });
@@ -79,6 +80,14 @@ std::string StrategyInfo::refusal(std::string_view density) const {
   if (accepts(density)) return {};
   return "strategy " + name + " does not run on trees with density '" + std::string(density) +
          "' (it runs on: " + joined_names(densities) + ")";
+}
+
+std::string StrategyInfo::coherent_refusal() const {
+  if (coherent) return "";
+  std::string those;
+  for (const StrategyInfo& s : strategy_table())
+    if (s.coherent) those += (those.empty() ? "" : ", ") + s.name;
+  return "strategy " + name + " does not run coherent (the strategies that do: " + those + ")";
 }
 
 const ParamSpec* StrategyInfo::parameter(std::string_view name) const {
@@ -144,6 +153,7 @@ nlohmann::json policies_json() {
                           {"budget", budget_text(s.budget)},
                           {"needs_polygons", s.needs_polygons},
                           {"needs_density", s.needs_density},
+                          {"coherent", s.coherent},
                           {"densities", s.densities},
                           {"parameters", parameters_json(s.parameters)}});
   return {{"densities", densities}, {"strategies", strategies}};

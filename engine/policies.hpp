@@ -27,6 +27,7 @@ struct StrategyInfo {
   BudgetUse budget = BudgetUse::None;
   bool needs_polygons = false;         ///< cannot run on trees saved without polygons
   bool needs_density = false;          ///< does not run on trees without a density
+  bool coherent = false;               ///< runs coherent over a sequence of poses (traversal/coherent.hpp)
   std::vector<std::string> densities;  ///< the registered densities it runs on
   std::vector<ParamSpec> parameters;
   [[nodiscard]] bool accepts(std::string_view density) const;
@@ -34,6 +35,9 @@ struct StrategyInfo {
   /// on trees with density 'none' (it runs on: adb, adb_paper, adb_normal)".
   [[nodiscard]] std::string refusal(std::string_view density) const;
   [[nodiscard]] const ParamSpec* parameter(std::string_view name) const;
+  /// Empty when it runs coherent; else the one message every caller gives: "strategy adb does not run
+  /// coherent (the strategies that do: exact, all_contacts)".
+  [[nodiscard]] std::string coherent_refusal() const;
 };
 
 /// In registration order.

@@ -33,7 +33,7 @@ std::string StrategyVariant::budget_label() const {
 }
 
 std::string StrategyVariant::label() const {
-  return strategy_label(strategy, values, budget);
+  return strategy_label(strategy, values, budget) + (coherent ? " coherent" : "");
 }
 
 double StrategyVariant::value_or(std::string_view name, double fallback) const {
@@ -43,6 +43,8 @@ double StrategyVariant::value_or(std::string_view name, double fallback) const {
 
 std::vector<StrategyVariant> expand(const StrategySpec& spec) {
   const StrategyInfo& info = strategy_info(spec.name);
+  if (spec.coherent)
+    if (std::string refusal = info.coherent_refusal(); !refusal.empty()) throw std::invalid_argument(refusal);
   // Cross product of the given values (a sweep may hold several), in the order of the parameter table.
   std::vector<ParamValues> combos{{}};
   for (const ParamSpec& p : info.parameters) {
@@ -61,7 +63,8 @@ std::vector<StrategyVariant> expand(const StrategySpec& spec) {
   std::vector<StrategyVariant> out;
   for (const ParamValues& combo : combos)
     for (const Budget& budget : budgets)
-      out.push_back({spec.name, resolve_parameters(info.parameters, combo, spec.name), budget});
+      out.push_back(
+          {spec.name, resolve_parameters(info.parameters, combo, spec.name), budget, spec.coherent});
   return out;
 }
 
@@ -96,6 +99,9 @@ StrategyVariant strategy_variant(const std::string& name, const ParamValues& giv
 }
 
 void check_strategy_options(const StrategyVariant& variant) {
+  if (variant.coherent)
+    if (std::string refusal = strategy_info(variant.strategy).coherent_refusal(); !refusal.empty())
+      throw std::invalid_argument(refusal);
   with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
     (void)strategy_options<S>(variant.values, variant.budget);
   });

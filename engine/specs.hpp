@@ -46,6 +46,7 @@ struct StrategySpec {
   std::map<std::string, std::vector<double>, std::less<>> values;  ///< as given; defaults come in expand()
   std::vector<Budget> budgets;                                     ///< strategies that take a budget
   std::vector<std::string> hierarchies;  ///< restricts the strategy to these; empty: all it applies to
+  bool coherent = false;                 ///< each variant runs coherent (StrategyVariant::coherent)
 };
 
 /// One concrete way to answer a query: the unit of a results row.
@@ -53,8 +54,11 @@ struct StrategyVariant {
   std::string strategy = "exact";
   ParamValues values;  ///< resolved
   Budget budget;
+  /// A query over a sequence of poses starts each pose where the previous one ended (traversal/coherent.hpp);
+  /// only strategies that run coherent take it (StrategyInfo::coherent). Same answers, less work.
+  bool coherent = false;
   [[nodiscard]] std::string budget_label() const;  ///< "" or "bv_tests=200" or "deadline_us=20"
-  [[nodiscard]] std::string label() const;         ///< e.g. "adb p_min=0.9"
+  [[nodiscard]] std::string label() const;         ///< e.g. "adb p_min=0.9", "exact coherent"
   /// The value of parameter `name`, or `fallback` when the strategy has none.
   [[nodiscard]] double value_or(std::string_view name, double fallback) const;
 };
@@ -79,7 +83,7 @@ DensitySpec density_spec(const std::string& name, const ParamValues& given);
 /// A strategy variant from its name, given parameters and budget, checked as `bvhlab query` checks them.
 /// Throws std::invalid_argument.
 StrategyVariant strategy_variant(const std::string& name, const ParamValues& given, const Budget& budget);
-/// Throws std::invalid_argument when the strategy refuses the variant's values or budget.
+/// Throws std::invalid_argument when the strategy refuses the variant's values, budget or coherence.
 void check_strategy_options(const StrategyVariant& variant);
 
 }  // namespace bvhlab

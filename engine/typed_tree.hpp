@@ -84,15 +84,29 @@ template <class S, class BV, class D, bool kSurfaces>
 class TypedQuery final : public PreparedQuery {
  public:
   TypedQuery(std::shared_ptr<const TypedBase<BV, D>> a, std::shared_ptr<const TypedBase<BV, D>> b,
-             typename S::Options options)
-      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)) {}
+             typename S::Options options, bool coherent)
+      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)), coherent_(coherent) {}
 
   void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
+    if (coherent_) {
+      CoherentState state;
+      return run(poses, sink, state);
+    }
     for (std::size_t i = 0; i < poses.size(); ++i) sink(i, query(poses[i]));
   }
+  void run(std::span<const RigidTransform> poses, const ResultSink& sink,
+           CoherentState& state) const override {
+    if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
+    for (std::size_t i = 0; i < poses.size(); ++i) sink(i, query(poses[i], state));
+  }
   void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out) const override {
+    if (coherent_) {
+      CoherentState state;
+      return timed_series(poses, warmup, out, [&](const RigidTransform& pose) { return query(pose, state); });
+    }
     timed_series(poses, warmup, out, [this](const RigidTransform& pose) { return query(pose); });
   }
+  [[nodiscard]] bool coherent() const override { return coherent_; }
 
  private:
   /// Not inlined: both loops call one copy of the traversal (a direct call per query, not a virtual one),
@@ -105,8 +119,20 @@ class TypedQuery final : public PreparedQuery {
       return S::query(a_->tree, b_->tree, pose, options_);
     }
   }
+  /// The coherent query (prepare lets coherent_ be set only for a strategy that has one).
+  [[gnu::noinline]] Result query(const RigidTransform& pose, CoherentState& state) const {
+    if constexpr (!kRunsCoherent<S>) {
+      throw std::logic_error("strategy " + std::string(S::name()) + " prepared coherent");
+    } else if constexpr (kSurfaces) {
+      const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), pose);
+      return S::query_coherent(a_->tree, b_->tree, pose, options_, state, leaves);
+    } else {
+      return S::query_coherent(a_->tree, b_->tree, pose, options_, state);
+    }
+  }
   std::shared_ptr<const TypedBase<BV, D>> a_, b_;
   typename S::Options options_;
+  bool coherent_ = false;
 };
 
 /// A typed tree, of a mesh or of a point cloud (then with its surface): what a query needs of either.
@@ -193,9 +219,11 @@ struct TypedBase : TreeModel {
     if constexpr (ProbabilityDensity<D>)  // refuses trees annotated with other parameters, before any pose
       (void)D::estimator(tree.density, b->tree.density);
     auto options = strategy_options<S>(variant.values, variant.budget);
+    if (variant.coherent && !kRunsCoherent<S>)
+      throw std::invalid_argument(strategy_info(variant.strategy).coherent_refusal());
     if (side().is_cloud() || b->side().is_cloud()) {
       if constexpr (kCloudDensity<D>)
-        return prepare_points<S>(std::move(a), std::move(b), std::move(options), variant.strategy);
+        return prepare_points<S>(std::move(a), std::move(b), std::move(options), variant);
       else
         throw std::logic_error("a tree over points with density " + info.density);
     }
@@ -204,21 +232,26 @@ struct TypedBase : TreeModel {
           "strategy " + variant.strategy +
           " tests triangles, and a tree was loaded without polygons (load it with its "
           "mesh)");
-    return std::make_unique<TypedQuery<S, BV, D, false>>(std::move(a), std::move(b), std::move(options));
+    return std::make_unique<TypedQuery<S, BV, D, false>>(std::move(a), std::move(b), std::move(options),
+                                                         variant.coherent);
   }
 
   /// S with the surface test, after SurfaceLeaves' checks of the two sides (so running cannot fail).
   template <class S>
   static std::unique_ptr<PreparedQuery> prepare_points(std::shared_ptr<const TypedBase> a,
                                                        std::shared_ptr<const TypedBase> b,
-                                                       typename S::Options options, const std::string& name) {
+                                                       typename S::Options options,
+                                                       const StrategyVariant& variant) {
     (void)SurfaceLeaves<BV>(a->tree.bvh, a->side(), b->tree.bvh, b->side(), RigidTransform{});
-    if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, name); !refusal.empty())
+    if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, variant.strategy);
+        !refusal.empty())
       throw std::invalid_argument(refusal);
     if constexpr (takes_leaf_test<S, BV, D>)
-      return std::make_unique<TypedQuery<S, BV, D, true>>(std::move(a), std::move(b), std::move(options));
+      return std::make_unique<TypedQuery<S, BV, D, true>>(std::move(a), std::move(b), std::move(options),
+                                                          variant.coherent);
     else
-      throw std::logic_error("cloud_query_refusal let strategy " + name + " through without a leaf test");
+      throw std::logic_error("cloud_query_refusal let strategy " + variant.strategy +
+                             " through without a leaf test");
   }
 };
 

@@ -4,6 +4,7 @@
 
 #include "../adb/parameters.hpp"
 #include "adb.hpp"
+#include "coherent.hpp"
 #include "exact.hpp"
 #include "strategy.hpp"
 #include "strategy_names.hpp"
@@ -66,6 +67,12 @@ struct ExactStrategy {
   static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options mode,
                       const Leaves& leaves = kTriangleLeaves) {
     return query_exact(a.bvh, b.bvh, b_to_a, mode, leaves);
+  }
+  static constexpr bool coherent = true;
+  template <class TreeA, class TreeB, class Leaves = TriangleLeaves>
+  static Result query_coherent(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options mode,
+                               CoherentState& state, const Leaves& leaves = kTriangleLeaves) {
+    return query_exact_coherent(a.bvh, b.bvh, b_to_a, state, mode, leaves);
   }
 };
 

@@ -25,6 +25,12 @@
 //   S::query(..., options, leaves)  The same with another leaf test (traversal/driver.hpp): the shipped
 //                                   strategies take SurfaceLeaves for point clouds
 //                                   (traversal/point_leaves.hpp); optional for a new strategy.
+// Optional: running coherent over a sequence of poses (traversal/coherent.hpp)
+//   S::coherent            constexpr bool true: the strategy offers
+//   S::query_coherent(a, b, b_to_a, options, state[, leaves])
+//                          Result of S::query, starting from `state` (a CoherentState the caller keeps for
+//                          this pair of trees) and leaving its own front there. Its answers are those of
+//                          S::query: a state makes a query faster, never other.
 #pragma once
 
 #include "../adb/parameters.hpp"
@@ -51,6 +57,12 @@ concept Strategy = requires(const ParamValues& values, const Budget& budget) {
   { S::template accepts<NoDensity> } -> std::convertible_to<bool>;
   { S::parameters() } -> std::same_as<std::span<const ParamSpec>>;
   { S::configure(values, budget) } -> std::same_as<typename S::Options>;
+};
+
+/// Whether S runs coherent (S::coherent and S::query_coherent, above).
+template <class S>
+inline constexpr bool kRunsCoherent = requires {
+  requires S::coherent;
 };
 
 /// "bv_tests=200", "deadline_us=20", "bv_tests=200;deadline_us=20", or "" when unlimited.

@@ -3,6 +3,7 @@
 #include "bench/core/ground_truth.hpp"
 #include "engine/policies.hpp"
 #include "engine/tree_cache.hpp"
+#include "traversal/coherent_state.hpp"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -63,9 +64,14 @@ Truth exact_truth(const WorkloadSpec& workload, const PreparedHierarchy& exact, 
 std::vector<PoseAnswer> answer_prepared(const PreparedQuery& query, std::span<const RigidTransform> poses,
                                         int repeat) {
   const double overhead = repeat > 0 ? clock_overhead_us() : 0;
+  CoherentState state;  // a coherent query's first answers: each pose starts where the previous one ended
   const auto first = [&](const RigidTransform& pose) {
     Result result;
-    query.run(std::span(&pose, 1), [&](std::size_t, const Result& r) { result = r; });
+    const ResultSink sink = [&](std::size_t, const Result& r) { result = r; };
+    if (query.coherent())
+      query.run(std::span(&pose, 1), sink, state);
+    else
+      query.run(std::span(&pose, 1), sink);
     return result;
   };
   return answer_poses(poses, repeat, overhead, first,

@@ -52,7 +52,8 @@ std::vector<PoseAnswer> answer_poses(std::span<const RigidTransform> poses, int 
 }
 
 /// answer_poses with a prepared query of the run-time layer: its first answer at each pose, then `repeat`
-/// timed passes (PreparedQuery::time).
+/// timed passes (PreparedQuery::time). A coherent query's first answers run over the poses in order with one
+/// state, and each timed pass with a state of its own.
 std::vector<PoseAnswer> answer_prepared(const PreparedQuery& query, std::span<const RigidTransform> poses,
                                         int repeat);
 

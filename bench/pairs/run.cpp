@@ -225,12 +225,13 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
   scene.density = request.density;
   StrategySpec strategy;
   strategy.name = request.strategy.strategy;
+  strategy.coherent = request.strategy.coherent;
   scene.strategies = {strategy};
   const StrategyInfo& info = strategy_info(strategy.name);
   if (std::string refusal = info.refusal(request.density.name); !refusal.empty())
     throw std::invalid_argument(refusal);
-  if (request.hierarchy.is_fcl() && strategy.name != kExactStrategyName)
-    throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only");
+  if (request.hierarchy.is_fcl() && (strategy.name != kExactStrategyName || strategy.coherent))
+    throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only, not coherent");
   Preparation preparation(options.cache_dir, outcome.stats, log_of(options), threads_of(options.threads));
   const ObjectData object_a = load_object(a);
   const ObjectData object_b = &a == &b ? ObjectData{} : load_object(b);
@@ -247,13 +248,17 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
           size_advice(request.strategy.strategy, a.name + "|" + b.name, object_a.mesh, ob.mesh);
       !advice.empty())
     outcome.advice.push_back(std::move(advice));
-  const double overhead = request.repeat ? clock_overhead_us() : 0;
-  outcome.answers = answer_poses(
-      poses, request.repeat, overhead,
-      [&](const RigidTransform& p) { return hierarchy->query(request.strategy, p); },
-      [&](std::span<const RigidTransform> all, std::vector<QueryRecord>& records) {
-        hierarchy->run(request.strategy, all, 0, records);
-      });
+  if (const auto [tree_a, tree_b] = hierarchy->trees(); tree_a) {
+    outcome.answers = answer_prepared(*tree_a->prepare(*tree_b, request.strategy), poses, request.repeat);
+  } else {  // an FCL pair
+    const double overhead = request.repeat ? clock_overhead_us() : 0;
+    outcome.answers = answer_poses(
+        poses, request.repeat, overhead,
+        [&](const RigidTransform& p) { return hierarchy->query(request.strategy, p); },
+        [&](std::span<const RigidTransform> all, std::vector<QueryRecord>& records) {
+          hierarchy->run(request.strategy, all, 0, records);
+        });
+  }
   const auto models = preparation.models();
   outcome.model_a = hierarchy->model;
   outcome.model_b = models.back();
