@@ -3,6 +3,7 @@
 #include "engine/any_tree.hpp"
 #include "engine/protocol.hpp"
 #include "python/bindings.hpp"
+#include "traversal/coherent_state.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -157,15 +158,19 @@ struct BatchColumns {
 /// the GIL back and lets Python handle its signals, so that Ctrl-C raises KeyboardInterrupt within a fraction
 /// of a second instead of after the whole batch (the results so far are dropped: nothing half-made returns).
 void run_interruptibly(const PreparedQuery& prepared, std::span<const RigidTransform> poses,
-                       const ResultSink& sink) {
+                       const ResultSink& sink, CoherentState* state) {
   using Clock = std::chrono::steady_clock;
   constexpr std::size_t kChunk = 16;
   constexpr auto kCheckEvery = std::chrono::milliseconds(50);
   py::gil_scoped_release release;
   auto checked = Clock::now();
   for (std::size_t begin = 0; begin < poses.size(); begin += kChunk) {
-    prepared.run(poses.subspan(begin, std::min(kChunk, poses.size() - begin)),
-                 [&](std::size_t i, const Result& r) { sink(begin + i, r); });
+    const auto chunk = poses.subspan(begin, std::min(kChunk, poses.size() - begin));
+    const ResultSink chunk_sink = [&](std::size_t i, const Result& r) { sink(begin + i, r); };
+    if (state)
+      prepared.run(chunk, chunk_sink, *state);  // the chunks continue one sequence
+    else
+      prepared.run(chunk, chunk_sink);
     if (Clock::now() - checked < kCheckEvery) continue;
     py::gil_scoped_acquire acquire;
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
@@ -175,14 +180,33 @@ void run_interruptibly(const PreparedQuery& prepared, std::span<const RigidTrans
 
 py::dict query_batch(const AnyTree& a, const AnyTree& b, const py::object& poses, const py::object& rotations,
                      const py::object& translations, const std::string& strategy, long long bv_tests,
-                     double deadline_us, const py::kwargs& parameters) {
-  const StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
+                     double deadline_us, bool coherent, CoherentState* state, const py::kwargs& parameters) {
+  StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
+  if (state && !coherent) throw py::value_error("a state is kept by coherent queries: give coherent=True");
+  variant.coherent = coherent;
+  check_strategy_options(variant);
   const std::vector<RigidTransform> checked = poses_from(poses, rotations, translations);
   check_same_kind_of_units(a.info(), b.info());
   const std::unique_ptr<PreparedQuery> prepared = a.prepare(b, variant);
   BatchColumns columns(static_cast<py::ssize_t>(checked.size()));
-  run_interruptibly(*prepared, checked, columns.sink());
+  CoherentState own;
+  run_interruptibly(*prepared, checked, columns.sink(), coherent ? (state ? state : &own) : nullptr);
   return columns.dict();
+}
+
+void bind_coherent_state(py::module_& m) {
+  py::class_<CoherentState>(m, "CoherentState",
+                            "What coherent queries of one pair of trees keep between calls: the front where "
+                            "the last query stopped, its contact, its pose. Pass it to query_batch(..., "
+                            "coherent=True, state=s) to continue a sequence of poses across calls. It "
+                            "belongs to one pair of trees and one caller at a time.")
+      .def(py::init<>())
+      .def("reset", &CoherentState::reset, "Forget the front and the contact: the next query starts cold.")
+      .def_property_readonly("front_size", &CoherentState::front_size, "node pairs the next query re-tests")
+      .def_property_readonly("jumps", &CoherentState::jumps,
+                             "queries that started from the root because the pose jumped")
+      .def_property_readonly("witness_hits", &CoherentState::witness_hits,
+                             "queries answered by the remembered contact alone");
 }
 
 py::array_t<double> protocol_matrices(double distance, int first, int count, int steps) {
@@ -197,6 +221,7 @@ py::array_t<double> protocol_matrices(double distance, int first, int count, int
 }  // namespace
 
 void bind_queries(py::module_& m) {
+  bind_coherent_state(m);
   py::class_<QueryResult>(m, "Result", "The answer of one query.")
       .def_property_readonly("collides", [](const QueryResult& q) { return q.result.collides; })
       .def_property_readonly(
@@ -235,11 +260,14 @@ void bind_queries(py::module_& m) {
   m.def(
       "query_batch", &query_batch, py::arg("a"), py::arg("b"), py::arg("poses") = py::none(), py::kw_only(),
       py::arg("rotations") = py::none(), py::arg("translations") = py::none(), py::arg("strategy") = "exact",
-      py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0,
+      py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0, py::arg("coherent") = false,
+      py::arg("state") = static_cast<CoherentState*>(nullptr),
       (std::string(
            "Queries every pose of poses (K, 4, 4), or of rotations (K, 3, 3; default identities) and "
            "translations (K, 3), without holding the GIL; Ctrl-C interrupts it (KeyboardInterrupt) within a "
-           "fraction of a second. Every pose is checked before the first query. "
+           "fraction of a second. Every pose is checked before the first query. coherent=True (strategies "
+           "exact and all_contacts) starts each pose where the previous one ended: the same answers, less "
+           "work on poses close to each other; state (a CoherentState) carries that over to the next call. "
            "Returns a dict of arrays of length K: collides, probability, exact, budget_exhausted, "
            "witness_a and witness_b (-1: none), contact_count and the counters.") +
        strategy_help)

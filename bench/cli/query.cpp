@@ -27,7 +27,7 @@ struct QueryArgs {
   std::string a, b, pose, protocol, poses_file, bv = "aabb", strategy = "exact", cache, density, cloud;
   double deadline = 0, bv_tests = 0;
   int repeat = 0;
-  bool all = false, json = false, normalize = false, no_cache = false;
+  bool all = false, json = false, normalize = false, no_cache = false, coherent = false;
   ParameterOptions parameters;
   const CLI::Option* bv_option = nullptr;
   const CLI::Option* bv_tests_option = nullptr;
@@ -57,19 +57,29 @@ void check_value(const ParamSpec& spec, double value, const std::string& option)
     throw CLI::ValidationError(option, std::string(spec.name) + " " + problem);
 }
 
-RigidTransform protocol_pose_argument(const std::string& protocol) {
+/// DISTANCE,STEP,STEPS: that step's pose; DISTANCE,STEPS: every step in order, each listed by its step.
+std::vector<ListedPose> protocol_poses_argument(const std::string& protocol) {
   const auto v = parse_numbers(protocol, "--protocol");
-  if (v.size() != 3) throw CLI::ValidationError("--protocol", "expected DISTANCE,STEP,STEPS");
+  if (v.size() != 2 && v.size() != 3)
+    throw CLI::ValidationError("--protocol", "expected DISTANCE,STEP,STEPS or DISTANCE,STEPS");
   check_value(limits::kDistance, v[0], "--protocol");
-  check_value(limits::kSteps, v[2], "--protocol");
+  check_value(limits::kSteps, v.back(), "--protocol");
+  const int steps = static_cast<int>(v.back());
+  if (v.size() == 2) {
+    std::vector<ListedPose> out;
+    for (int step = 0; step < steps; ++step)
+      out.push_back({protocol_pose(v[0], step, steps), static_cast<std::size_t>(step)});
+    return out;
+  }
   if (!(v[1] >= 0 && v[1] < v[2] && v[1] == std::floor(v[1])))
     throw CLI::ValidationError("--protocol", "STEP must be an integer in [0, STEPS - 1], got " +
                                                  parameter_text(v[1]) + " with STEPS " +
                                                  parameter_text(v[2]));
-  return protocol_pose(v[0], static_cast<int>(v[1]), static_cast<int>(v[2]));
+  return {{protocol_pose(v[0], static_cast<int>(v[1]), steps), 0}};
 }
 
-/// The poses to query, each with the line of the pose list it came from (0 for --pose and --protocol).
+/// The poses to query, each with the line of the pose list it came from (0 for --pose and a single
+/// --protocol step; the step for a --protocol turn).
 std::vector<ListedPose> poses_of(const QueryArgs& args) {
   if (!args.poses_file.empty()) {
     try {
@@ -78,7 +88,7 @@ std::vector<ListedPose> poses_of(const QueryArgs& args) {
       throw CLI::ValidationError("--poses", e.what());
     }
   }
-  if (!args.protocol.empty()) return {{protocol_pose_argument(args.protocol), 0}};
+  if (!args.protocol.empty()) return protocol_poses_argument(args.protocol);
   try {
     return {{pose_from_numbers(parse_numbers(args.pose, "--pose")), 0}};
   } catch (const std::invalid_argument& e) {
@@ -181,6 +191,13 @@ QueryRequest query_request(const QueryArgs& args, bool trees) {
       resolve_parameters(strategy.parameters, args.parameters.pick(strategy.parameters), names.strategy);
   if (!trees) request.density = density_from(names.density, args.parameters);
   request.strategy.budget = budget_of(args, strategy);
+  request.strategy.coherent = args.coherent;
+  if (args.coherent) {
+    if (std::string refusal = strategy.coherent_refusal(); !refusal.empty())
+      throw CLI::ValidationError("--coherent", refusal);
+    if (args.bv.rfind("fcl_", 0) == 0)
+      throw CLI::ValidationError("--coherent", "FCL hierarchies do not run coherent; give a bvhlab volume");
+  }
   request.repeat = args.repeat;
   return request;
 }
@@ -190,6 +207,7 @@ struct QueryRun {
   QueryOutcome outcome;
   std::vector<ListedPose> poses;
   std::string name_a, name_b, bv;
+  const char* index = "line";  ///< what ListedPose::line holds: a pose list's line, or a protocol step
 };
 
 /// Says on stderr in which units the poses are read, when they are not the mesh files' own.
@@ -282,7 +300,7 @@ void print_json(const QueryRun& run, bool all_contacts, bool batch) {
   nlohmann::json results = nlohmann::json::array();
   for (std::size_t k = 0; k < run.poses.size(); ++k) {
     nlohmann::json j = answer_json(run.outcome.answers[k], all_contacts);
-    j["line"] = run.poses[k].line;
+    j[run.index] = run.poses[k].line;
     results.push_back(std::move(j));
   }
   std::cout << nlohmann::json{{"results", results}}.dump(2) << '\n';
@@ -321,8 +339,8 @@ void print_answer(const PoseAnswer& answer, bool all_contacts, bool counters) {
 
 /// A pose list: one row per pose; --json (or a single --pose) has every detail.
 void print_table(const QueryRun& run, bool all_contacts, bool repeat) {
-  std::printf("  %6s  %-8s  %11s  %-5s  %10s  %10s  %14s%s%s\n", "line", "collides", "probability", "exact",
-              "time_us", "bv_tests", "triangle_tests", repeat ? "  warm_median_us" : "",
+  std::printf("  %6s  %-8s  %11s  %-5s  %10s  %10s  %14s%s%s\n", run.index, "collides", "probability",
+              "exact", "time_us", "bv_tests", "triangle_tests", repeat ? "  warm_median_us" : "",
               all_contacts ? "  contacts" : "");
   for (std::size_t k = 0; k < run.poses.size(); ++k) {
     const PoseAnswer& answer = run.outcome.answers[k];
@@ -377,8 +395,9 @@ int query_command(const QueryArgs& given) {
   const bool trees = args.cloud.empty() && saved_trees(args);
   const QueryRequest request = query_request(args, trees);
   std::vector<ListedPose> poses = poses_of(args);
-  const QueryRun run = execute_query(args, trees, request, std::move(poses));
-  const bool batch = !args.poses_file.empty();
+  const bool batch = !args.poses_file.empty() || poses.size() > 1;
+  QueryRun run = execute_query(args, trees, request, std::move(poses));
+  if (!args.protocol.empty()) run.index = "step";
   // The contacts are listed whether the strategy was named or given by --all-contacts.
   const bool all_contacts = request.strategy.strategy == kAllContactsStrategyName;
   if (args.json)
@@ -424,13 +443,18 @@ Command add_query_command(CLI::App& app) {
       "--pose", args->pose,
       "B's pose: TX,TY,TZ or TX,TY,TZ,AX,AY,AZ,DEGREES, or the 12 numbers of [R | t] row by row");
   query->add_option("--protocol", args->protocol,
-                    "B's pose from the protocol: DISTANCE,STEP,STEPS (its distances assume --normalize)");
+                    "B's pose from the protocol: DISTANCE,STEP,STEPS, or DISTANCE,STEPS for every step in "
+                    "order (its distances assume --normalize)");
   query->add_option("--poses", args->poses_file,
                     "A pose list: one pose per line, as --pose takes it (blanks or commas between numbers; "
                     "'#' starts a comment line)");
   add_policy_options(query, *args);
   query->add_flag("--all-contacts", args->all,
                   "Short for --strategy all_contacts: every intersecting triangle pair, listed");
+  query->add_flag("--coherent", args->coherent,
+                  "Start each pose where the previous one ended (strategies exact and all_contacts; the same "
+                  "answers, less work on poses close to each other): the poses of --poses or a --protocol "
+                  "turn in order, and each --repeat pass");
   query->add_flag("--normalize", args->normalize,
                   "Apply the protocol normalisation to each mesh (centre to the origin, longest side 2); "
                   "default: the mesh files' own units");
@@ -455,6 +479,7 @@ Command add_query_command(CLI::App& app) {
       "  bvhlab query injector_pipes.stl injector_pipes.stl --normalize --protocol 1.6,42,5000 "
       "--strategy time_critical --bv-tests 200 --repeat 100\n"
       "  bvhlab query pinion.off pinion.off --normalize --poses bench/scenes/example_poses.txt --json\n"
+      "  bvhlab query jeep1.ms3d jeep1.ms3d --normalize --protocol 0.8,2000 --coherent --repeat 5\n"
       "  bvhlab query scan.xyz pinion.off --cloud a --pose 0.5,0,0 --strategy adb --p-min 0.99");
   return {query, [args] { return query_command(*args); }};
 }

@@ -58,8 +58,9 @@ bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec&
   for (std::size_t k = 0, m = hs.array_size(); k < m; ++k) {
     if (skipped(hs.child(k).string())) continue;
     const std::string name = hs.child(k).choice(names);
-    if (scene.hierarchy(name)->is_fcl() && spec.name != kExactStrategyName)
-      hs.child(k).fail("\"" + spec.name + "\" needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only");
+    if (scene.hierarchy(name)->is_fcl() && (spec.name != kExactStrategyName || spec.coherent))
+      hs.child(k).fail("\"" + spec.name + "\"" + (spec.coherent ? " coherent" : "") +
+                       " needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only, not coherent");
     spec.hierarchies.push_back(name);
   }
   return !spec.hierarchies.empty();
@@ -88,17 +89,24 @@ std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Sk
   std::vector<std::string> fields{"type", "hierarchies"};
   for (const ParamSpec& p : info.parameters) fields.emplace_back(p.name);
   if (info.budget != BudgetUse::None) fields.emplace_back("budgets");
+  fields.emplace_back("coherent");  // refused below, by name, for a strategy that does not run coherent
   s.expect_object(fields);
   for (const ParamSpec& p : info.parameters)
     if (s.has(std::string(p.name)))
       spec.values[std::string(p.name)] = read_values(s.child(std::string(p.name)), p);
   if (info.budget == BudgetUse::Required || s.has("budgets"))
     spec.budgets = parse_budgets(s.child("budgets"));
+  if (s.has("coherent")) {
+    spec.coherent = s.child("coherent").boolean();
+    if (spec.coherent && !info.coherent) s.child("coherent").fail(info.coherent_refusal());
+  }
   if (!parse_strategy_hierarchies(s, scene, spec, skipped)) return std::nullopt;
   if (info.needs_density) check_densities(s, scene, spec, info);
   if (std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
                    [&](const HierarchySpec& h) { return scene.applies(spec, h); }))
-    s.fail("\"" + spec.name + "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\" only)");
+    s.fail("\"" + spec.name +
+           "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\" only, not "
+           "coherent)");
   checked(s, [&] {
     for (const StrategyVariant& v : expand(spec)) check_strategy_options(v);
     return 0;
@@ -228,7 +236,7 @@ bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
   if (!s.hierarchies.empty() &&
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
-  return !h.is_fcl() || s.name == kExactStrategyName;
+  return !h.is_fcl() || (s.name == kExactStrategyName && !s.coherent);
 }
 
 const DensitySpec& Scene::density_of(const HierarchySpec& h) const {

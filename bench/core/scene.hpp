@@ -11,11 +11,11 @@
 //                      {"bv": "fcl_obbrss", "optional": true} ],   // optional: skipped if this build lacks
 //                      it
 //     "annotation": {"type": "adb", "grid": 2, "tau": 0.25},     // or {"type": "none"} (the default)
-//     "strategies": [ {"type": "exact"}, {"type": "guided_exact"},
+//     "strategies": [ {"type": "exact"}, {"type": "exact", "coherent": true}, {"type": "guided_exact"},
 //                     {"type": "adb", "p_min": [0.5, 0.9]},
 //                     {"type": "time_critical", "p_min": 0.9, "budgets": [{"bv_tests": 200}, {"deadline_us":
 //                     20}]} ],
-//     "workload": {"type": "protocol", "distances": [0.4, 0.6], "steps": 500}
+//     "workload": {"type": "protocol", "distances": [0.4, 0.6], "steps": 500, "stride": 1}
 //              or {"type": "poses", "file": "poses.json"},
 //     "calibration": {"training_seed": 2, "training_steps": 500},   // optional: calibrated series too
 //     "report": {"quality_distances": [1.2, 2.0], "cgal_sample": 64,
@@ -84,6 +84,9 @@ struct WorkloadSpec {
   enum class Axis { Distance, Separation, Group } axis = Axis::Distance;
   std::vector<double> distances{0.4, 0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0};
   int steps = 5000;
+  /// Protocol only: every stride-th step of the steps' full turn (how far B turns between two queries of a
+  /// coherent strategy).
+  int stride = 1;
   std::filesystem::path pose_file;  ///< PoseFile only (resolved)
   /// Random only: how many poses, the seed, and the box B's translation is drawn from.
   int count = 0;

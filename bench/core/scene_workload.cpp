@@ -201,7 +201,7 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
     if (type == "random") {
       parse_random(w, workload);
     } else if (type == "protocol") {
-      w.expect_object({"type", "distances", "steps", "axis"});  // axis: refused by parse_axis, by name
+      w.expect_object({"type", "distances", "steps", "stride", "axis"});  // axis: refused by parse_axis
       if (w.has("distances")) {
         workload.distances = w.child("distances").numbers(0, limits::kDistance.min, limits::kDistance.max);
         if (workload.distances.empty()) w.child("distances").fail("expected at least one distance");
@@ -209,6 +209,7 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
       if (w.has("steps"))
         workload.steps = static_cast<int>(w.child("steps").integer(
             static_cast<long long>(limits::kSteps.min), static_cast<long long>(limits::kSteps.max)));
+      if (w.has("stride")) workload.stride = static_cast<int>(w.child("stride").integer(1, workload.steps));
     } else {
       parse_pose_file(w, base_dir, workload);
     }
@@ -216,11 +217,17 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
   }
   if (workload.kind == WorkloadSpec::Kind::Protocol) {
     std::string identity = "protocol:steps=" + std::to_string(workload.steps) + ":d=";
+    if (workload.stride != 1)
+      identity = "protocol:steps=" + std::to_string(workload.steps) +
+                 ":stride=" + std::to_string(workload.stride) + ":d=";
     for (double d : workload.distances) {
       char buf[32];
       std::snprintf(buf, sizeof buf, "%.17g,", d);
       identity += buf;
-      workload.groups.push_back({d, protocol_poses(d, workload.steps)});
+      std::vector<RigidTransform> poses;
+      for (int step = 0; step < workload.steps; step += workload.stride)
+        poses.push_back(protocol_pose(d, step, workload.steps));
+      workload.groups.push_back({d, std::move(poses)});
     }
     workload.identity = identity;
   }

@@ -328,6 +328,42 @@ TEST_F(Cli, PoseListsAreQueriedInOrder) {
                  "one of --pose, --protocol, --poses");
 }
 
+// --coherent over a protocol turn (--protocol DISTANCE,STEPS: every step in order): the cold answers, with
+// fewer BV tests in all; strategies that do not run coherent and FCL hierarchies are refused by name.
+TEST_F(Cli, CoherentQueriesAnswerAsColdOverAProtocolTurn) {
+  testing::write_obj(testing::make_torus(0.7, 0.25, 24, 12), dir / "torus.obj");
+  const std::string turn = "query torus.obj torus.obj --protocol 1.2,120 --json";
+  const nlohmann::json cold = nlohmann::json::parse(ok(turn).out)["results"];
+  const nlohmann::json coherent = nlohmann::json::parse(ok(turn + " --coherent").out)["results"];
+  ASSERT_EQ(cold.size(), 120u);
+  ASSERT_EQ(coherent.size(), 120u);
+  std::size_t colliding = 0;
+  std::uint64_t cold_tests = 0, coherent_tests = 0;
+  for (std::size_t k = 0; k < cold.size(); ++k) {
+    EXPECT_EQ(coherent[k]["step"], k);
+    EXPECT_EQ(coherent[k]["collides"], cold[k]["collides"]) << k;
+    EXPECT_EQ(coherent[k]["exact"], true) << k;
+    colliding += cold[k]["collides"].get<bool>();
+    cold_tests += cold[k]["bv_tests"].get<std::uint64_t>();
+    coherent_tests += coherent[k]["bv_tests"].get<std::uint64_t>();
+  }
+  EXPECT_GT(colliding, 0u);
+  EXPECT_LT(colliding, cold.size());
+  EXPECT_LT(coherent_tests, cold_tests);
+  const std::string text = ok("query torus.obj torus.obj --protocol 1.2,120 --coherent --all-contacts").out;
+  EXPECT_NE(text.find("torus vs torus, all_contacts coherent on aabb, 120 poses\n"), std::string::npos)
+      << text;
+  expect_refused(
+      "query torus.obj torus.obj --protocol 1.2,120 --coherent --strategy adb",
+      "--coherent: strategy adb does not run coherent (the strategies that do: exact, all_contacts)");
+#ifdef BVHLAB_HAVE_FCL
+  expect_refused("query torus.obj torus.obj --protocol 1.2,120 --coherent --bv fcl_obb",
+                 "FCL hierarchies do not run coherent");
+#endif
+  expect_refused("query torus.obj torus.obj --protocol 1.2",
+                 "expected DISTANCE,STEP,STEPS or DISTANCE,STEPS");
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Per-pose output
 

@@ -1,5 +1,6 @@
 // Scene files: a full scene parses into what it says; every bad field is refused with its JSON path.
 #include "bench/core/scene.hpp"
+#include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "scene_fixtures.hpp"
 #include "support/generated_meshes.hpp"
@@ -102,6 +103,32 @@ TEST_F(SceneTest, DefaultsFollowTheProtocol) {
   EXPECT_TRUE(scene.needs_density(scene.hierarchies[1]));
 }
 
+TEST_F(SceneTest, CoherentStrategiesAndProtocolStrides) {
+  const Scene scene =
+      parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                       R"([{"type": "exact"}, {"type": "all_contacts", "coherent": true}])",
+                       R"("workload": {"distances": [0.8, 1.2], "steps": 100, "stride": 7})"));
+  ASSERT_EQ(scene.strategies.size(), 2u);
+  EXPECT_FALSE(scene.strategies[0].coherent);
+  EXPECT_TRUE(scene.strategies[1].coherent);
+  const auto variants = expand(scene.strategies[1]);
+  ASSERT_EQ(variants.size(), 1u);
+  EXPECT_TRUE(variants[0].coherent);
+  EXPECT_EQ(variants[0].label(), "all_contacts coherent");
+  // Every 7th of 100 steps: steps 0, 7, ..., 98, in order.
+  ASSERT_EQ(scene.workload.groups.size(), 2u);
+  const auto& poses = scene.workload.groups[1].poses;
+  ASSERT_EQ(poses.size(), 15u);
+  EXPECT_TRUE(poses[3].rotation.isApprox(protocol_pose(1.2, 21, 100).rotation));
+  EXPECT_EQ(poses[3].translation, protocol_pose(1.2, 21, 100).translation);
+  // The stride is part of the pose set's identity (the ground-truth cache's key).
+  const Scene every_step =
+      parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                       R"("workload": {"distances": [0.8, 1.2], "steps": 100})"));
+  EXPECT_NE(scene.workload.identity, every_step.workload.identity);
+  EXPECT_EQ(every_step.workload.groups[1].poses.size(), 100u);
+}
+
 TEST_F(SceneTest, ExactOnlySceneNeedsNoAnnotation) {
   const Scene scene =
       parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])", ""));
@@ -185,6 +212,16 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
                   R"("workload": {"type": "protocol", "steps": 0})"),
        "/workload/steps: expected an integer in [1, 10000000]; got 0"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("workload": {"type": "protocol", "steps": 100, "stride": 101})"),
+       "/workload/stride: expected an integer in [1, 100]; got 101"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                  R"([{"type": "adb", "p_min": 0.9, "coherent": true}])", R"("annotation": {"type": "adb"})"),
+       "/strategies/0/coherent: strategy adb does not run coherent (the strategies that do: exact, "
+       "all_contacts)"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                  R"([{"type": "exact", "coherent": 1}])", ""),
+       "/strategies/0/coherent: expected true or false; got 1"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
                   R"("workload": {"distances": [1, "far"]})"),
        "/workload/distances/1: expected a number; got \"far\""},

@@ -236,3 +236,36 @@ def test_ctrl_c_interrupts_a_batch_within_half_a_second(gear_trees):
     late = time.perf_counter() - begin - 0.2
     timer.join()
     assert late < 0.5, f"KeyboardInterrupt {late:.2f} s after Ctrl-C (a batch of {len(long_batch)} poses)"
+
+
+@pytest.mark.parametrize("strategy", ["exact", "all_contacts"])
+def test_coherent_batches_answer_as_cold_ones_with_less_work(gear_trees, strategy):
+    """coherent=True starts each pose where the previous one ended: the cold answers, fewer BV tests; a
+    CoherentState carries the sequence over to the next call, and chunked or split, the work is the same."""
+    tree = gear_trees["none"]
+    poses = np.concatenate([bvhlab.protocol_poses(d, 300) for d in (0.9, 1.4)])
+    cold = bvhlab.query_batch(tree, tree, poses, strategy=strategy)
+    coherent = bvhlab.query_batch(tree, tree, poses, strategy=strategy, coherent=True)
+    for key in ("collides", "exact", "contact_count"):
+        np.testing.assert_array_equal(coherent[key], cold[key], err_msg=key)
+    assert 0 < cold["collides"].sum() < len(poses)
+    assert coherent["bv_tests"].sum() < cold["bv_tests"].sum()
+    state = bvhlab.CoherentState()
+    half = len(poses) // 2
+    first = bvhlab.query_batch(tree, tree, poses[:half], strategy=strategy, coherent=True, state=state)
+    assert state.front_size > 0 or state.witness_hits > 0  # what the first half left
+    second = bvhlab.query_batch(tree, tree, poses[half:], strategy=strategy, coherent=True, state=state)
+    np.testing.assert_array_equal(np.concatenate([first["bv_tests"], second["bv_tests"]]), coherent["bv_tests"])
+
+
+def test_coherent_batches_refuse_what_cannot_run_coherent(gear_trees):
+    tree, annotated = gear_trees["none"], gear_trees["adb"]
+    poses = bvhlab.protocol_poses(1.0, 10)
+    with pytest.raises(ValueError, match="strategy adb does not run coherent"):
+        bvhlab.query_batch(annotated, annotated, poses, strategy="adb", coherent=True)
+    with pytest.raises(ValueError, match="give coherent=True"):
+        bvhlab.query_batch(tree, tree, poses, state=bvhlab.CoherentState())
+    state = bvhlab.CoherentState()
+    bvhlab.query_batch(tree, tree, poses, coherent=True, state=state)
+    with pytest.raises(ValueError, match="made for other trees"):
+        bvhlab.query_batch(annotated, annotated, poses, coherent=True, state=state)
