@@ -265,9 +265,9 @@ void bind_queries(py::module_& m) {
       (std::string(
            "Queries every pose of poses (K, 4, 4), or of rotations (K, 3, 3; default identities) and "
            "translations (K, 3), without holding the GIL; Ctrl-C interrupts it (KeyboardInterrupt) within a "
-           "fraction of a second. Every pose is checked before the first query. coherent=True (strategies "
-           "exact and all_contacts) starts each pose where the previous one ended: the same answers, less "
-           "work on poses close to each other; state (a CoherentState) carries that over to the next call. "
+           "fraction of a second. Every pose is checked before the first query. coherent=True starts each "
+           "pose where the previous one ended: less work on poses close to each other (traversal/README.md, "
+           "\"Coherent queries\"); state (a CoherentState) carries that over to the next call. "
            "Returns a dict of arrays of length K: collides, probability, exact, budget_exhausted, "
            "witness_a and witness_b (-1: none), contact_count and the counters.") +
        strategy_help)

@@ -192,6 +192,7 @@ class AdbHooks {
         return true;
       });
       if (!hit) return Step::Continue;
+      decided_at_.emplace(p.a, p.b);
       result_.collides = true;
       result_.exact = true;
       result_.probability = 1;
@@ -256,6 +257,13 @@ class AdbHooks {
     return true;
   }
 
+  /// A node pair a coherent query remembered (query_adb_coherent) decides again as reaching it would: under
+  /// exact leaves, a leaf pair whose triangles intersect (an exact answer); else decides_again.
+  bool recall(const Pair& p) {
+    if (!options_.exact_leaves) return decides_again(p);
+    return trees_.is_leaf_pair(p) && trees_.overlap(p) && leaf_pair(p) == Step::Decided;
+  }
+
  private:
   [[gnu::always_inline]] PairGeometry geometry(const Pair& p) const {
     if constexpr (kNodeFrames)
@@ -288,14 +296,32 @@ class AdbHooks {
   std::optional<std::pair<std::uint32_t, std::uint32_t>> decided_at_;
 };
 
-/// ADB query on two trees annotated with a ProbabilityDensity (adb/concept.hpp). `b_to_a` maps B's frame
-/// into A's. The probability model comes from the trees' own annotation. `leaves` is the leaf test (the
-/// default: triangles; traversal/point_leaves.hpp passes point surfaces: query_adb_points).
-/// `Order` is AdbBestFirst (the paper's) or AdbDepthFirst. Const and thread-safe: the model is read-only and
-/// all traversal state is local.
-template <class Order = AdbBestFirst, TreeVolume BV, ProbabilityDensity D, class Leaves = TriangleLeaves>
-Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
-                 const AdbOptions& options, const Leaves& leaves = kTriangleLeaves) {
+namespace detail {
+
+/// A coherent query's remembered node pair: tried before the traversal (in), the pair that decided (out).
+struct AdbRecall {
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> pair;
+  bool hit = false;  ///< the remembered pair decided this query
+};
+
+/// Whether the remembered pair decides now. Only volumes whose walkers carry nothing down from the root can
+/// start below it (as the frame budget's memory).
+template <TreeVolume BV, class Leaves, class Hooks>
+bool recalled(const TreePair<BV, Leaves>& trees, Hooks& hooks, AdbRecall& recall) {
+  if constexpr (!std::is_empty_v<typename VolumeWalker<BV>::Working>) {
+    return false;
+  } else {
+    if (!recall.pair) return false;
+    const auto [i, j] = *recall.pair;
+    if (i >= trees.a.nodes().size() || j >= trees.b.nodes().size()) return false;
+    return recall.hit = hooks.recall(typename Hooks::Pair{{}, i, j, {}, {}, {}});
+  }
+}
+
+/// query_adb, with a remembered pair tried first when `recall` is given (one instantiation for both).
+template <class Order, TreeVolume BV, ProbabilityDensity D, class Leaves>
+Result adb_query(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
+                 const AdbOptions& options, const Leaves& leaves, AdbRecall* recall) {
   BudgetLimit limit(options.budget);  // a deadline counts from here, set-up included
   options.validate();
   b_to_a.validate();
@@ -319,13 +345,30 @@ Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransfor
                                    std::uint32_t j) { return estimate(i, box_a, j, box_b, overlap); };
     AdbHooks<BV, decltype(node_estimate), Leaves, estimates_in_node_frames<D, BV>> hooks(
         trees, result, options, node_estimate);
-    traverse<typename Order::Queue, typename Order::Descent>(trees, hooks,
-                                                             limit);  // frees its queue before it returns
+    if (!(recall && recalled(trees, hooks, *recall)))
+      traverse<typename Order::Queue, typename Order::Descent>(trees, hooks,
+                                                               limit);  // frees its queue before it returns
+    if (recall) recall->pair = hooks.decided_at();
+  } else if (recall) {
+    recall->pair.reset();
   }
   // The loop reads the clock before each pop, so it misses a deadline that passed during the last step
   // (a decision, the last pair). Such an answer stands but came late: it is flagged too.
   if (!result.budget_exhausted && limit.deadline_passed()) result.budget_exhausted = true;
   return result;
+}
+
+}  // namespace detail
+
+/// ADB query on two trees annotated with a ProbabilityDensity (adb/concept.hpp). `b_to_a` maps B's frame
+/// into A's. The probability model comes from the trees' own annotation. `leaves` is the leaf test (the
+/// default: triangles; traversal/point_leaves.hpp passes point surfaces: query_adb_points).
+/// `Order` is AdbBestFirst (the paper's) or AdbDepthFirst. Const and thread-safe: the model is read-only and
+/// all traversal state is local.
+template <class Order = AdbBestFirst, TreeVolume BV, ProbabilityDensity D, class Leaves = TriangleLeaves>
+Result query_adb(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
+                 const AdbOptions& options, const Leaves& leaves = kTriangleLeaves) {
+  return detail::adb_query<Order>(a, b, b_to_a, options, leaves, nullptr);
 }
 
 }  // namespace bvhlab

@@ -34,6 +34,17 @@ namespace coherent_detail {
 inline constexpr std::uint32_t kCold = ~std::uint32_t{0};
 using LeafPair = std::pair<std::uint32_t, std::uint32_t>;
 
+/// Binds a new state to its trees (and B's root box: what a pose jump is measured against, in B's frame);
+/// throws std::invalid_argument for a state bound to other trees.
+template <TreeVolume BV>
+void attach(CoherentState& state, const Bvh<BV>& a, const Bvh<BV>& b) {
+  if (!state.bound() && !b.empty()) {
+    const Box box = b.root_volume().bounding_box();
+    state.bind(&a, a.nodes().size(), &b, b.nodes().size(), box.center(), box.extent().norm() / 2);
+  }
+  state.check_trees(&a, a.nodes().size(), &b, b.nodes().size());
+}
+
 /// One walk over the stored traversal tree (`stored`, possibly empty: from the root), writing the new one
 /// into `next`. Iterative: a stack of items, each a pair to visit or an inner pair to try to raise.
 template <TreeVolume BV, class Leaves>
@@ -179,11 +190,8 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
                             const Leaves& leaves = kTriangleLeaves) {
   check_exact_query<Leaves>(b_to_a, mode);
   const CoherentState::InUse in_use(state);
-  if (!state.bound() && !b.empty()) {
-    const Box box = b.root_volume().bounding_box();  // B's frame: what a pose jump is measured against
-    state.bind(&a, a.nodes().size(), &b, b.nodes().size(), box.center(), box.extent().norm() / 2);
-  }
-  state.check_trees(&a, a.nodes().size(), &b, b.nodes().size());
+  coherent_detail::attach(state, a, b);
+  state.serve(CoherentState::Use::Exact);
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;

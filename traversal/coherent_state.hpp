@@ -88,8 +88,17 @@ class CoherentState {
   std::vector<FrontPair>& spare() { return spare_; }
   /// Keeps `next` (built for `pose`) as the stored tree, or drops it when larger than max_pairs.
   void store(std::vector<FrontPair>& next, const RigidTransform& pose);
-  /// The leaf pair of the last contact found, if any.
+  /// The node pair that decided the last answer, if one did: the exact queries' colliding leaf pair, the
+  /// ADB queries' deciding pair (traversal/coherent_adb.hpp).
   std::optional<std::pair<std::uint32_t, std::uint32_t>> witness;
+  /// What filled the state: an exact, ADB or guided exact query (their node pairs mean different things).
+  enum class Use : std::uint8_t { None, Exact, Adb, Guided };
+  /// Starts the state afresh (reset) when it was filled by another kind of query.
+  void serve(Use use) {
+    if (use_ == use) return;
+    reset();
+    use_ = use;
+  }
   void count_witness_hit() { ++witness_hits_; }
 
  private:
@@ -103,6 +112,7 @@ class CoherentState {
   std::vector<FrontPair> spare_;  ///< the next tree is built here, then swapped in (no allocation per query)
   RigidTransform pose_;           ///< the pose pairs_ was computed at
   std::uint64_t jumps_ = 0, witness_hits_ = 0;
+  Use use_ = Use::None;
   /// Set while a query uses the state; a copy of the state is not in use.
   struct BusyFlag {
     std::atomic<bool> busy{false};

@@ -5,6 +5,7 @@
 #include "../adb/parameters.hpp"
 #include "adb.hpp"
 #include "coherent.hpp"
+#include "coherent_adb.hpp"
 #include "exact.hpp"
 #include "strategy.hpp"
 #include "strategy_names.hpp"
@@ -107,6 +108,12 @@ struct GuidedExactStrategy {
                       const Leaves& leaves = kTriangleLeaves) {
     return query_adb(a, b, b_to_a, options, leaves);
   }
+  static constexpr bool coherent = true;
+  template <class TreeA, class TreeB, class Leaves = TriangleLeaves>
+  static Result query_coherent(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options,
+                               CoherentState& state, const Leaves& leaves = kTriangleLeaves) {
+    return query_adb_coherent(a, b, b_to_a, options, state, leaves);
+  }
 };
 
 /// ADB with p_min: "collision" once a pair's estimated probability exceeds p_min (adb/README.md, section 3).
@@ -138,6 +145,12 @@ struct InOrder : Base {
   static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a,
                       const typename Base::Options& options, const Leaves& leaves = kTriangleLeaves) {
     return query_adb<Order>(a, b, b_to_a, options, leaves);
+  }
+  template <class TreeA, class TreeB, class Leaves = TriangleLeaves>
+  static Result query_coherent(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a,
+                               const typename Base::Options& options, CoherentState& state,
+                               const Leaves& leaves = kTriangleLeaves) {
+    return query_adb_coherent<Order>(a, b, b_to_a, options, state, leaves);
   }
 };
 /// The depth-first order: the most probable child of the pair just expanded next.

@@ -452,9 +452,9 @@ Command add_query_command(CLI::App& app) {
   query->add_flag("--all-contacts", args->all,
                   "Short for --strategy all_contacts: every intersecting triangle pair, listed");
   query->add_flag("--coherent", args->coherent,
-                  "Start each pose where the previous one ended (strategies exact and all_contacts; the same "
-                  "answers, less work on poses close to each other): the poses of --poses or a --protocol "
-                  "turn in order, and each --repeat pass");
+                  "Start each pose where the previous one ended (less work on poses close to each other; "
+                  "traversal/README.md, \"Coherent queries\"): the poses of --poses or a --protocol turn in "
+                  "order, and each --repeat pass");
   query->add_flag("--normalize", args->normalize,
                   "Apply the protocol normalisation to each mesh (centre to the origin, longest side 2); "
                   "default: the mesh files' own units");

@@ -35,6 +35,22 @@ TEST_F(TestPolicies, TheTablesListThemWithTheirParameters) {
   EXPECT_FALSE(strategy.exact);
   EXPECT_FALSE(strategy.needs_polygons);
   EXPECT_TRUE(strategy.accepts("tricount"));
+  // Without a query_coherent of its own, it does not run coherent, and says so wherever it is asked to.
+  EXPECT_FALSE(strategy.coherent);
+  const std::string refusal = "strategy root_overlap does not run coherent (the strategies that do: exact, ";
+  EXPECT_EQ(strategy.coherent_refusal().rfind(refusal, 0), 0u) << strategy.coherent_refusal();
+  const auto error_of = [&](const std::string& text) {
+    try {
+      (void)parse_scene(text, dir.path(), "c.json");
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(error_of(R"({"objects": [{"mesh": "torus.obj"}], "hierarchies": [{"bv": "aabb"}],
+      "strategies": [{"type": "root_overlap", "coherent": true}]})")
+                .find("c.json: /strategies/0/coherent: " + refusal),
+            std::string::npos);
   // The shipped ADB strategy runs on the new density: it is a ProbabilityDensity.
   EXPECT_TRUE(strategy_info("adb").accepts("tricount"));
   EXPECT_TRUE(strategy_info("guided_exact").accepts("tricount"));

@@ -216,10 +216,6 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
                   R"("workload": {"type": "protocol", "steps": 100, "stride": 101})"),
        "/workload/stride: expected an integer in [1, 100]; got 101"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
-                  R"([{"type": "adb", "p_min": 0.9, "coherent": true}])", R"("annotation": {"type": "adb"})"),
-       "/strategies/0/coherent: strategy adb does not run coherent (the strategies that do: exact, "
-       "all_contacts)"},
-      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
                   R"([{"type": "exact", "coherent": 1}])", ""),
        "/strategies/0/coherent: expected true or false; got 1"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",

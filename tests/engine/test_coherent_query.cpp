@@ -137,26 +137,38 @@ TEST(CoherentQueryState, AStateOfOtherTreesIsRefused) {
   EXPECT_THROW(a.prepare(b, variant("exact", false))->run(poses, sink, state), std::logic_error);
 }
 
-TEST(CoherentQueryState, StrategiesThatDoNotRunCoherentAreRefusedByName) {
-  const std::string refusal =
-      "strategy adb does not run coherent (the strategies that do: exact, all_contacts)";
-  EXPECT_TRUE(strategy_info("exact").coherent);
-  EXPECT_TRUE(strategy_info("all_contacts").coherent);
-  EXPECT_FALSE(strategy_info("adb").coherent);
-  EXPECT_EQ(strategy_info("adb").coherent_refusal(), refusal);
-  EXPECT_EQ(strategy_info("exact").coherent_refusal(), "");
+TEST(CoherentQueryState, EveryShippedStrategyRunsCoherent) {
+  for (const StrategyInfo& s : strategy_table()) {
+    EXPECT_TRUE(s.coherent) << s.name;
+    EXPECT_EQ(s.coherent_refusal(), "") << s.name;
+  }
+  EXPECT_EQ(variant("exact", true).label(), "exact coherent");
+  // The refusal of a strategy that does not run coherent: tests/bench/test_policies.cpp (the test-only one).
+}
 
-  StrategyVariant adb = strategy_variant("adb", {}, Budget{});
-  adb.coherent = true;
-  EXPECT_EQ(error_of([&] { check_strategy_options(adb); }), refusal);
-  StrategySpec spec;
-  spec.name = "adb";
-  spec.coherent = true;
-  EXPECT_EQ(error_of([&] { (void)expand(spec); }), refusal);
+/// The ADB strategies through the engine: guided exact answers as the exact query; adb and time_critical
+/// as the cold query but where the remembered pair decides on its own estimate (traversal/coherent_adb.hpp).
+TEST(CoherentQueryState, AdbStrategiesRememberTheirDecidingPair) {
   const AnyTree a = AnyTree::build(testing::make_torus(0.7, 0.25, 24, 12), MeshUnits{}, "aabb",
                                    density_spec("adb", {}), BuildOptions{});
-  EXPECT_EQ(error_of([&] { (void)a.prepare(a, adb); }), refusal);
-  EXPECT_EQ(variant("exact", true).label(), "exact coherent");
+  const auto poses = turns();
+  const auto exact = run_all(*a.prepare(a, variant("exact", false)), poses);
+  for (const char* strategy : {"guided_exact", "adb", "adb_dfs", "adb_larger", "time_critical"}) {
+    StrategyVariant v = strategy_variant(
+        strategy, {}, strategy == std::string("time_critical") ? Budget{.max_bv_tests = 60} : Budget{});
+    const auto cold = run_all(*a.prepare(a, v), poses);
+    v.coherent = true;
+    const auto coherent = run_all(*a.prepare(a, v), poses);
+    std::size_t disagreements = 0;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      disagreements += coherent[i].collides != cold[i].collides;
+      if (strategy == std::string("guided_exact")) {
+        EXPECT_EQ(coherent[i].collides, exact[i].collides) << i;
+      }
+    }
+    EXPECT_LE(disagreements, poses.size() / 50) << strategy;
+    EXPECT_LT(bv_tests(coherent), bv_tests(cold)) << strategy;
+  }
 }
 
 }  // namespace
