@@ -133,8 +133,9 @@ TEST(CoherentAdb, AStateServesOneKindOfQueryAtATime) {
   EXPECT_EQ(state.witness_hits(), 1u);
   // Trees of another volume are refused by name.
   const AdbTrees<Aabb> others;
-  EXPECT_NE(testing::error_of([&] { (void)query_adb_coherent(others.a, others.b, pose, options, state); })
-                .find("other trees"),
+  EXPECT_NE(testing::error_of([&] {
+              (void)query_adb_coherent(others.a, others.b, pose, options, state);
+            }).find("other trees"),
             std::string::npos);
 }
 
