@@ -17,7 +17,8 @@ namespace bvhlab {
 /// it: for them this is query_adb. Throws as query_adb does, and as query_exact_coherent does for the state.
 template <class Order = AdbBestFirst, TreeVolume BV, ProbabilityDensity D, class Leaves = TriangleLeaves>
 Result query_adb_coherent(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
-                          const AdbOptions& options, CoherentState& state, const Leaves& leaves = kTriangleLeaves) {
+                          const AdbOptions& options, CoherentState& state,
+                          const Leaves& leaves = kTriangleLeaves) {
   const CoherentState::InUse in_use(state);
   coherent_detail::attach(state, a.bvh, b.bvh);
   state.serve(options.exact_leaves ? CoherentState::Use::Guided : CoherentState::Use::Adb);

@@ -110,8 +110,9 @@ struct GuidedExactStrategy {
   }
   static constexpr bool coherent = true;
   template <class TreeA, class TreeB, class Leaves = TriangleLeaves>
-  static Result query_coherent(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, const Options& options,
-                               CoherentState& state, const Leaves& leaves = kTriangleLeaves) {
+  static Result query_coherent(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a,
+                               const Options& options, CoherentState& state,
+                               const Leaves& leaves = kTriangleLeaves) {
     return query_adb_coherent(a, b, b_to_a, options, state, leaves);
   }
 };
