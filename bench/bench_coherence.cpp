@@ -43,8 +43,7 @@ std::vector<PoseSet> make_pose_sets(const std::vector<double>& distances, int st
       PoseSet set;
       set.label =
           "d:" + std::to_string(d).substr(0, 3) + "/stride:" + std::to_string(static_cast<int>(stride));
-      for (int k = 0; k < steps; k += static_cast<int>(stride))
-        set.poses.push_back(protocol_pose(d, k, steps));
+      set.poses = protocol_poses(d, steps, static_cast<int>(stride));
       sets.push_back(std::move(set));
     }
   return sets;

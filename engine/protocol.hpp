@@ -27,11 +27,11 @@ inline RigidTransform protocol_pose(double distance, int step, int steps) {
   return pose;
 }
 
-/// All poses of one distance, in step order.
-inline std::vector<RigidTransform> protocol_poses(double distance, int steps) {
+/// All poses of one distance, in step order; with `stride`, only steps 0, stride, 2 stride, ...
+inline std::vector<RigidTransform> protocol_poses(double distance, int steps, int stride = 1) {
   std::vector<RigidTransform> poses;
-  poses.reserve(static_cast<std::size_t>(steps));
-  for (int k = 0; k < steps; ++k) poses.push_back(protocol_pose(distance, k, steps));
+  poses.reserve(static_cast<std::size_t>(steps / stride + 1));
+  for (int k = 0; k < steps; k += stride) poses.push_back(protocol_pose(distance, k, steps));
   return poses;
 }
 

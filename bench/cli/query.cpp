@@ -67,8 +67,7 @@ std::vector<ListedPose> protocol_poses_argument(const std::string& protocol) {
   const int steps = static_cast<int>(v.back());
   if (v.size() == 2) {
     std::vector<ListedPose> out;
-    for (int step = 0; step < steps; ++step)
-      out.push_back({protocol_pose(v[0], step, steps), static_cast<std::size_t>(step)});
+    for (const RigidTransform& pose : protocol_poses(v[0], steps)) out.push_back({pose, out.size()});
     return out;
   }
   if (!(v[1] >= 0 && v[1] < v[2] && v[1] == std::floor(v[1])))

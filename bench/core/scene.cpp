@@ -58,7 +58,7 @@ bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec&
   for (std::size_t k = 0, m = hs.array_size(); k < m; ++k) {
     if (skipped(hs.child(k).string())) continue;
     const std::string name = hs.child(k).choice(names);
-    if (scene.hierarchy(name)->is_fcl() && (spec.name != kExactStrategyName || spec.coherent))
+    if (scene.hierarchy(name)->is_fcl() && !runs_on_fcl(spec))
       hs.child(k).fail("\"" + spec.name + "\"" + (spec.coherent ? " coherent" : "") +
                        " needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only, not coherent");
     spec.hierarchies.push_back(name);
@@ -232,11 +232,15 @@ const HierarchySpec* Scene::hierarchy(std::string_view name) const {
   return nullptr;
 }
 
+bool runs_on_fcl(const StrategySpec& s) {
+  return s.name == kExactStrategyName && !s.coherent;
+}
+
 bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
   if (!s.hierarchies.empty() &&
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
-  return !h.is_fcl() || (s.name == kExactStrategyName && !s.coherent);
+  return !h.is_fcl() || runs_on_fcl(s);
 }
 
 const DensitySpec& Scene::density_of(const HierarchySpec& h) const {

@@ -203,6 +203,9 @@ struct TimingSpec {
 };
 const char* statistic_name(TimingSpec::Statistic statistic);
 
+/// Whether `s` runs on FCL hierarchies: exact first contact, not coherent.
+bool runs_on_fcl(const StrategySpec& s);
+
 struct Scene {
   std::string name;
   std::filesystem::path file;  ///< where it was read from (empty for a string)

@@ -216,18 +216,14 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
     parse_axis(w, workload);
   }
   if (workload.kind == WorkloadSpec::Kind::Protocol) {
-    std::string identity = "protocol:steps=" + std::to_string(workload.steps) + ":d=";
-    if (workload.stride != 1)
-      identity = "protocol:steps=" + std::to_string(workload.steps) +
-                 ":stride=" + std::to_string(workload.stride) + ":d=";
+    // A stride of 1 keeps the identity it had before strides: the ground-truth cache stays valid.
+    std::string identity = "protocol:steps=" + std::to_string(workload.steps) +
+                           (workload.stride != 1 ? ":stride=" + std::to_string(workload.stride) : "") + ":d=";
     for (double d : workload.distances) {
       char buf[32];
       std::snprintf(buf, sizeof buf, "%.17g,", d);
       identity += buf;
-      std::vector<RigidTransform> poses;
-      for (int step = 0; step < workload.steps; step += workload.stride)
-        poses.push_back(protocol_pose(d, step, workload.steps));
-      workload.groups.push_back({d, std::move(poses)});
+      workload.groups.push_back({d, protocol_poses(d, workload.steps, workload.stride)});
     }
     workload.identity = identity;
   }

@@ -9,7 +9,6 @@
 #include "bench/pairs/prepare.hpp"
 #include "bench/pairs/summary_band.hpp"
 #include "engine/policies.hpp"
-#include "traversal/strategy_names.hpp"
 
 #include <fmt/format.h>
 
@@ -230,7 +229,7 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
   const StrategyInfo& info = strategy_info(strategy.name);
   if (std::string refusal = info.refusal(request.density.name); !refusal.empty())
     throw std::invalid_argument(refusal);
-  if (request.hierarchy.is_fcl() && (strategy.name != kExactStrategyName || strategy.coherent))
+  if (request.hierarchy.is_fcl() && !runs_on_fcl(strategy))
     throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only, not coherent");
   Preparation preparation(options.cache_dir, outcome.stats, log_of(options), threads_of(options.threads));
   const ObjectData object_a = load_object(a);

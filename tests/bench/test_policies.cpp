@@ -6,6 +6,7 @@
 #include "bench/run.hpp"
 #include "engine/policies.hpp"
 #include "scene_fixtures.hpp"
+#include "support/errors.hpp"
 #include "support/generated_meshes.hpp"
 
 #include <gtest/gtest.h>
@@ -39,17 +40,11 @@ TEST_F(TestPolicies, TheTablesListThemWithTheirParameters) {
   EXPECT_FALSE(strategy.coherent);
   const std::string refusal = "strategy root_overlap does not run coherent (the strategies that do: exact, ";
   EXPECT_EQ(strategy.coherent_refusal().rfind(refusal, 0), 0u) << strategy.coherent_refusal();
-  const auto error_of = [&](const std::string& text) {
-    try {
-      (void)parse_scene(text, dir.path(), "c.json");
-    } catch (const SceneError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
-  };
-  EXPECT_NE(error_of(R"({"objects": [{"mesh": "torus.obj"}], "hierarchies": [{"bv": "aabb"}],
-      "strategies": [{"type": "root_overlap", "coherent": true}]})")
-                .find("c.json: /strategies/0/coherent: " + refusal),
+  const std::string scene = R"({"objects": [{"mesh": "torus.obj"}], "hierarchies": [{"bv": "aabb"}],
+      "strategies": [{"type": "root_overlap", "coherent": true}]})";
+  EXPECT_NE(testing::error_of([&] {
+              (void)parse_scene(scene, dir.path(), "c.json");
+            }).find("c.json: /strategies/0/coherent: " + refusal),
             std::string::npos);
   // The shipped ADB strategy runs on the new density: it is a ProbabilityDensity.
   EXPECT_TRUE(strategy_info("adb").accepts("tricount"));
