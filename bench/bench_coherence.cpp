@@ -2,13 +2,14 @@
 // `--steps` per query at each distance, and every `--strides`-th pose is asked, in order.
 //
 //   bench_coherence [--meshes=a.stl,b.obj] [--volumes=aabb,dop24] [--steps=2000] [--strides=1,8,64]
-//                   [--distances=0.6,1.0,1.4] [benchmark flags]
+//                   [--distances=0.6,1.0,1.4] [--judge=work|time] [--max_cold_run=128] [benchmark flags]
 //
 // One iteration is one cold pass and one coherent pass over the same poses (a fresh state), in alternating
 // order, each timed on its own: the ratio of each iteration's two passes is what is compared, so a stall
 // of the machine touches both sides of one ratio or neither. Counters (over the iterations): the median
 // speed-up cold/coherent and its interquartile range, each side's median microseconds per query, BV and
-// triangle tests per query, the share of queries the remembered contact answered, pose jumps, and the
+// triangle tests per query, the share of queries the remembered contact answered, pose jumps, the share
+// of queries that started from the root because the front had cost more (cold_share), and the
 // disagreements with the cold answers (the run fails unless 0).
 #include "bench/core/bench_flags.hpp"
 #include "bench/report_tables.hpp"
@@ -73,7 +74,7 @@ Pass timed_pass(const std::vector<RigidTransform>& poses, Query&& query) {
 struct Series {
   std::vector<double> cold_us, coherent_us, ratios;
   Counters cold_work, coherent_work;
-  std::uint64_t witness_hits = 0, jumps = 0, disagreements = 0;
+  std::uint64_t witness_hits = 0, jumps = 0, cold_queries = 0, disagreements = 0;
 };
 
 void set_counters(benchmark::State& state, const Series& s, std::size_t queries) {
@@ -89,8 +90,11 @@ void set_counters(benchmark::State& state, const Series& s, std::size_t queries)
   state.counters["coherent_bv"] = static_cast<double>(s.coherent_work.bv_tests) / (n * passes);
   state.counters["cold_tri"] = static_cast<double>(s.cold_work.triangle_tests) / (n * passes);
   state.counters["coherent_tri"] = static_cast<double>(s.coherent_work.triangle_tests) / (n * passes);
+  state.counters["cold_nodes"] = static_cast<double>(s.cold_work.nodes_visited) / (n * passes);
+  state.counters["coherent_nodes"] = static_cast<double>(s.coherent_work.nodes_visited) / (n * passes);
   state.counters["witness_share"] = static_cast<double>(s.witness_hits) / (n * passes);
   state.counters["jumps"] = static_cast<double>(s.jumps) / passes;
+  state.counters["cold_share"] = static_cast<double>(s.cold_queries) / (n * passes);
   state.counters["disagreements"] = static_cast<double>(s.disagreements);
 }
 
@@ -103,17 +107,21 @@ void record(Series& s, const Pass& cold, const Pass& coherent, const CoherentSta
   s.coherent_work += coherent.work;
   s.witness_hits += state.witness_hits();
   s.jumps += state.jumps();
+  s.cold_queries += state.cold_queries();
   for (std::size_t k = 0; k < cold.answers.size(); ++k)
     s.disagreements += cold.answers[k] != coherent.answers[k];
 }
 
 /// Cold and coherent passes over `poses`, alternating which goes first.
+/// The states' options, from --judge and --max_cold_run.
+CoherenceOptions coherence_options;
+
 template <class BV>
 void run_series(benchmark::State& state, const Bvh<BV>& tree, const std::vector<RigidTransform>& poses) {
   Series s;
   bool cold_first = true;
   for (auto _ : state) {
-    CoherentState coherence;
+    CoherentState coherence(coherence_options);
     auto cold = [&] { return timed_pass(poses, [&](const auto& p) { return query_exact(tree, tree, p); }); };
     auto coherent = [&] {
       return timed_pass(poses, [&](const auto& p) { return query_exact_coherent(tree, tree, p, coherence); });
@@ -152,18 +160,34 @@ int main(int argc, char** argv) {
   std::vector<double> distances{0.6, 1.0, 1.4};
   std::vector<double> strides{1, 8, 64};
   int steps = 2000;
-  if (auto exit = initialize_benchmark("bench_coherence",
-                                       {{"meshes", &meshes, "meshes to run"},
-                                        {"volumes", &volumes, "bounding volumes"},
-                                        {"distances", &distances, "protocol distances"},
-                                        {"strides", &strides, "ask every m-th pose of the turn (step size)"},
-                                        {"steps", &steps, "poses per full turn"}},
-                                       argc, argv))
+  std::string judge_name = "work";
+  int max_cold_run = static_cast<int>(CoherenceOptions{}.max_cold_run);
+  if (auto exit =
+          initialize_benchmark("bench_coherence",
+                               {{"meshes", &meshes, "meshes to run"},
+                                {"volumes", &volumes, "bounding volumes"},
+                                {"distances", &distances, "protocol distances"},
+                                {"strides", &strides, "ask every m-th pose of the turn (step size)"},
+                                {"steps", &steps, "poses per full turn"},
+                                {"judge", &judge_name, "what decides front or root: work or time"},
+                                {"max_cold_run", &max_cold_run, "longest run of cold queries (0: none)"}},
+                               argc, argv))
     return *exit;
   if (steps < 1 || std::any_of(strides.begin(), strides.end(), [](double m) { return !(m >= 1); })) {
     std::fprintf(stderr, "bench_coherence: --steps and every stride must be at least 1\n");
     return 2;
   }
+  if (judge_name != "work" && judge_name != "time") {
+    std::fprintf(stderr, "bench_coherence: --judge is work or time, not '%s'\n", judge_name.c_str());
+    return 2;
+  }
+  if (max_cold_run < 0) {
+    std::fprintf(stderr, "bench_coherence: --max_cold_run must be at least 0\n");
+    return 2;
+  }
+  coherence_options.judge =
+      judge_name == "time" ? CoherenceOptions::Judge::time : CoherenceOptions::Judge::work;
+  coherence_options.max_cold_run = static_cast<std::uint32_t>(max_cold_run);
   static const std::vector<PoseSet> sets = make_pose_sets(distances, steps, strides);
   for (const auto& file : meshes) {
     if (!find_mesh(file)) {

@@ -206,7 +206,9 @@ void bind_coherent_state(py::module_& m) {
       .def_property_readonly("jumps", &CoherentState::jumps,
                              "queries that started from the root because the pose jumped")
       .def_property_readonly("witness_hits", &CoherentState::witness_hits,
-                             "queries answered by the remembered contact alone");
+                             "queries answered by the remembered contact alone")
+      .def_property_readonly("cold_queries", &CoherentState::cold_queries,
+                             "queries that started from the root because walking the front had cost more");
 }
 
 py::array_t<double> protocol_matrices(double distance, int first, int count, int steps) {

@@ -22,6 +22,7 @@
 #include "coherent_state.hpp"
 #include "exact.hpp"
 
+#include <chrono>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -189,6 +190,14 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
                             CoherentState& state, ContactMode mode = ContactMode::First,
                             const Leaves& leaves = kTriangleLeaves) {
   check_exact_query<Leaves>(b_to_a, mode);
+  // What the query costs decides where the next ones start (CoherenceOptions::judge): the clock is read only
+  // when that cost is the time.
+  using Clock = std::chrono::steady_clock;
+  const bool timed = state.options().judge == CoherenceOptions::Judge::time;
+  const Clock::time_point start = timed ? Clock::now() : Clock::time_point{};
+  const auto seconds = [&] {
+    return timed ? std::chrono::duration<double>(Clock::now() - start).count() : 0.0;
+  };
   const CoherentState::InUse in_use(state);
   coherent_detail::attach(state, a, b);
   state.serve(CoherentState::Use::Exact);
@@ -200,19 +209,33 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
   using Walk = coherent_detail::FrontWalk<BV, Leaves>;
   typename Walk::Hooks hooks(trees, result, mode);
-  if (mode == ContactMode::First && state.witness) {
+  // In a cold turn (the front cost more than starting from the root) neither the contact nor the front is
+  // tried: the query is the cold one, but for the turn's last, a walk from the root that leaves its front.
+  const bool cold = state.cold_turns_left() > 0;
+  if (state.cold_turns_left() > 1) {
+    Result cold_result = query_exact(a, b, b_to_a, mode, leaves);
+    state.witness.reset();
+    state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
+    return cold_result;
+  }
+  if (!cold && mode == ContactMode::First && state.witness) {
     const auto [i, j] = *state.witness;
     if (hooks.leaf_pair(typename Walk::Pair{{}, i, j, {}, {}, {}}) == Step::Decided) {
       state.count_witness_hit();
+      state.record_cost(result.counters, seconds(), CoherentState::Start::Front);
       return result;
     }
   }
-  if (!state.front_usable(b_to_a)) state.pairs().clear();
+  const bool from_front = !cold && state.front_usable(b_to_a);
+  if (!from_front) state.pairs().clear();
   std::vector<FrontPair>& next = state.spare();
   Walk walk(trees, state.pairs(), next, hooks, state.options().raise_hold);
   state.witness = walk.run();
-  // A contact ends the walk early: the stored tree (a cut, from an earlier pose) stays for the next query.
-  if (!state.witness) state.store(next, b_to_a);
+  // A contact ends the walk early; the tree it built is still a cut of every pair (each pair not reached yet
+  // is a front pair there, to be tested), so the next query starts from it rather than from the root.
+  state.store(next, b_to_a);
+  state.record_cost(result.counters, seconds(),
+                    from_front ? CoherentState::Start::Front : CoherentState::Start::Root);
   return result;
 }
 

@@ -19,6 +19,9 @@ CoherentState::CoherentState(CoherenceOptions options) : options_(options) {
 void CoherentState::reset() {
   pairs_.clear();
   witness.reset();
+  front_cost_ = root_cost_ = -1;
+  cold_left_ = 0;
+  cold_run_ = 2;
 }
 
 std::size_t CoherentState::front_size() const {
@@ -65,6 +68,44 @@ bool CoherentState::front_usable(const RigidTransform& pose) {
   if (moved <= options_.max_jump * b_radius_) return true;
   ++jumps_;
   return false;
+}
+
+namespace {
+/// A query's work: a node pair taken, a BV test, and a triangle test worth about four BV tests.
+double work_of(const Counters& c) {
+  return static_cast<double>(c.nodes_visited + c.bv_tests + 4 * c.triangle_tests);
+}
+/// A running average that forgets (weight: the newest sample's share), so a change of step size is
+/// followed. A sample is capped at 8 times the average: a stall of the machine is not a query's cost.
+void average_into(double& average, double sample, double weight) {
+  if (average < 0) {
+    average = sample;
+    return;
+  }
+  average = (1 - weight) * average + weight * std::min(sample, 8 * average);
+}
+}  // namespace
+
+void CoherentState::record_cost(const Counters& counters, double seconds, Start start) {
+  if (options_.max_cold_run == 0) return;
+  const double cost = options_.judge == CoherenceOptions::Judge::time ? seconds : work_of(counters);
+  if (start == Start::Root) {
+    average_into(root_cost_, cost, 0.125);  // queries from the root vary with the pose: a longer memory
+    if (cold_left_ > 0) {
+      --cold_left_;
+      ++cold_queries_;
+    }
+    return;
+  }
+  average_into(front_cost_, cost, 0.25);
+  if (root_cost_ < 0) return;
+  if (front_cost_ > root_cost_) {
+    cold_left_ = std::min(cold_run_, options_.max_cold_run);
+    cold_run_ = std::min(2 * cold_run_, options_.max_cold_run);
+    front_cost_ = -1;  // after the run, the front's next walk is judged on its own
+  } else if (2 * front_cost_ < root_cost_) {
+    cold_run_ = std::max(cold_run_ / 2, 2u);  // the front pays again: a later loss starts a shorter run
+  }
 }
 
 void CoherentState::store(std::vector<FrontPair>& next, const RigidTransform& pose) {

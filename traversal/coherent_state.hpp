@@ -25,6 +25,17 @@ struct CoherenceOptions {
   /// A front pair whose parent pair was tested for raising and still overlapped waits this many queries
   /// before its parent is tested again (so pairs close to contact do not pay a useless test every query).
   std::uint8_t raise_hold = 8;
+  /// Where the pose changes too much between queries for the front to pay, walking it costs more than a
+  /// query from the root. When the front's recent walks cost more than the recent queries from the root
+  /// (CoherentState::record_cost), the next queries start from the root: 2 of them, twice as many each time
+  /// the front loses again, at most this many. 0: always walk the front.
+  std::uint32_t max_cold_run = 128;
+  /// What "cost" means there. `work` (the default): node pairs, BV tests and triangle tests (four BV tests
+  /// each), which repeat exactly from run to run, so the counters do too. `time`: each query's own
+  /// seconds, what the caller pays: a walk's node pair costs 1.05 to 2.5 times a cold traversal's, by
+  /// volume (bench/RESULTS.md), which the work does not see; the counters then vary from run to run.
+  enum class Judge : std::uint8_t { work, time };
+  Judge judge = Judge::work;
 
   /// Throws std::invalid_argument for nonsense values (max_pairs 0, a NaN or negative max_jump).
   void validate() const;
@@ -48,8 +59,8 @@ class CoherentState {
  public:
   explicit CoherentState(CoherenceOptions options = {});
 
-  /// Forgets the stored front and the remembered contact: the next query starts from the root. The trees
-  /// it is bound to and its counters (jumps, witness hits) stay.
+  /// Forgets the stored front, the remembered contact and what the front's walks cost: the next query
+  /// starts from the root. The trees it is bound to and its counters (jumps, witness hits, cold runs) stay.
   void reset();
   [[nodiscard]] const CoherenceOptions& options() const { return options_; }
   /// Front pairs of the stored traversal tree (0 before the first query).
@@ -60,6 +71,8 @@ class CoherentState {
   [[nodiscard]] std::uint64_t jumps() const { return jumps_; }
   /// Queries answered by the remembered contact alone.
   [[nodiscard]] std::uint64_t witness_hits() const { return witness_hits_; }
+  /// Queries that started from the root because walking the front had cost more (max_cold_run).
+  [[nodiscard]] std::uint64_t cold_queries() const { return cold_queries_; }
 
   // ---- For the coherent queries (traversal/coherent.hpp) ----------------------------------------------
   /// Binds the state to its trees (their addresses and sizes) and B's root box (its centre and radius in
@@ -100,6 +113,15 @@ class CoherentState {
     use_ = use;
   }
   void count_witness_hit() { ++witness_hits_; }
+  /// While the front lost its last comparison with queries from the root: the queries of that run still to
+  /// go (this one included). They start from the root; the last one builds the front the next walk starts
+  /// from.
+  [[nodiscard]] std::uint32_t cold_turns_left() const { return cold_left_; }
+  /// How a query started, for record_cost.
+  enum class Start : std::uint8_t { Front, Root };
+  /// Records one query's cost (its seconds or its work: CoherenceOptions::judge) and decides whether the
+  /// next queries walk the front or start from the root.
+  void record_cost(const Counters& counters, double seconds, Start start);
 
  private:
   CoherenceOptions options_;
@@ -111,8 +133,12 @@ class CoherentState {
   std::vector<FrontPair> pairs_;  ///< the stored traversal tree; pairs_[0] is the root pair
   std::vector<FrontPair> spare_;  ///< the next tree is built here, then swapped in (no allocation per query)
   RigidTransform pose_;           ///< the pose pairs_ was computed at
-  std::uint64_t jumps_ = 0, witness_hits_ = 0;
+  std::uint64_t jumps_ = 0, witness_hits_ = 0, cold_queries_ = 0;
   Use use_ = Use::None;
+  // The comparison of the front's walks with queries from the root (record_cost); cost < 0: none yet.
+  double front_cost_ = -1, root_cost_ = -1;
+  std::uint32_t cold_left_ = 0;  ///< queries from the root still to run before the front is tried again
+  std::uint32_t cold_run_ = 2;   ///< the length of the next such run
   /// Set while a query uses the state; a copy of the state is not in use.
   struct BusyFlag {
     std::atomic<bool> busy{false};

@@ -68,8 +68,8 @@ TYPED_TEST_P(Coherent, AllContactsAlongAPathAreTheColdQuerys) {
 }
 
 TYPED_TEST_P(Coherent, UnrelatedPosesStayExact) {
-  // No jump limit: the front of one pose is walked at the next, however far apart they are.
-  CoherentState state(CoherenceOptions{.max_jump = 1e9});
+  // No jump limit and no fallback: the front of one pose is walked at the next, however far apart they are.
+  CoherentState state(CoherenceOptions{.max_jump = 1e9, .max_cold_run = 0});
   std::mt19937_64 rng(3);
   int colliding = 0;
   for (int k = 0; k < 150; ++k) {
@@ -86,7 +86,40 @@ TYPED_TEST_P(Coherent, UnrelatedPosesStayExact) {
   EXPECT_LT(colliding, 140);
 }
 
+/// The work CoherentState weighs (coherent_state.cpp): node pairs, BV tests, a triangle test as four.
+inline double work_of(const Counters& c) {
+  return static_cast<double>(c.nodes_visited + c.bv_tests + 4 * c.triangle_tests);
+}
+
+TYPED_TEST_P(Coherent, WhereTheFrontDoesNotPayTheQueriesStartFromTheRoot) {
+  // Unrelated poses with no jump limit: every walk starts from a front made for another pose.
+  std::mt19937_64 rng(5);
+  std::vector<RigidTransform> poses;
+  for (int k = 0; k < 400; ++k) poses.push_back(testing::random_pose(rng, 2.2));
+  double cold = 0, walked = 0, falling_back = 0;
+  CoherentState always(CoherenceOptions{.max_jump = 1e9, .max_cold_run = 0});
+  CoherentState state(CoherenceOptions{.max_jump = 1e9});
+  for (const RigidTransform& pose : poses) {
+    const Result reference = query_exact(this->a, this->b, pose);
+    const Result r = query_exact_coherent(this->a, this->b, pose, state);
+    ASSERT_EQ(r.collides, reference.collides);
+    cold += work_of(reference.counters);
+    walked += work_of(query_exact_coherent(this->a, this->b, pose, always).counters);
+    falling_back += work_of(r.counters);
+  }
+  EXPECT_GT(walked, 1.2 * cold);         // the stale fronts cost more: the case the fallback is for
+  EXPECT_LT(falling_back, 1.15 * cold);  // the probes of the front, and the walks from the root
+  EXPECT_GT(state.cold_queries(), 250u);
+  EXPECT_EQ(always.cold_queries(), 0u);
+  // Judged by time, the same answers (which run is faster depends on the machine: bench_coherence).
+  CoherentState timed(CoherenceOptions{.max_jump = 1e9, .judge = CoherenceOptions::Judge::time});
+  for (const RigidTransform& pose : poses)
+    ASSERT_EQ(query_exact_coherent(this->a, this->b, pose, timed).collides,
+              query_exact(this->a, this->b, pose).collides);
+}
+
 REGISTER_TYPED_TEST_SUITE_P(Coherent, FirstContactAlongAPathIsExactWithLessWork,
-                            AllContactsAlongAPathAreTheColdQuerys, UnrelatedPosesStayExact);
+                            AllContactsAlongAPathAreTheColdQuerys, UnrelatedPosesStayExact,
+                            WhereTheFrontDoesNotPayTheQueriesStartFromTheRoot);
 
 }  // namespace bvhlab::coherent_tests

@@ -21,7 +21,7 @@ class ClearOfContact : public ::testing::Test {
   }
   const Bvh<Aabb> a = Bvh<Aabb>::build(torus());
   const Bvh<Aabb> b = Bvh<Aabb>::build(soup());
-  CoherentState state;
+  CoherentState state{CoherenceOptions{.max_cold_run = 0}};  // always the front: how it is walked
   RigidTransform pose = RigidTransform::translate(Vec3(1.0, 0.1, 0.05));
 };
 
@@ -67,6 +67,7 @@ TEST(Coherent, ARepeatedContactIsAnsweredByItsWitness) {
   const RigidTransform pose = RigidTransform::translate(Vec3(0.7, 0, 0));
   const Result first = query_exact_coherent(a, b, pose, state);
   ASSERT_TRUE(first.collides);
+  EXPECT_GT(state.stored_pairs(), 1u);  // the tree walked up to the contact: the next walk starts there
   const Result again = query_exact_coherent(a, b, pose, state);
   EXPECT_TRUE(again.collides);
   EXPECT_EQ(again.witness, first.witness);
