@@ -84,6 +84,11 @@ class PreparedQuery {
   /// Times every pose once after `warmup` untimed queries (timed_series, engine/timing.hpp).
   virtual void time(std::span<const RigidTransform> poses, int warmup,
                     std::vector<QueryRecord>& out) const = 0;
+  /// The same, continuing from `state` and leaving the last pose's front there (a world's pair, frame after
+  /// frame). The warm-up queries run on a copy of `state`: they must not hand the timed ones their answers.
+  /// Throws as run(..., state) does.
+  virtual void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
+                    CoherentState& state) const = 0;
   [[nodiscard]] virtual bool coherent() const = 0;
 };
 

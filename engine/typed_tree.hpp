@@ -106,6 +106,18 @@ class TypedQuery final : public PreparedQuery {
     }
     timed_series(poses, warmup, out, [this](const RigidTransform& pose) { return query(pose); });
   }
+  void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
+            CoherentState& state) const override {
+    if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
+    if (warmup > 0) {
+      CoherentState scratch = state;
+      std::vector<QueryRecord> ignored;
+      const std::size_t count = std::min(poses.size(), static_cast<std::size_t>(warmup));
+      timed_series(poses.first(count), 0, ignored,
+                   [&](const RigidTransform& pose) { return query(pose, scratch); });
+    }
+    timed_series(poses, 0, out, [&](const RigidTransform& pose) { return query(pose, state); });
+  }
   [[nodiscard]] bool coherent() const override { return coherent_; }
 
  private:

@@ -38,6 +38,11 @@ void describe_tree(ModelInfo& m, const TreeInfo& tree) {
   m.annotate_seconds = tree.annotate_seconds;
 }
 
+void PreparedHierarchy::run(const StrategyVariant& variant, std::span<const RigidTransform>, int,
+                            std::vector<QueryRecord>&, CoherentState&) const {
+  throw std::logic_error("runner: " + variant.label() + " runs coherent on bvhlab trees only");
+}
+
 namespace {
 
 /// Two trees of the run-time layer, each series prepared once per call (no dispatch per query).
@@ -49,6 +54,10 @@ class BvhlabHierarchy final : public PreparedHierarchy {
   void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
            std::vector<QueryRecord>& out) const override {
     a_.prepare(b_, variant)->time(poses, warmup, out);
+  }
+  void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
+           std::vector<QueryRecord>& out, CoherentState& state) const override {
+    a_.prepare(b_, variant)->time(poses, warmup, out, state);
   }
   [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
     Result result;

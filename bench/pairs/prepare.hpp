@@ -45,6 +45,10 @@ class PreparedHierarchy {
   /// Times `variant` on every pose (one dispatch to the strategy's type per series, none per query).
   virtual void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
                    std::vector<QueryRecord>& out) const = 0;
+  /// The same for a coherent variant, continuing from `state` (PreparedQuery::time with a state). FCL
+  /// models run no coherent queries: std::logic_error (scenes refuse them when parsed).
+  virtual void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
+                   std::vector<QueryRecord>& out, CoherentState& state) const;
   /// Exact first-contact answer (the ground truth's source).
   [[nodiscard]] virtual bool exact_collides(const RigidTransform& pose) const = 0;
   [[nodiscard]] virtual bool has_counters() const { return true; }

@@ -7,6 +7,7 @@
 #include "bench/world/motion.hpp"
 #include "engine/policies.hpp"
 #include "traversal/broad_phase/registry.hpp"
+#include "traversal/coherent_state.hpp"
 #include "traversal/frame_budget.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
@@ -55,6 +56,10 @@ ScalingWorld scaling_world(const Scene& scene, int count) {
   return out;
 }
 
+/// The coherent states of a world's instance pairs: a pair that is a candidate again starts where its last
+/// query ended (a pose that moved too far since starts from the root: CoherenceOptions::max_jump).
+using PairStates = std::map<ObjectPair, CoherentState>;
+
 /// A candidate pair of one frame: the instances, the prepared trees of their objects and B's pose in A's.
 struct Candidate {
   ObjectPair instances;
@@ -74,6 +79,8 @@ class WorldHierarchy {
   [[nodiscard]] const PlannedHierarchy& planned() const { return planned_; }
   /// The frame schedules' memories of the previous frame, by series (run_frame_budgets).
   std::map<std::string, FrameMemory>& memories() { return memories_; }
+  /// A coherent variant's state of each instance pair, carried from frame to frame (by series).
+  PairStates& coherent_states(const std::string& series) { return coherent_states_[series]; }
 
   /// The prepared trees of two objects (by name), made on first use.
   const PreparedHierarchy& trees(const std::string& a, const std::string& b) {
@@ -157,6 +164,7 @@ class WorldHierarchy {
   std::vector<const PreparedHierarchy*> instance_trees_;
   std::map<std::pair<std::string, std::string>, std::unique_ptr<PreparedHierarchy>> pairs_;
   std::map<std::string, FrameMemory> memories_;
+  std::map<std::string, PairStates> coherent_states_;
 };
 
 /// The pair rows a run keeps (RunOptions::per_pose): every answer, or only the wrong ones, each of the frame
@@ -190,9 +198,10 @@ void count(WorldSeriesRow& row, const std::vector<Candidate>& candidates, const 
   }
 }
 
-/// A per-pair strategy on every candidate pair, each query timed alone (as the pair runner times them).
+/// A per-pair strategy on every candidate pair, each query timed alone (as the pair runner times them); a
+/// coherent variant continues each pair's state in `states`.
 WorldSeriesRow run_variant(const StrategyVariant& variant, const std::vector<Candidate>& candidates,
-                           int warmup, PairRows& pair_rows) {
+                           int warmup, PairStates& states, PairRows& pair_rows) {
   WorldSeriesRow row;
   row.series = variant.label();
   row.exact_strategy = strategy_info(variant.strategy).exact;
@@ -200,7 +209,11 @@ WorldSeriesRow run_variant(const StrategyVariant& variant, const std::vector<Can
   std::vector<QueryRecord> records;
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     records.clear();
-    candidates[k].trees->run(variant, std::span(&candidates[k].b_to_a, 1), warmup, records);
+    const auto pose = std::span(&candidates[k].b_to_a, 1);
+    if (variant.coherent)
+      candidates[k].trees->run(variant, pose, warmup, records, states[candidates[k].instances]);
+    else
+      candidates[k].trees->run(variant, pose, warmup, records);
     row.micros += records.front().micros;
     row.bv_tests += records.front().counters.bv_tests;
     answers[k] = records.front().collides;
@@ -524,7 +537,8 @@ WorldOutput run_world(const Scene& scene, const RunOptions& options) {
       pair_rows.hierarchy = h->planned().hierarchy->name;
       std::vector<WorldSeriesRow> rows;
       for (const StrategyVariant& variant : h->planned().variants)
-        rows.push_back(run_variant(variant, candidates, options.warmup_queries, pair_rows));
+        rows.push_back(run_variant(variant, candidates, options.warmup_queries,
+                                   h->coherent_states(variant.label()), pair_rows));
       for (WorldSeriesRow& row : run_frame_budgets(scene, h->planned(), candidates, options.warmup_queries,
                                                    h->memories(), pair_rows))
         rows.push_back(row);

@@ -272,6 +272,52 @@ TEST_F(WorldTest, TheExactAnswerPerFrameAgreesWithCgalOnEveryPairOfInstances) {
   EXPECT_EQ(std::count_if(out.series.begin(), out.series.end(), is_bvhlab_row<WorldSeriesRow>), 3 * 6);
 }
 
+// A coherent strategy keeps each instance pair's state from frame to frame: the cold answers, with fewer BV
+// tests where the objects move a little. The warm-up queries run on a copy of the state
+// (PreparedQuery::time): with or without them, the timed queries do the same work.
+TEST_F(WorldTest, CoherentQueriesCarryEachPairsStateAcrossFrames) {
+  const Scene scene = parse(R"({"objects": [{"mesh": "torus.obj"}, {"mesh": "ring.obj"}],
+      "hierarchies": [{"bv": "aabb"}, {"bv": "obb"}],
+      "strategies": [{"type": "exact"}, {"type": "exact", "coherent": true}],
+      "world": {"instances": [{"object": "torus", "count": 8}, {"object": "ring", "count": 6}],
+        "region": {"min": [-1.5, -1.5, -1.5], "max": [1.5, 1.5, 1.5]},
+        "motion": {"type": "random_walk", "frames": 30, "seed": 5, "step": 0.01, "turn_deg": 0.5}}})");
+  RunOptions options = quiet_options();
+  options.per_pose = PerPose::all;
+  const WorldOutput out = run_world(scene, options);
+  options.warmup_queries = 1;
+  std::map<std::string, std::uint64_t> tests, warmed_up;
+  for (const WorldSeriesRow& row : run_world(scene, options).series)
+    if (is_bvhlab_row(row)) warmed_up[row.hierarchy + " " + row.series] += row.bv_tests;
+
+  std::size_t candidates = 0;
+  for (const WorldSeriesRow& row : out.series) {
+    if (!is_bvhlab_row(row)) continue;
+    EXPECT_EQ(row.missed + row.false_pairs, 0u) << row.series << " frame " << row.frame;
+    tests[row.hierarchy + " " + row.series] += row.bv_tests;
+    candidates += row.candidates;
+  }
+  ASSERT_GT(candidates, 200u);  // enough persisting pairs to carry a state
+  EXPECT_EQ(warmed_up, tests);
+  for (const char* bv : {"aabb", "obb"}) {
+    const std::uint64_t cold = tests[std::string(bv) + " exact"];
+    const std::uint64_t coherent = tests[std::string(bv) + " exact coherent"];
+    EXPECT_GT(coherent, 0u) << bv;
+    EXPECT_LT(2 * coherent, cold) << bv;
+  }
+  // Pair by pair, the coherent answer is the cold one.
+  std::map<std::tuple<int, std::string, std::string, std::string>, bool> cold;
+  for (const WorldPairRow& r : out.pairs)
+    if (r.series == "exact") cold[{r.frame, r.hierarchy, r.a, r.b}] = r.collides;
+  std::size_t compared = 0;
+  for (const WorldPairRow& r : out.pairs)
+    if (r.series == "exact coherent") {
+      EXPECT_EQ(r.collides, cold.at({r.frame, r.hierarchy, r.a, r.b}));
+      ++compared;
+    }
+  EXPECT_EQ(compared, cold.size());
+}
+
 TEST_F(WorldTest, EveryBroadPhaseFindsTheSameCandidatesInEveryFrame) {
   const Scene scene = parse(crowded_world(R"([{"bv": "aabb"}, {"bv": "sphere"}])", R"([{"type": "exact"}])"));
   const WorldOutput out = run_world(scene, quiet_options());

@@ -124,6 +124,26 @@ TEST(CoherentQueryState, ACallersStateContinuesTheSequenceAcrossCalls) {
   EXPECT_EQ(after_reset.counters.bv_tests, from_fresh.counters.bv_tests);
 }
 
+// time() with a caller's state (a world's pair, frame after frame): the warm-up queries run on a copy, so
+// the timed ones do the work they would do without them, and the state continues from the last pose.
+TEST(CoherentQueryState, WarmUpQueriesRunOnACopyOfTheCallersState) {
+  const AnyTree a = torus_tree("aabb"), b = torus_tree("aabb");
+  const auto poses = turns();
+  const auto query = a.prepare(b, variant("exact", true));
+  CoherentState plain, warmed;
+  std::vector<QueryRecord> without, with;
+  query->time(poses, 0, without, plain);
+  query->time(poses, 5, with, warmed);
+  ASSERT_EQ(with.size(), poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    EXPECT_EQ(with[i].collides, without[i].collides) << i;
+    EXPECT_EQ(with[i].counters.bv_tests, without[i].counters.bv_tests) << i;
+  }
+  EXPECT_EQ(warmed.front_size(), plain.front_size());
+  EXPECT_EQ(warmed.witness, plain.witness);
+  EXPECT_THROW(a.prepare(b, variant("exact", false))->time(poses, 0, with, plain), std::logic_error);
+}
+
 TEST(CoherentQueryState, AStateOfOtherTreesIsRefused) {
   const AnyTree a = torus_tree("aabb"), b = torus_tree("aabb"), c = torus_tree("aabb", 30);
   const auto poses = turns();
