@@ -31,15 +31,16 @@ struct QueryRecord {
   Counters counters;
 };
 
-/// The timing loop: `warmup` untimed queries, then each pose timed on its own.
-template <class Query>
+/// The timing loop: `warmup` untimed queries through `warm_up`, then each pose timed on its own through
+/// `query`. A separate warm-up query lets a coherent series warm up on a copy of its state.
+template <class WarmUp, class Query>
 void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
-                  Query&& query) {
+                  WarmUp&& warm_up, Query&& query) {
   out.clear();
   out.reserve(poses.size());
   bool sink = false;
   for (std::size_t k = 0; k < poses.size() && k < static_cast<std::size_t>(std::max(warmup, 0)); ++k)
-    sink ^= query(poses[k]).collides;
+    sink ^= warm_up(poses[k]).collides;
   for (const RigidTransform& pose : poses) {
     const auto start = Clock::now();
     const Result r = query(pose);
@@ -48,6 +49,13 @@ void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector
                    std::chrono::duration<double, std::micro>(stop - start).count(), r.counters});
   }
   if (sink && out.empty()) std::fputc(' ', stderr);  // keeps the warm-up from being optimised away
+}
+
+/// The timing loop with the timed query as its own warm-up.
+template <class Query>
+void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
+                  Query&& query) {
+  timed_series(poses, warmup, out, query, query);
 }
 
 }  // namespace bvhlab

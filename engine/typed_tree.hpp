@@ -109,14 +109,11 @@ class TypedQuery final : public PreparedQuery {
   void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
             CoherentState& state) const override {
     if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
-    if (warmup > 0) {
-      CoherentState scratch = state;
-      std::vector<QueryRecord> ignored;
-      const std::size_t count = std::min(poses.size(), static_cast<std::size_t>(warmup));
-      timed_series(poses.first(count), 0, ignored,
-                   [&](const RigidTransform& pose) { return query(pose, scratch); });
-    }
-    timed_series(poses, 0, out, [&](const RigidTransform& pose) { return query(pose, state); });
+    // The warm-up runs on a copy, so the caller's state continues as if there had been none.
+    CoherentState scratch = warmup > 0 ? state : CoherentState{};
+    timed_series(
+        poses, warmup, out, [&](const RigidTransform& pose) { return query(pose, scratch); },
+        [&](const RigidTransform& pose) { return query(pose, state); });
   }
   [[nodiscard]] bool coherent() const override { return coherent_; }
 

@@ -201,14 +201,6 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   const CoherentState::InUse in_use(state);
   coherent_detail::attach(state, a, b);
   state.serve(CoherentState::Use::Exact);
-  Result result;
-  result.exact = true;
-  if (a.empty() || b.empty()) return result;
-  if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "coherent exact query");
-  const auto context = VolumeWalker<BV>::make_context(b_to_a);
-  const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
-  using Walk = coherent_detail::FrontWalk<BV, Leaves>;
-  typename Walk::Hooks hooks(trees, result, mode);
   // In a cold turn (the front cost more than starting from the root) neither the contact nor the front is
   // tried: the query is the cold one, but for the turn's last, a walk from the root that leaves its front.
   const bool cold = state.cold_turns_left() > 0;
@@ -218,6 +210,14 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
     state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
     return cold_result;
   }
+  Result result;
+  result.exact = true;
+  if (a.empty() || b.empty()) return result;
+  if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "coherent exact query");
+  const auto context = VolumeWalker<BV>::make_context(b_to_a);
+  const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
+  using Walk = coherent_detail::FrontWalk<BV, Leaves>;
+  typename Walk::Hooks hooks(trees, result, mode);
   if (!cold && mode == ContactMode::First && state.witness) {
     const auto [i, j] = *state.witness;
     if (hooks.leaf_pair(typename Walk::Pair{{}, i, j, {}, {}, {}}) == Step::Decided) {
