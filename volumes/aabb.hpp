@@ -18,6 +18,7 @@ struct Aabb {
     PlainMat3 rotation;      // B -> A
     PlainMat3 abs_rotation;  // |R|, widened by a few ulps so re-boxed extents stay conservative
     Double3 translation;
+    double translation_magnitude;  // max |t_i|
   };
 
   static constexpr std::string_view name() { return "aabb"; }
@@ -41,18 +42,21 @@ struct Aabb {
   }
   static PairContext make_context(const RigidTransform& pose) {
     const Mat3 abs_r = pose.rotation.cwiseAbs().array() + Scalar(4) * std::numeric_limits<Scalar>::epsilon();
-    return {PlainMat3::from(pose.rotation), PlainMat3::from(abs_r), to_double3(pose.translation)};
+    return {PlainMat3::from(pose.rotation), PlainMat3::from(abs_r), to_double3(pose.translation),
+            pose.translation.cwiseAbs().maxCoeff()};
   }
   static bool overlap(const Aabb& a, const Aabb& b, const PairContext& c) {
     const Vec3 a_lo = to_vec(a.lo), a_hi = to_vec(a.hi), b_lo = to_vec(b.lo), b_hi = to_vec(b.hi);
     const Vec3 a_center = (a_lo + a_hi) * Scalar(0.5), a_half = (a_hi - a_lo) * Scalar(0.5);
-    const Vec3 b_center = c.rotation.map() * ((b_lo + b_hi) * Scalar(0.5)) + to_vec(c.translation);
+    const Vec3 b_own_center = (b_lo + b_hi) * Scalar(0.5);
+    const Vec3 b_center = c.rotation.map() * b_own_center + to_vec(c.translation);
     const Vec3 b_half = c.abs_rotation.map() * ((b_hi - b_lo) * Scalar(0.5));
     const Vec3 gap = (b_center - a_center).cwiseAbs() - a_half - b_half;
-    // Slack for the rounding of these few operations, relative to the magnitudes involved.
+    // Slack for the rounding of these few operations, relative to the magnitudes involved: R c_b + t rounds
+    // relative to |c_b| and |t|, not to its own size (B far from its origin, brought back by the pose).
     const Scalar slack = Scalar(16) * std::numeric_limits<Scalar>::epsilon() *
-                         (b_center.cwiseAbs().maxCoeff() + a_center.cwiseAbs().maxCoeff() +
-                          a_half.maxCoeff() + b_half.maxCoeff());
+                         (2 * b_own_center.cwiseAbs().maxCoeff() + c.translation_magnitude +
+                          a_center.cwiseAbs().maxCoeff() + a_half.maxCoeff() + b_half.maxCoeff());
     return gap.maxCoeff() <= slack;
   }
 

@@ -36,6 +36,9 @@ struct RestrictedBox {
     Double3 center;  ///< in the test frame
     Double3 half;    ///< in the test frame
     std::uint32_t depth = 0;
+    /// What the root's image R c + t rounds relative to: |c| and |t|, large when the tree lies far from its
+    /// own origin and the pose brings it back. Kept in what was padding.
+    float image_magnitude = 0;
   };
 
   static constexpr std::string_view name() { return "rbox"; }
@@ -73,12 +76,15 @@ struct RestrictedBox {
     const Vec3 lo = to_vec(root.lo), hi = to_vec(root.hi);
     const Vec3 center = frame.rotation.map() * ((lo + hi) * 0.5) + to_vec(frame.translation);
     const Vec3 half = frame.abs_rotation.map() * ((hi - lo) * 0.5);
-    return {root, to_double3(center), to_double3(half), 0};
+    const double image_magnitude =
+        2 * ((lo + hi) * 0.5).cwiseAbs().maxCoeff() + to_vec(frame.translation).cwiseAbs().maxCoeff();
+    return {root, to_double3(center), to_double3(half), 0, float_up(image_magnitude)};
   }
   static Working descend(const Working& parent, const RestrictedBox& node, const Frame& frame) {
     Working out;
     out.own = decode(parent.own, node);
     out.depth = parent.depth + 1;
+    out.image_magnitude = parent.image_magnitude;
     const std::uint32_t k = node.axis;
     const double dc =
         0.5 * ((double(node.lo) + double(node.hi)) - (double(parent.own.lo[k]) + double(parent.own.hi[k])));
@@ -98,8 +104,8 @@ struct RestrictedBox {
     const Vec3 ca = to_vec(a.center), ha = to_vec(a.half), cb = to_vec(b.center), hb = to_vec(b.half);
     const Vec3 gap = (cb - ca).cwiseAbs() - ha - hb;
     // Each incremental level adds at most a few ulps of these magnitudes; allow 8 per level and side.
-    const double magnitude =
-        ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + ha.maxCoeff() + hb.maxCoeff();
+    const double magnitude = ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + ha.maxCoeff() +
+                             hb.maxCoeff() + double(a.image_magnitude) + double(b.image_magnitude);
     const double slack =
         8.0 * double(a.depth + b.depth + 2) * std::numeric_limits<double>::epsilon() * magnitude;
     return gap.maxCoeff() <= slack;
@@ -108,5 +114,6 @@ struct RestrictedBox {
 
 static_assert(HierarchicalVolume<RestrictedBox>);
 static_assert(sizeof(RestrictedBox) == 12);
+static_assert(sizeof(RestrictedBox::Working) == 80, "the traversal state fills its padding, no more");
 
 }  // namespace bvhlab
