@@ -1,0 +1,227 @@
+#include "bvh/triangle_distance.hpp"
+
+#include "bvh/triangle_intersection.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace bvhlab {
+namespace {
+
+// Below this squared length (local coordinates, pair size ~1) a normal is no plane: the triangle or the edge
+// pair is then within 1e-70 of the vertex-edge candidates, which stand for it.
+constexpr double kTinySquared = 1e-280;
+
+// a * b - c * d within about one rounding (Kahan's scheme with fma). The plain difference cancels for nearly
+// parallel vectors, and a sliver's normal would tilt by eps / angle: its plane distances would be wrong.
+double difference_of_products(double a, double b, double c, double d) {
+  const double cd = c * d;
+  const double cd_error = std::fma(-c, d, cd);  // cd - c * d, exactly
+  return std::fma(a, b, -cd) + cd_error;
+}
+
+Vec3 accurate_cross(const Vec3& u, const Vec3& v) {
+  return {difference_of_products(u.y(), v.z(), u.z(), v.y()),
+          difference_of_products(u.z(), v.x(), u.x(), v.z()),
+          difference_of_products(u.x(), v.y(), u.y(), v.x())};
+}
+
+// Exact (barring underflow); ldexp per coordinate only where 2^exponent itself is out of range.
+Vec3 times_power_of_two(const Vec3& v, int exponent) {
+  if (exponent == 0) return v;
+  if (std::abs(exponent) <= 1000) return v * std::ldexp(1.0, exponent);
+  return {std::ldexp(v.x(), exponent), std::ldexp(v.y(), exponent), std::ldexp(v.z(), exponent)};
+}
+
+// Local coordinates y = (x 2^-pre - origin) 2^-exponent, all of magnitude below 1. Translating to p[0] keeps
+// the digits of a small pair far from the origin; the power-of-two scales are exact and keep the squares and
+// cross products of tiny or huge pairs clear of underflow and overflow. `pre` is non-zero only near overflow,
+// where the translation itself could overflow.
+struct Frame {
+  int pre = 0;
+  Vec3 origin = Vec3::Zero();
+  int exponent = 0;
+
+  static int exponent_above(double magnitude) { return magnitude > 0 ? std::ilogb(magnitude) + 1 : 0; }
+
+  // Sets the frame for the pair and returns the pair in it.
+  std::array<TrianglePoints, 2> enter(const TrianglePoints& p, const TrianglePoints& q) {
+    std::array<TrianglePoints, 2> local = {p, q};
+    double largest = 0;
+    for (const TrianglePoints& t : local)
+      for (const Vec3& v : t) largest = std::max(largest, v.cwiseAbs().maxCoeff());
+    if (largest > 0x1p1000) pre = exponent_above(largest);
+    origin = times_power_of_two(p[0], -pre);
+    double extent = 0;
+    for (TrianglePoints& t : local)
+      for (Vec3& v : t) {
+        v = times_power_of_two(v, -pre) - origin;
+        extent = std::max(extent, v.cwiseAbs().maxCoeff());
+      }
+    exponent = exponent_above(extent);
+    for (TrianglePoints& t : local)
+      for (Vec3& v : t) v = times_power_of_two(v, -exponent);
+    return local;
+  }
+  [[nodiscard]] Vec3 world(const Vec3& y) const {
+    return times_power_of_two(times_power_of_two(y, exponent) + origin, pre);
+  }
+  [[nodiscard]] double world_length(double d) const { return std::ldexp(d, exponent + pre); }
+};
+
+// A triangle with its normal. `flat` (collinear, repeated vertices, or a sliver narrower than 1e-70): no
+// plane, its edges are the point set.
+struct Face {
+  TrianglePoints v;
+  Vec3 normal, unit = Vec3::Zero();
+  bool flat;
+
+  explicit Face(const TrianglePoints& t) : v(t), normal(accurate_cross(t[1] - t[0], t[2] - t[0])) {
+    const double squared = normal.squaredNorm();
+    flat = !(squared > kTinySquared);
+    if (!flat) unit = normal / std::sqrt(squared);
+  }
+  [[nodiscard]] const Vec3& next(int k) const { return v[(k + 1) % 3]; }
+
+  // Signed distance of x above the plane when x's foot lies in the closed face. A foot on the boundary is an
+  // edge's business: rounding either way there changes the distance only to second order.
+  [[nodiscard]] std::optional<double> height_over(const Vec3& x) const {
+    if (flat) return std::nullopt;
+    for (int k = 0; k < 3; ++k)
+      if ((next(k) - v[k]).cross(x - v[k]).dot(normal) < 0) return std::nullopt;
+    return (x - v[0]).dot(unit);
+  }
+};
+
+// |v|, also where the squares of its components underflow (a gap of 1e-300 between unit triangles).
+double length(const Vec3& v) {
+  const double squared = v.squaredNorm();
+  if (squared >= 0x1p-1000) return std::sqrt(squared);
+  const double largest = v.cwiseAbs().maxCoeff();
+  return largest > 0 ? largest * (v / largest).norm() : 0.0;
+}
+
+// The point of segment [a, b] nearest x; a zero-length segment is its endpoint.
+Vec3 nearest_on_segment(const Vec3& x, const Vec3& a, const Vec3& b) {
+  const Vec3 d = b - a;
+  const double squared = d.squaredNorm();
+  if (!(squared > 0)) return a;
+  const double t = std::clamp((x - a).dot(d) / squared, 0.0, 1.0);
+  return t < 1 ? Vec3(a + t * d) : b;
+}
+
+double distance_to_face(const Face& f, const Vec3& x) {
+  double d = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) d = std::min(d, length(x - nearest_on_segment(x, f.v[k], f.next(k))));
+  if (const auto height = f.height_over(x)) d = std::min(d, std::abs(*height));
+  return d;
+}
+
+struct Pair {
+  double distance = std::numeric_limits<double>::infinity();
+  Vec3 on_p = Vec3::Zero(), on_q = Vec3::Zero();
+};
+
+void keep_nearer(Pair& best, const Vec3& on_p, const Vec3& on_q) {
+  const Vec3 gap = on_p - on_q;
+  if (gap.squaredNorm() >= best.distance * best.distance) return;  // most candidates: no square root
+  const double d = length(gap);
+  if (d < best.distance) best = {d, on_p, on_q};
+}
+
+// Segments [a0, a1] and [b0, b1] where the nearest points are interior to both: the common perpendicular of
+// the lines. Its parameter s is ill-conditioned for nearly parallel edges (a plain cross product is no worse
+// here), but sliding both points along the edges together barely changes their distance, and the two
+// projections that follow remove the rest. Parallel or tiny edges have an endpoint among their nearest
+// points: the vertex-edge candidates.
+void edge_edge(Pair& best, const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1) {
+  const Vec3 u = a1 - a0, v = b1 - b0, n = u.cross(v);
+  const double squared = n.squaredNorm();
+  if (!(squared > kTinySquared)) return;
+  const double s = std::clamp((b0 - a0).cross(v).dot(n) / squared, 0.0, 1.0);
+  const Vec3 on_b = nearest_on_segment(a0 + s * u, b0, b1);
+  keep_nearer(best, nearest_on_segment(on_b, a0, a1), on_b);
+}
+
+// The minimum over the features that can hold the nearest pair of disjoint triangles: vertex-edge (18),
+// edge-edge interiors (9) and vertex-face interiors (6). Exact arithmetic would make it the distance.
+Pair nearest_features(const Face& p, const Face& q) {
+  Pair best;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      keep_nearer(best, p.v[i], nearest_on_segment(p.v[i], q.v[j], q.next(j)));
+      keep_nearer(best, nearest_on_segment(q.v[j], p.v[i], p.next(i)), q.v[j]);
+      edge_edge(best, p.v[i], p.next(i), q.v[j], q.next(j));
+    }
+    if (const auto height = q.height_over(p.v[i]); height && std::abs(*height) < best.distance)
+      best = {std::abs(*height), p.v[i], p.v[i] - *height * q.unit};
+    if (const auto height = p.height_over(q.v[i]); height && std::abs(*height) < best.distance)
+      best = {std::abs(*height), q.v[i] - *height * p.unit, q.v[i]};
+  }
+  return best;
+}
+
+// Where segment [a, b] meets the face's plane, when its ends are on opposite sides or one is on it.
+std::optional<Vec3> plane_crossing(const Face& f, const Vec3& a, const Vec3& b) {
+  if (f.flat) return std::nullopt;
+  const double da = (a - f.v[0]).dot(f.normal), db = (b - f.v[0]).dot(f.normal);
+  if (da == db || (da > 0 && db > 0) || (da < 0 && db < 0)) return std::nullopt;
+  return a + (da / (da - db)) * (b - a);  // |da| <= |da - db|: the ratio is in [0, 1]
+}
+
+// A point of both triangles, known to intersect: where an edge of one crosses the other's plane (the ends of
+// a transversal intersection), or the midpoint of the nearest feature pair (a vertex in the other triangle,
+// coplanar edges crossing, touching features). Whichever is nearest to both triangles after rounding wins, so
+// the fallback is the nearest feature pair itself.
+Vec3 common_point(const Face& p, const Face& q, const Pair& nearest) {
+  Vec3 best = Vec3::Zero();
+  double residual = std::numeric_limits<double>::infinity();
+  const auto consider = [&](const Vec3& x) {
+    const double r = std::max(distance_to_face(p, x), distance_to_face(q, x));
+    if (r < residual) {
+      residual = r;
+      best = x;
+    }
+  };
+  consider((nearest.on_p + nearest.on_q) / 2);
+  for (int k = 0; k < 3 && residual > 0; ++k) {
+    if (const auto x = plane_crossing(q, p.v[k], p.next(k))) consider(*x);
+    if (const auto x = plane_crossing(p, q.v[k], q.next(k))) consider(*x);
+  }
+  return best;
+}
+
+void require_finite(const TrianglePoints& t, const char* name) {
+  for (int i = 0; i < 3; ++i)
+    if (!t[i].allFinite())
+      throw std::invalid_argument(std::string("triangle_distance: triangle ") + name + " vertex " +
+                                  std::to_string(i) + " has a NaN or infinite coordinate");
+}
+
+}  // namespace
+
+TriangleDistance triangle_distance(const TrianglePoints& p, const TrianglePoints& q) {
+  require_finite(p, "P");
+  require_finite(q, "Q");
+  const bool touching = triangles_intersect(p, q);
+  Frame frame;
+  const auto local = frame.enter(p, q);
+  const Face fp(local[0]), fq(local[1]);
+  const Pair nearest = nearest_features(fp, fq);
+  if (touching) {
+    const Vec3 x = frame.world(common_point(fp, fq, nearest));
+    return {0.0, x, x};
+  }
+  // Disjoint triangles are never at distance 0, even where the gap is below what doubles resolve.
+  const double distance =
+      std::max(frame.world_length(nearest.distance), std::numeric_limits<double>::denorm_min());
+  return {distance, frame.world(nearest.on_p), frame.world(nearest.on_q)};
+}
+
+}  // namespace bvhlab
