@@ -34,6 +34,21 @@
 //                               (PlacedBoxes&, geometry.hpp) the two boxes as the pair lies, which the test
 //                               computes anyway. A volume that has it is a `FramePlacingVolume`: the ADB
 //                               estimate in the nodes' frames reads that placement instead of its own.
+//   BV::distance_lower_bound(a, b, ctx)
+//                               double: a lower bound, >= 0, on the distance between any point contained in
+//                               a and any point contained in b after applying the pose (a in A's frame, b in
+//                               B's, ctx from make_context(pose) as for overlap). Conservative like
+//                               overlap(), rounding included: never larger than the true distance (each
+//                               model subtracts at least the slack its overlap() allows). 0 is always a
+//                               valid answer, and it is the answer wherever overlap(a, b, ctx) is true; a
+//                               positive bound proves separation, so overlap(a, b, ctx) is then false. It is
+//                               meant to be useful, not only valid: the separation the overlap test measures
+//                               (the widest gap on its separating axes, normalised to unit axes), at the
+//                               same order of cost. For an empty volume any value >= 0 is allowed (the
+//                               distance to an empty set is infinite). Assumes, as overlap() does, that the
+//                               pose's rotation is orthonormal to rounding. A volume that has it is a
+//                               `DistanceVolume` (proximity queries, issue #38). Hierarchical volumes
+//                               (below) have none.
 #pragma once
 
 #include "geometry.hpp"
@@ -71,6 +86,14 @@ template <class BV>
 concept FramePlacingVolume = FramedVolume<BV> &&
     requires(const BV& a, const BV& b, const typename BV::PairContext& context, PlacedBoxes& placed) {
   { BV::overlap(a, b, context, placed) } -> std::same_as<bool>;
+};
+
+/// A volume with a conservative distance bound between two placed volumes (the optional
+/// `distance_lower_bound` above).
+template <class BV>
+concept DistanceVolume = BoundingVolume<BV> &&
+    requires(const BV& a, const BV& b, const typename BV::PairContext& context) {
+  { BV::distance_lower_bound(a, b, context) } -> std::same_as<double>;
 };
 
 /// Concept `HierarchicalVolume<HV>`: a node volume stored relative to its parent's, as in Zachmann's

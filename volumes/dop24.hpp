@@ -32,6 +32,6 @@ struct Zachmann24 {
 
 using Dop24 = KDop<dop_sets::Zachmann24>;
 
-static_assert(BoundingVolume<Dop24>);
+static_assert(BoundingVolume<Dop24> && DistanceVolume<Dop24>);
 
 }  // namespace bvhlab

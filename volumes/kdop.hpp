@@ -384,24 +384,14 @@ struct KDop {
   }
 
   static bool overlap(const KDop& a, const KDop& b, const PairContext& c) {
-    // Smallest signed overlap of the projection intervals over A's axes; negative means separated.
-    double worst = std::numeric_limits<double>::infinity();
-    for (std::size_t m = 0; m < kAxes; ++m) {
-      const std::size_t opposite = m + kAxes;
-      const double b_upper = c.coefficients[m][0] * double(b.offsets[c.planes[m][0]]) +
-                             c.coefficients[m][1] * double(b.offsets[c.planes[m][1]]) +
-                             c.coefficients[m][2] * double(b.offsets[c.planes[m][2]]) + c.axis_shift[m];
-      const double b_neg_lower = c.coefficients[opposite][0] * double(b.offsets[c.planes[opposite][0]]) +
-                                 c.coefficients[opposite][1] * double(b.offsets[c.planes[opposite][1]]) +
-                                 c.coefficients[opposite][2] * double(b.offsets[c.planes[opposite][2]]) -
-                                 c.axis_shift[m];
-      // B's interval [-b_neg_lower, b_upper] against A's [-a.offsets[opposite], a.offsets[m]].
-      worst = std::min(worst,
-                       std::min(b_upper + double(a.offsets[opposite]), b_neg_lower + double(a.offsets[m])));
-    }
-    const double slack = c.slack_per_a_scale * a.coordinate_scale() +
-                         c.slack_per_b_scale * b.coordinate_scale() + c.slack_translation;
-    return worst >= -slack;
+    return smallest_overlap(a, b, c) >= -slack(a, b, c);
+  }
+
+  /// DistanceVolume: the widest gap between A's interval and B's (conservative) interval on A's unit axes,
+  /// less overlap()'s slack. Projection onto a unit axis does not increase distances, so a gap there is a
+  /// lower bound on the distance. 0 exactly where overlap() is true (the same two numbers compared).
+  static double distance_lower_bound(const KDop& a, const KDop& b, const PairContext& c) {
+    return std::max(0.0, -smallest_overlap(a, b, c) - slack(a, b, c));
   }
 
   [[nodiscard]] bool empty() const { return offsets[0] + offsets[kAxes] < 0; }
@@ -441,6 +431,31 @@ struct KDop {
   }
 
  private:
+  // Smallest signed overlap of the projection intervals over A's axes; negative means separated (by the
+  // largest gap, -smallest_overlap). Shared by overlap() and distance_lower_bound().
+  [[gnu::always_inline]] static double smallest_overlap(const KDop& a, const KDop& b, const PairContext& c) {
+    double worst = std::numeric_limits<double>::infinity();
+    for (std::size_t m = 0; m < kAxes; ++m) {
+      const std::size_t opposite = m + kAxes;
+      const double b_upper = c.coefficients[m][0] * double(b.offsets[c.planes[m][0]]) +
+                             c.coefficients[m][1] * double(b.offsets[c.planes[m][1]]) +
+                             c.coefficients[m][2] * double(b.offsets[c.planes[m][2]]) + c.axis_shift[m];
+      const double b_neg_lower = c.coefficients[opposite][0] * double(b.offsets[c.planes[opposite][0]]) +
+                                 c.coefficients[opposite][1] * double(b.offsets[c.planes[opposite][1]]) +
+                                 c.coefficients[opposite][2] * double(b.offsets[c.planes[opposite][2]]) -
+                                 c.axis_shift[m];
+      // B's interval [-b_neg_lower, b_upper] against A's [-a.offsets[opposite], a.offsets[m]].
+      worst = std::min(worst,
+                       std::min(b_upper + double(a.offsets[opposite]), b_neg_lower + double(a.offsets[m])));
+    }
+    return worst;
+  }
+  // The rounding slack of smallest_overlap (make_context).
+  [[gnu::always_inline]] static double slack(const KDop& a, const KDop& b, const PairContext& c) {
+    return c.slack_per_a_scale * a.coordinate_scale() + c.slack_per_b_scale * b.coordinate_scale() +
+           c.slack_translation;
+  }
+
   static constexpr std::array<float, kPlanes> filled(float value) {
     std::array<float, kPlanes> out{};
     for (auto& x : out) x = value;
@@ -528,9 +543,9 @@ struct ForK<26> {
 template <int K>
 using Dop = KDop<typename dop_sets::ForK<K>::type>;
 
-static_assert(BoundingVolume<Dop<6>>);
-static_assert(BoundingVolume<Dop<14>>);
-static_assert(BoundingVolume<Dop<18>>);
-static_assert(BoundingVolume<Dop<26>>);
+static_assert(BoundingVolume<Dop<6>> && DistanceVolume<Dop<6>>);
+static_assert(BoundingVolume<Dop<14>> && DistanceVolume<Dop<14>>);
+static_assert(BoundingVolume<Dop<18>> && DistanceVolume<Dop<18>>);
+static_assert(BoundingVolume<Dop<26>> && DistanceVolume<Dop<26>>);
 
 }  // namespace bvhlab

@@ -112,6 +112,32 @@ struct Obb {
     return test(a, b, c, &placed);
   }
 
+  /// DistanceVolume: the widest separating-axis gap, each axis's gap less overlap()'s slack and divided by
+  /// the axis's length. Projection onto a unit axis does not increase distances, so each is a lower bound.
+  /// Edge axes shorter than kMinEdgeAxis (edges within about 6 degrees of parallel) are skipped, which is
+  /// always allowed: dividing by their length would magnify the slack, which is absolute and scales with
+  /// the coordinates, more than tenfold (at coordinates 1e6 such an axis moved the bound by 1.3e-6 at
+  /// distance 1), and they raise the bound only in rare near-parallel edge-edge poses (on the tests'
+  /// separated clouds, a median of bound / distance 0.941 with all nine, 0.940 without those, 0.899 with
+  /// none). 0 exactly where overlap() is true.
+  [[gnu::flatten]] static double distance_lower_bound(const Obb& a, const Obb& b, const PairContext& c) {
+    const Placement p = place(a, b, c);
+    double best = 0;  // face axes are unit to a few ulps (the final factor covers them)
+    for (int i = 0; i < 3; ++i) best = std::max(best, face_gap_a(p, i) - p.slack);
+    for (int j = 0; j < 3; ++j) best = std::max(best, face_gap_b(p, j) - p.slack);
+    for (int i = 0; i < 3; ++i) {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+      for (int j = 0; j < 3; ++j) {
+        const double gap = edge_gap(p, i, j) - p.slack;
+        if (gap <= 0) continue;
+        const double length = std::sqrt(p.m(i1, j) * p.m(i1, j) + p.m(i2, j) * p.m(i2, j));
+        if (length >= kMinEdgeAxis) best = std::max(best, gap / length);
+      }
+    }
+    // The divisions, square roots and subtractions above round by a few ulps of the result.
+    return best * (1 - 16 * std::numeric_limits<double>::epsilon());
+  }
+
   [[nodiscard]] bool empty() const { return half[0] < 0; }
 
   /// For loaders of raw node bytes: finite, non-negative half extents and a quaternion that is close to unit
@@ -148,37 +174,54 @@ struct Obb {
   }
 
  private:
+  // B's box in A's box frame and what the separating-axis gaps need; computed once per test.
+  struct Placement {
+    Mat3 m;      // B's axes (columns) in A's box frame
+    Vec3 t;      // B's centre in A's box frame
+    Mat3 abs_m;  // |m|, widened by a few ulps
+    Vec3 ha, hb;
+    double slack;  // rounding slack of every gap below
+  };
+  [[gnu::always_inline]] static Placement place(const Obb& a, const Obb& b, const PairContext& c) {
+    const Mat3 ra = axes_of(a.orientation), rb = axes_of(b.orientation);
+    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center);
+    const auto rotation = c.rotation.map();
+    const Mat3 m = ra.transpose() * (rotation * rb);
+    const Vec3 t = ra.transpose() * (rotation * cb + to_vec(c.translation) - ca);
+    const Mat3 abs_m = m.cwiseAbs().array() + Scalar(8) * std::numeric_limits<Scalar>::epsilon();
+    const double slack = 64 * std::numeric_limits<double>::epsilon() *
+                         (a.magnitude() + b.magnitude() + c.translation_magnitude);
+    return {m, t, abs_m, to_vec(a.half), to_vec(b.half), slack};
+  }
+  // |T . L| - radius_a - radius_b on A's face axis i, B's face axis j, and the edge axis a_i x b_j (not a
+  // unit vector: its length is sqrt(m(i1, j)^2 + m(i2, j)^2)).
+  [[gnu::always_inline]] static double face_gap_a(const Placement& p, int i) {
+    return std::abs(p.t[i]) - p.ha[i] - p.abs_m.row(i).dot(p.hb);
+  }
+  [[gnu::always_inline]] static double face_gap_b(const Placement& p, int j) {
+    return std::abs(p.t.dot(p.m.col(j))) - p.abs_m.col(j).dot(p.ha) - p.hb[j];
+  }
+  [[gnu::always_inline]] static double edge_gap(const Placement& p, int i, int j) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+    const double distance = std::abs(p.t[i2] * p.m(i1, j) - p.t[i1] * p.m(i2, j));
+    const double radius_a = p.ha[i1] * p.abs_m(i2, j) + p.ha[i2] * p.abs_m(i1, j);
+    const double radius_b = p.hb[j1] * p.abs_m(i, j2) + p.hb[j2] * p.abs_m(i, j1);
+    return distance - radius_a - radius_b;
+  }
+
   // The 15-axis test; with `placed`, what it computed of the placement is written there.
   [[gnu::always_inline]] static bool test(const Obb& a, const Obb& b, const PairContext& c,
                                           PlacedBoxes* placed) {
-    const Mat3 ra = axes_of(a.orientation), rb = axes_of(b.orientation);
-    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center), ha = to_vec(a.half), hb = to_vec(b.half);
-    const auto rotation = c.rotation.map();
-    // B's axes (columns) and the centre offset in A's box frame.
-    const Mat3 m = ra.transpose() * (rotation * rb);
-    const Vec3 t = ra.transpose() * (rotation * cb + to_vec(c.translation) - ca);
-    if (placed) *placed = {ha, hb, {m, t}};
-    const Mat3 abs_m = m.cwiseAbs().array() + Scalar(8) * std::numeric_limits<Scalar>::epsilon();
-
-    const double slack = 64 * std::numeric_limits<double>::epsilon() *
-                         (a.magnitude() + b.magnitude() + c.translation_magnitude);
+    const Placement p = place(a, b, c);
+    if (placed) *placed = {p.ha, p.hb, {p.m, p.t}};
     double gap = -std::numeric_limits<double>::infinity();  // largest (|T . L| - radii) over the axes
-    for (int i = 0; i < 3; ++i) gap = std::max(gap, std::abs(t[i]) - ha[i] - abs_m.row(i).dot(hb));
-    for (int j = 0; j < 3; ++j) gap = std::max(gap, std::abs(t.dot(m.col(j))) - abs_m.col(j).dot(ha) - hb[j]);
+    for (int i = 0; i < 3; ++i) gap = std::max(gap, face_gap_a(p, i));
+    for (int j = 0; j < 3; ++j) gap = std::max(gap, face_gap_b(p, j));
     // One branch: most pairs a traversal tests are separated by a face axis, so skip the 9 edge axes.
-    if (gap > slack) return false;
-    for (int i = 0; i < 3; ++i) {
-      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
-      for (int j = 0; j < 3; ++j) {
-        const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-        // L = a_i x b_j in A's frame.
-        const double distance = std::abs(t[i2] * m(i1, j) - t[i1] * m(i2, j));
-        const double radius_a = ha[i1] * abs_m(i2, j) + ha[i2] * abs_m(i1, j);
-        const double radius_b = hb[j1] * abs_m(i, j2) + hb[j2] * abs_m(i, j1);
-        gap = std::max(gap, distance - radius_a - radius_b);
-      }
-    }
-    return gap <= slack;
+    if (gap > p.slack) return false;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) gap = std::max(gap, edge_gap(p, i, j));
+    return gap <= p.slack;
   }
 
   // One expression for fit and contains, so a fitted point always tests as contained.
@@ -204,6 +247,7 @@ struct Obb {
   // rounding instead of re-measuring against the stored floats also keeps this correct under GCC 12's -O2
   // SLP vectoriser, which folds double(float(x)) back to x.
   static constexpr double kFrameRounding = 0x1p-21;
+  static constexpr double kMinEdgeAxis = 0.1;  // shortest edge axis distance_lower_bound divides by
   static Obb box_in_frame(std::span<const Vec3> points, const Mat3& frame, double margin) {
     Obb out;
     Eigen::Quaterniond q(frame);
@@ -262,6 +306,6 @@ struct Obb {
   }
 };
 
-static_assert(BoundingVolume<Obb> && FramedVolume<Obb>);
+static_assert(BoundingVolume<Obb> && FramedVolume<Obb> && DistanceVolume<Obb>);
 
 }  // namespace bvhlab

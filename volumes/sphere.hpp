@@ -68,13 +68,17 @@ struct Sphere {
   }
 
   static bool overlap(const Sphere& a, const Sphere& b, const PairContext& c) {
-    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center);
-    const Vec3 offset = c.rotation.map() * cb + to_vec(c.translation) - ca;
-    const double slack = 32 * std::numeric_limits<double>::epsilon() *
-                         (ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + c.translation_magnitude +
-                          double(a.radius) + double(b.radius));
-    const double reach = double(a.radius) + double(b.radius) + slack;
-    return offset.squaredNorm() <= reach * reach;
+    const Placed p = place(a, b, c);
+    return p.squared_distance <= p.reach * p.reach;
+  }
+
+  /// DistanceVolume. Every point of a is within r_a of c_a and every placed point of b within r_b of
+  /// R c_b + t, so the triangle inequality bounds their distance below by |c_a - (R c_b + t)| - r_a - r_b;
+  /// `reach` holds overlap()'s rounding slack too. 0 exactly where overlap() is true: sqrt is monotone and
+  /// sqrt(reach * reach) rounds back to reach.
+  static double distance_lower_bound(const Sphere& a, const Sphere& b, const PairContext& c) {
+    const Placed p = place(a, b, c);
+    return std::max(0.0, std::sqrt(p.squared_distance) - p.reach);
   }
 
   [[nodiscard]] bool empty() const { return radius < 0; }
@@ -100,6 +104,21 @@ struct Sphere {
   }
 
  private:
+  // The centres' squared distance as the pair lies, and the radii plus the rounding slack: what overlap()
+  // compares, computed once for it and distance_lower_bound.
+  struct Placed {
+    double squared_distance;
+    double reach;
+  };
+  static Placed place(const Sphere& a, const Sphere& b, const PairContext& c) {
+    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center);
+    const Vec3 offset = c.rotation.map() * cb + to_vec(c.translation) - ca;
+    const double slack = 32 * std::numeric_limits<double>::epsilon() *
+                         (ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + c.translation_magnitude +
+                          double(a.radius) + double(b.radius));
+    return {offset.squaredNorm(), double(a.radius) + double(b.radius) + slack};
+  }
+
   // One expression for fit and contains, so a fitted point always tests as contained.
   static double distance(const Vec3& c, const Vec3& p) { return (p - c).norm(); }
 
@@ -143,6 +162,6 @@ struct Sphere {
   }
 };
 
-static_assert(BoundingVolume<Sphere>);
+static_assert(BoundingVolume<Sphere> && DistanceVolume<Sphere>);
 
 }  // namespace bvhlab
