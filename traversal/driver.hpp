@@ -64,6 +64,9 @@
 //   Step leaf_pair(const Pair&)            a pair of two leaves taken off the queue. Exact strategies run
 //                                          trees.leaf_contact: the one triangle-pair loop, or the trees'
 //                                          other leaf test (TreePair's Leaves: point surfaces).
+//   Step taken(const Pair&)                optional: a pair just taken off the queue, before its leaf test
+//                                          or expansion; Decided ends the loop (distance: the nearest pair
+//                                          left is no nearer than the best found).
 //   Step children_evaluated(const Pair& parent, const Score* scores, int count)   optional: after all of a
 //                                          parent's children were evaluated, before any is admitted (ADB's
 //                                          "confirm with children").
@@ -314,6 +317,10 @@ class BudgetLimit {
 // ---- The loop -------------------------------------------------------------------------------------------
 
 namespace driver_detail {
+template <class Hooks, class Pair>
+concept HasTakenHook = requires(Hooks& h, const Pair& p) {
+  { h.taken(p) } -> std::same_as<Step>;
+};
 template <class Hooks, class Pair, class Score>
 concept HasChildrenHook = requires(Hooks& h, const Pair& p, const Score* s) {
   { h.children_evaluated(p, s, 1) } -> std::same_as<Step>;
@@ -355,6 +362,8 @@ class Traversal {
       if (!limit_.allows_pop()) return hooks_.finish(queue_, Ended::BudgetExhausted);
       const Pair top = queue_.pop();
       ++trees_.counters.nodes_visited;
+      if constexpr (driver_detail::HasTakenHook<Hooks, Pair>)
+        if (hooks_.taken(top) == Step::Decided) return;
       if (trees_.is_leaf_pair(top)) {
         if (hooks_.leaf_pair(top) == Step::Decided) return;
         continue;
@@ -389,6 +398,8 @@ class Traversal {
   [[gnu::always_inline]] TraversalState step() {
     const Pair top = queue_.pop();
     ++trees_.counters.nodes_visited;
+    if constexpr (driver_detail::HasTakenHook<Hooks, Pair>)
+      if (hooks_.taken(top) == Step::Decided) return TraversalState::Done;
     if (trees_.is_leaf_pair(top)) {
       if (hooks_.leaf_pair(top) == Step::Decided) return TraversalState::Done;
       return settled();

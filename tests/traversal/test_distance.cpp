@@ -1,0 +1,175 @@
+// Proximity queries (traversal/distance.hpp) against a brute force over every triangle pair, for every
+// volume with a distance bound.
+#include "support/generated_meshes.hpp"
+#include "traversal/distance.hpp"
+#include "volumes/shipped.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace bvhlab {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// The smallest triangle_distance over every triangle pair, B moved by the pose: what the query must find.
+double brute_force_distance(const Mesh& a, const Mesh& b, const RigidTransform& pose) {
+  double best = kInf;
+  for (std::size_t j = 0; j < b.triangles.size(); ++j) {
+    const TrianglePoints t = b.triangle(static_cast<std::uint32_t>(j));
+    const TrianglePoints moved = {pose.apply(t[0]), pose.apply(t[1]), pose.apply(t[2])};
+    for (std::size_t i = 0; i < a.triangles.size(); ++i)
+      best = std::min(best, triangle_distance(a.triangle(static_cast<std::uint32_t>(i)), moved).distance);
+  }
+  return best;
+}
+
+/// Distance from point p to triangle t (both in one frame): how far a reported closest point is off it.
+double off_triangle(const Vec3& p, const TrianglePoints& t) {
+  return triangle_distance({p, p, p}, t).distance;
+}
+
+RigidTransform translated(RigidTransform pose, const Vec3& shift) {
+  pose.translation += shift;
+  return pose;
+}
+
+template <class BV>
+class DistanceQuery : public ::testing::Test {
+ protected:
+  Mesh a = testing::make_torus(0.7, 0.25, 12, 6);
+  Mesh b = testing::make_random_soup(100, 0.15, 3);
+  Bvh<BV> tree_a = Bvh<BV>::build(a);
+  Bvh<BV> tree_b = Bvh<BV>::build(b);
+  /// Poses from deep overlap to a few object sizes apart.
+  std::vector<RigidTransform> poses() const {
+    std::mt19937_64 rng(17);
+    std::vector<RigidTransform> out;
+    for (int k = 0; k < 24; ++k) out.push_back(testing::random_pose(rng, 0.5 + 0.25 * k));
+    return out;
+  }
+};
+
+// The sanitizer builds keep one k-DOP for the family, as tests/support/volume_lists.hpp explains.
+#ifdef BVHLAB_LEAN_VOLUMES
+using DistanceVolumes = ::testing::Types<Aabb, Obb, Sphere, Dop24>;
+#else
+using DistanceVolumes = ::testing::Types<Aabb, Obb, Sphere, Dop<6>, Dop<14>, Dop24>;
+#endif
+TYPED_TEST_SUITE(DistanceQuery, DistanceVolumes);
+
+TYPED_TEST(DistanceQuery, FindsTheNearestTrianglePairWithItsPoints) {
+  int touching = 0, apart = 0;
+  for (const RigidTransform& pose : this->poses()) {
+    const DistanceResult r = query_distance(this->tree_a, this->tree_b, pose);
+    const double expected = brute_force_distance(this->a, this->b, pose);
+    ASSERT_EQ(r.distance, expected);
+    ASSERT_TRUE(r.exact);
+    ASSERT_FALSE(r.budget_exhausted);
+    ASSERT_EQ(r.lower_bound, r.distance);
+    ASSERT_TRUE(r.triangles.has_value());
+    // The points lie on the named triangles and are as far apart as reported.
+    const TrianglePoints tb = this->b.triangle(r.triangles->b);
+    const TrianglePoints moved = {pose.apply(tb[0]), pose.apply(tb[1]), pose.apply(tb[2])};
+    EXPECT_LT(off_triangle(r.on_a, this->a.triangle(r.triangles->a)), 1e-12);
+    EXPECT_LT(off_triangle(r.on_b, moved), 1e-12);
+    EXPECT_NEAR((r.on_a - r.on_b).norm(), r.distance, 1e-12);
+    // Distance 0 exactly when the exact intersection query finds a contact.
+    EXPECT_EQ(r.distance == 0, query_exact(this->tree_a, this->tree_b, pose).collides);
+    (r.distance == 0 ? touching : apart) += 1;
+  }
+  EXPECT_GT(touching, 3);
+  EXPECT_GT(apart, 8);
+}
+
+TYPED_TEST(DistanceQuery, PrunesMostPairsWhenApart) {
+  // Far apart, the bound must spare nearly all of the |A| x |B| triangle pairs a brute force tests.
+  const RigidTransform pose = translated(RigidTransform{}, Vec3(3, 0.5, 0));
+  const DistanceResult r = query_distance(this->tree_a, this->tree_b, pose);
+  EXPECT_LT(r.counters.triangle_tests, this->a.triangles.size() * this->b.triangles.size() / 20);
+}
+
+TYPED_TEST(DistanceQuery, AnytimeIntervalHoldsTheDistanceAndClosesWithTheFullBudget) {
+  for (const RigidTransform& pose : this->poses()) {
+    const DistanceResult full = query_distance(this->tree_a, this->tree_b, pose);
+    for (std::uint64_t cap : {1, 2, 5, 20, 100, 1000}) {
+      const DistanceResult r = query_distance_anytime(this->tree_a, this->tree_b, pose, Budget{cap, 0});
+      ASSERT_LE(r.lower_bound, full.distance) << "cap " << cap;
+      ASSERT_GE(r.distance, full.distance) << "cap " << cap;
+      ASSERT_LE(r.counters.bv_tests, cap);
+      if (r.budget_exhausted) continue;
+      ASSERT_EQ(r.distance, full.distance);
+      ASSERT_TRUE(r.exact);
+    }
+    const DistanceResult ample =
+        query_distance_anytime(this->tree_a, this->tree_b, pose, Budget{full.counters.bv_tests + 1, 0});
+    EXPECT_EQ(ample.distance, full.distance);
+    EXPECT_EQ(ample.lower_bound, full.distance);
+  }
+}
+
+TYPED_TEST(DistanceQuery, WithinToleranceAgreesWithTheDistance) {
+  for (const RigidTransform& pose : this->poses()) {
+    const double d = query_distance(this->tree_a, this->tree_b, pose).distance;
+    EXPECT_EQ(query_within(this->tree_a, this->tree_b, pose, 0).collides, d == 0);
+    if (d == 0) continue;
+    for (double eps : {d * 0.5, std::nextafter(d, 0.0), d, d * 1.5}) {
+      const Result r = query_within(this->tree_a, this->tree_b, pose, eps);
+      ASSERT_EQ(r.collides, d <= eps) << "eps " << eps << " distance " << d;
+      if (r.collides) {
+        ASSERT_TRUE(r.witness.has_value());
+        const TrianglePoints tb = this->b.triangle(r.witness->b);
+        EXPECT_LE(triangle_distance(this->a.triangle(r.witness->a),
+                                    {pose.apply(tb[0]), pose.apply(tb[1]), pose.apply(tb[2])})
+                      .distance,
+                  eps);
+      }
+    }
+  }
+}
+
+TYPED_TEST(DistanceQuery, KeepsItsPrecisionFarFromTheOrigin) {
+  // The same pair of objects, both moved 1e6 away. The query finds the brute force's distance there, and
+  // that differs from the one at the origin by 1e-9 of it plus what moving the vertices and applying the pose
+  // at 1e6 round (a few ulps of 1e6, about 1e-10 each): no precision is lost beyond the data's own.
+  const Vec3 far(1e6, -1e6, 1e6);
+  Mesh a_far = this->a, b_far = this->b;
+  for (Vec3& v : a_far.vertices) v += far;
+  for (Vec3& v : b_far.vertices) v += far;
+  const auto tree_a = Bvh<TypeParam>::build(a_far);
+  const auto tree_b = Bvh<TypeParam>::build(b_far);
+  std::mt19937_64 rng(4);
+  for (int k = 0; k < 4; ++k) {
+    RigidTransform pose = testing::random_pose(rng, 0.1);
+    pose.translation += Vec3(2.5, 0, 0);
+    const double near_origin = query_distance(this->tree_a, this->tree_b, pose).distance;
+    // B's frame maps into A's: moving both by `far` conjugates the pose.
+    RigidTransform far_pose = pose;
+    far_pose.translation = pose.translation + far - pose.rotation * far;
+    const DistanceResult r = query_distance(tree_a, tree_b, far_pose);
+    ASSERT_EQ(r.distance, brute_force_distance(a_far, b_far, far_pose)) << "pose " << k;
+    const double data_rounding = 8 * std::nextafter(1e6, kInf) - 8e6;
+    EXPECT_NEAR(r.distance, near_origin, 1e-9 * near_origin + data_rounding) << "pose " << k;
+    EXPECT_NEAR((r.on_a - r.on_b).norm(), r.distance, 1e-9 * near_origin + data_rounding);
+  }
+}
+
+TEST(DistanceQueryInput, RefusesNonsenseBeforeWork) {
+  const Mesh m = testing::make_torus(0.7, 0.25, 12, 6);
+  const auto tree = Bvh<Aabb>::build(m);
+  const RigidTransform pose = translated(RigidTransform{}, Vec3(3, 0, 0));
+  for (double eps : {-1.0, std::nan(""), kInf})
+    EXPECT_THROW(query_within(tree, tree, pose, eps), std::invalid_argument) << eps;
+  EXPECT_THROW(query_distance_anytime(tree, tree, pose, Budget{}), std::invalid_argument);
+  EXPECT_THROW(query_distance_anytime(tree, tree, pose, Budget{0, std::nan("")}), std::invalid_argument);
+  EXPECT_THROW(query_distance_anytime(tree, tree, pose, Budget{0, -5}), std::invalid_argument);
+  RigidTransform sheared = pose;
+  sheared.rotation(0, 1) = 0.3;
+  EXPECT_THROW(query_distance(tree, tree, sheared), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace bvhlab

@@ -1,0 +1,234 @@
+// Proximity queries: the distance between two triangle trees with its closest points, the tolerance query
+// (are they within eps?), and the anytime distance, which a budget may stop with a guaranteed interval.
+//
+// All three are configurations of the driver (driver.hpp), like every other strategy:
+//   distance    DistanceHooks with BestFirst on the volumes' lower bound (the nearest pair first),
+//               SplitLarger and no limit. A pair whose bound is no smaller than the best distance found is
+//               dropped, and the first such pair taken off the queue ends the query: all left are farther.
+//   anytime     the same under a BudgetLimit. When it stops, the best pair found is an upper bound and the
+//               smallest bound left on the queue a lower one: the exact distance lies between them.
+//   tolerance   ToleranceHooks, depth first: a pair is kept while its bound is at most eps, and the first
+//               triangle pair within eps decides. eps = 0 is the exact intersection query itself.
+// The volumes need a distance bound (the DistanceVolume refinement, volumes/concept.hpp); a tree of volumes
+// without one does not compile here, and the run-time layer refuses it by name.
+#pragma once
+
+#include "../bvh/triangle_distance.hpp"
+#include "driver.hpp"
+#include "exact.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace bvhlab {
+
+/// The best pair a distance traversal has found so far: its distance, its points (A's frame) and triangles.
+struct NearestPair {
+  double distance = std::numeric_limits<double>::infinity();
+  Vec3 on_a = Vec3::Zero(), on_b = Vec3::Zero();
+  TrianglePair triangles;
+};
+
+namespace distance_detail {
+
+/// The one triangle-pair loop of a distance traversal: every triangle pair of leaf pair (i, j) whose
+/// distance is below `nearest`'s replaces it. True when the triangles touch (distance 0: nothing is nearer).
+template <TreeVolume BV>
+bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t j, NearestPair& nearest) {
+  const TreeNode& na = trees.a.node(i);
+  const TreeNode& nb = trees.b.node(j);
+  const auto& tri_a = trees.a.triangles();
+  const auto& tri_b = trees.b.triangles();
+  for (std::uint32_t tb = nb.first; tb < nb.first + nb.count; ++tb) {
+    const TrianglePoints moved = {trees.b_to_a.apply(tri_b[tb][0]), trees.b_to_a.apply(tri_b[tb][1]),
+                                  trees.b_to_a.apply(tri_b[tb][2])};
+    for (std::uint32_t ta = na.first; ta < na.first + na.count; ++ta) {
+      ++trees.counters.triangle_tests;
+      const TriangleDistance d = triangle_distance(tri_a[ta], moved);
+      if (d.distance >= nearest.distance) continue;
+      nearest = {d.distance, d.on_p, d.on_q, {trees.a.triangle_ids()[ta], trees.b.triangle_ids()[tb]}};
+      if (d.distance == 0) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace distance_detail
+
+/// The distance strategy's hooks: a pair's score is its volumes' lower bound (one BV test), the queue key
+/// its negation (BestFirst takes the highest key: the nearest pair first).
+template <DistanceVolume BV>
+class DistanceHooks {
+ public:
+  using Pair = QueuedPair<BV, double>;
+
+  DistanceHooks(const TreePair<BV>& trees, NearestPair& nearest) : trees_(trees), nearest_(nearest) {}
+
+  [[gnu::always_inline]] double evaluate(const Pair& p) {
+    ++trees_.counters.bv_tests;
+    return BV::distance_lower_bound(trees_.a.volume(p.a), trees_.b.volume(p.b), trees_.context);
+  }
+  [[gnu::always_inline]] Admission admit(Pair& p, double bound) {
+    if (bound >= nearest_.distance) return Admission::Drop;
+    p.key = -bound;
+    return Admission::Queue;
+  }
+  /// Every pair still queued is at least as far as this one: none can hold a nearer triangle pair.
+  [[gnu::always_inline]] Step taken(const Pair& p) const {
+    return -p.key >= nearest_.distance ? Step::Decided : Step::Continue;
+  }
+  [[gnu::always_inline]] Step leaf_pair(const Pair& p) {
+    return distance_detail::nearer_triangles(trees_, p.a, p.b, nearest_) ? Step::Decided : Step::Continue;
+  }
+  /// Stopped by the budget: the distance is at least the smallest bound left unexamined.
+  template <class Queue>
+  void finish(const Queue& queue, Ended ended) {
+    if (ended != Ended::BudgetExhausted) return;
+    stopped_ = true;
+    // An empty queue here means the budget refused the root's test: nothing is known.
+    unexamined_bound_ = queue.empty() ? 0 : -queue.top().key;
+  }
+
+  [[nodiscard]] bool stopped() const { return stopped_; }
+  /// The smallest lower bound of the pairs a stopped traversal left (infinity: none left).
+  [[nodiscard]] double unexamined_bound() const { return unexamined_bound_; }
+
+ private:
+  const TreePair<BV>& trees_;
+  NearestPair& nearest_;
+  bool stopped_ = false;
+  double unexamined_bound_ = std::numeric_limits<double>::infinity();
+};
+
+/// What a distance query answers. `distance` is the nearest pair found, `lower_bound` what is proven: they
+/// are equal (and `exact`) unless a budget stopped the query, and the exact distance lies between them.
+/// Points are in A's frame (on_b is B's point moved by the pose); `triangles` are source-mesh indices.
+struct DistanceResult {
+  double distance = std::numeric_limits<double>::infinity();
+  double lower_bound = 0;
+  Vec3 on_a = Vec3::Zero(), on_b = Vec3::Zero();
+  std::optional<TrianglePair> triangles;  ///< empty only for an empty tree, or when stopped before a leaf
+  bool exact = true;
+  bool budget_exhausted = false;
+  Counters counters;
+};
+
+namespace distance_detail {
+
+template <DistanceVolume BV>
+void check_query(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, const char* who) {
+  b_to_a.validate();
+  TriangleLeaves::require(a, b, who);
+}
+
+/// The distance traversal under `limit` (Unlimited or BudgetLimit).
+template <DistanceVolume BV, class Limit>
+DistanceResult run(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, Limit& limit) {
+  DistanceResult result;
+  if (a.empty() || b.empty()) return result;  // no pair at all: infinitely far, and exactly so
+  const auto context = VolumeWalker<BV>::make_context(b_to_a);
+  const TreePair<BV> trees(a, b, b_to_a, context, result.counters);
+  NearestPair nearest;
+  DistanceHooks<BV> hooks(trees, nearest);
+  traverse<BestFirst, SplitLarger>(trees, hooks, limit);
+  result.distance = nearest.distance;
+  result.on_a = nearest.on_a;
+  result.on_b = nearest.on_b;
+  if (std::isfinite(nearest.distance)) result.triangles = nearest.triangles;
+  result.budget_exhausted = hooks.stopped();
+  result.lower_bound = std::min(nearest.distance, hooks.unexamined_bound());
+  result.exact = result.lower_bound == result.distance;
+  return result;
+}
+
+}  // namespace distance_detail
+
+/// The distance between the triangles of two trees, with the closest points and the triangles they lie on;
+/// 0 with a touching pair when they intersect. `b_to_a` maps B's frame into A's. Exact to the rounding of
+/// triangle_distance (bvh/triangle_distance.hpp). Throws std::invalid_argument for a non-rigid pose or a
+/// tree without triangles. Thread-safe on shared trees.
+template <DistanceVolume BV>
+DistanceResult query_distance(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a) {
+  distance_detail::check_query(a, b, b_to_a, "distance query");
+  Unlimited limit;
+  return distance_detail::run(a, b, b_to_a, limit);
+}
+
+/// The anytime distance: query_distance stopped by `budget` (BV tests and/or a deadline). The result's
+/// [lower_bound, distance] always holds the exact distance, and narrows as the budget grows. Throws
+/// std::invalid_argument for a budget that allows nothing (no cap and no deadline: use query_distance) or a
+/// deadline that is negative or NaN, before any work.
+template <DistanceVolume BV>
+DistanceResult query_distance_anytime(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
+                                      const Budget& budget) {
+  if (!(budget.deadline_us >= 0) || std::isinf(budget.deadline_us))
+    throw std::invalid_argument(
+        "anytime distance: the deadline must be a finite number of microseconds >= 0");
+  if (budget.unlimited())
+    throw std::invalid_argument(
+        "anytime distance: the budget is 0 (no BV-test cap and no deadline); give one, or ask for the full "
+        "distance query");
+  distance_detail::check_query(a, b, b_to_a, "anytime distance query");
+  BudgetLimit limit(budget);
+  return distance_detail::run(a, b, b_to_a, limit);
+}
+
+/// The tolerance strategy's hooks: a pair is kept while its volumes may hold points within eps; the first
+/// triangle pair within eps decides.
+template <DistanceVolume BV>
+class ToleranceHooks {
+ public:
+  using Pair = QueuedPair<BV>;
+
+  ToleranceHooks(const TreePair<BV>& trees, double tolerance, Result& result)
+      : trees_(trees), tolerance_(tolerance), result_(result) {}
+
+  [[gnu::always_inline]] bool evaluate(const Pair& p) {
+    ++trees_.counters.bv_tests;
+    return BV::distance_lower_bound(trees_.a.volume(p.a), trees_.b.volume(p.b), trees_.context) <= tolerance_;
+  }
+  static Admission admit(Pair&, bool near) { return near ? Admission::Queue : Admission::Drop; }
+  [[gnu::always_inline]] Step leaf_pair(const Pair& p) {
+    NearestPair nearest;
+    nearest.distance = std::nextafter(tolerance_, std::numeric_limits<double>::infinity());
+    distance_detail::nearer_triangles(trees_, p.a, p.b, nearest);
+    if (!(nearest.distance <= tolerance_)) return Step::Continue;
+    result_.collides = true;
+    result_.probability = 1;
+    result_.witness = nearest.triangles;
+    return Step::Decided;
+  }
+  template <class Queue>
+  static void finish(const Queue&, Ended) {}
+
+ private:
+  const TreePair<BV>& trees_;
+  double tolerance_;
+  Result& result_;
+};
+
+/// Are the two trees' triangles within `tolerance` of each other (distance <= tolerance)? `collides` says
+/// so, and `witness` names a triangle pair within it. With tolerance 0 this is query_exact. Throws
+/// std::invalid_argument for a negative or non-finite tolerance (before any work), a non-rigid pose or a
+/// tree without triangles.
+template <DistanceVolume BV>
+Result query_within(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, double tolerance) {
+  if (!(tolerance >= 0) || std::isinf(tolerance))
+    throw std::invalid_argument("tolerance query: the tolerance must be finite and >= 0, not " +
+                                std::to_string(tolerance));
+  if (tolerance == 0) return query_exact(a, b, b_to_a);
+  distance_detail::check_query(a, b, b_to_a, "tolerance query");
+  Result result;
+  result.exact = true;
+  if (a.empty() || b.empty()) return result;
+  const auto context = VolumeWalker<BV>::make_context(b_to_a);
+  const TreePair<BV> trees(a, b, b_to_a, context, result.counters);
+  ToleranceHooks<BV> hooks(trees, tolerance, result);
+  Unlimited limit;
+  traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
+  return result;
+}
+
+}  // namespace bvhlab
