@@ -11,6 +11,7 @@
 #include "bvh/triangle_distance.hpp"
 #include "bvh/triangle_intersection.hpp"
 #include "support/random_draws.hpp"
+#include "support/triangle_families.hpp"
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/squared_distance_3.h>
@@ -27,14 +28,12 @@
 #include <limits>
 #include <numbers>
 #include <random>
-#include <sstream>
 #include <string>
 
 namespace bvhlab {
 namespace {
 
-using Rng = std::mt19937_64;
-using generators::random_triangle;
+using namespace testing;  // the triangle families: support/triangle_families.hpp
 using generators::random_unit;
 using generators::uniform;
 using generators::uniform_point;
@@ -112,37 +111,6 @@ Membership within(const Vec3& x, const K::Triangle_3& t, double tolerance) {
 
 // ---- pairs and their transformations -----------------------------------------------------------------
 
-struct Pair {
-  TrianglePoints p, q;
-};
-using Generator = std::function<Pair(Rng&)>;
-
-long long integer(Rng& rng, long long lo, long long hi) {
-  return std::uniform_int_distribution<long long>(lo, hi)(rng);
-}
-bool coin(Rng& rng) {
-  return integer(rng, 0, 1) == 1;
-}
-double log_uniform(Rng& rng, double lo_exponent, double hi_exponent) {
-  return std::pow(10.0, uniform(rng, lo_exponent, hi_exponent));
-}
-Vec3 integer_point(Rng& rng, long long lo, long long hi) {
-  return Vec3{double(integer(rng, lo, hi)), double(integer(rng, lo, hi)), double(integer(rng, lo, hi))};
-}
-TrianglePoints permuted(const TrianglePoints& t, Rng& rng) {
-  static constexpr int kOrders[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
-  const auto& o = kOrders[integer(rng, 0, 5)];
-  return {t[o[0]], t[o[1]], t[o[2]]};
-}
-TrianglePoints translated(const TrianglePoints& t, const Vec3& by) {
-  return {t[0] + by, t[1] + by, t[2] + by};
-}
-TrianglePoints scaled(const TrianglePoints& t, double s) {
-  return {t[0] * s, t[1] * s, t[2] * s};
-}
-bool exactly_degenerate(const TrianglePoints& t) {  // for small-integer triangles only (products exact)
-  return (t[1] - t[0]).cross(t[2] - t[0]).isZero(0.0);
-}
 double longest_edge(const TrianglePoints& t) {
   return std::max({(t[1] - t[0]).stableNorm(), (t[2] - t[1]).stableNorm(), (t[0] - t[2]).stableNorm()});
 }
@@ -154,16 +122,6 @@ double largest_coordinate(std::initializer_list<Vec3> points) {
 Mat3 random_rotation(Rng& rng) {
   std::normal_distribution<double> normal;
   return testing::draw_quaternion(normal, rng).normalized().toRotationMatrix();
-}
-
-std::string describe(const TrianglePoints& t) {
-  std::ostringstream out;
-  char buffer[96];
-  for (const Vec3& v : t) {
-    std::snprintf(buffer, sizeof buffer, "(%a, %a, %a) ", v.x(), v.y(), v.z());
-    out << buffer;
-  }
-  return out.str();
 }
 
 // ---- the checks ----------------------------------------------------------------------------------------
@@ -297,20 +255,14 @@ void check_family(const char* name, std::uint64_t seed, std::size_t count, const
   EXPECT_EQ(stats.failures, 0u) << name << ": " << stats.first_failure;
 }
 
-// ---- generators: the families of test_triangle_intersection.cpp (file-local there), plus separated pairs,
-// parallel faces, nearly parallel edges and slivers. Random draws in a fixed order (braces, one per
-// statement): g++ and clang evaluate function arguments in different orders.
+// ---- generators: the families shared with test_triangle_intersection.cpp (support/triangle_families.hpp),
+// plus separated pairs, parallel faces, nearly parallel edges and slivers. Random draws in a fixed order
+// (braces, one per statement): g++ and clang evaluate function arguments in different orders.
 
 // Pairs per family. CGAL's exact distance leaves interval arithmetic for rationals on near contacts, parallel
 // features and slivers (ties in its own edge-pair loop), ~150 us a pair: those families, and the scales
 // (which repeat general position), get fewer, so that the whole test stays near 3 s.
 constexpr std::size_t kPairs = 1'000, kCostlyPairs = 600;
-
-// Two triangles whose centres lie in a common box: about half intersect.
-Pair general_pair(Rng& rng) {
-  const TrianglePoints p = random_triangle(rng, uniform_point(rng, 0.0, 0.5));
-  return {p, random_triangle(rng, uniform_point(rng, 0.0, 0.5))};
-}
 
 // A general pair with Q moved 1e-8..10 in a random direction: mostly disjoint, at every distance.
 Pair separated_pair(Rng& rng) {
@@ -319,48 +271,14 @@ Pair separated_pair(Rng& rng) {
   return {base.p, translated(base.q, direction * log_uniform(rng, -8, 1))};
 }
 
-// An exactly representable plane: integer origin and basis, times a power of two, so lattice points are
-// exact.
-struct LatticePlane {
-  Vec3 origin, e1, e2;
-  double unit = 1.0;
-  static LatticePlane random(Rng& rng) {
-    LatticePlane plane;
-    do {
-      plane.e1 = integer_point(rng, -9, 9);
-      plane.e2 = integer_point(rng, -9, 9);
-    } while (plane.e1.cross(plane.e2).isZero(0.0));
-    plane.origin = integer_point(rng, -1000, 1000);
-    plane.unit = std::ldexp(1.0, int(integer(rng, -20, 20)));
-    return plane;
-  }
-  [[nodiscard]] Vec3 at(const Eigen::Vector2d& ij) const {
-    return (origin + ij.x() * e1 + ij.y() * e2) * unit;
-  }
-};
-using Tri2 = std::array<Eigen::Vector2d, 3>;
-Eigen::Vector2d lattice2(Rng& rng, long long r) {
-  return {double(integer(rng, -r, r)), double(integer(rng, -r, r))};
-}
-bool degenerate2(const Tri2& t) {
-  const Eigen::Vector2d u = t[1] - t[0], v = t[2] - t[0];
-  return u.x() * v.y() - u.y() * v.x() == 0.0;
-}
-Tri2 random_tri2(Rng& rng, long long r) {
-  Tri2 t;
-  do t = {lattice2(rng, r), lattice2(rng, r), lattice2(rng, r)};
-  while (degenerate2(t));
-  return t;
-}
-Tri2 shifted2(const Tri2& t, const Eigen::Vector2d& by) {
-  return {t[0] + by, t[1] + by, t[2] + by};
-}
-TrianglePoints on_plane(const LatticePlane& plane, const Tri2& t) {
-  return {plane.at(t[0]), plane.at(t[1]), plane.at(t[2])};
+// A random direction times 1e-12..1e-2, for `sharing` (the direction drawn first).
+Vec3 small_offset(Rng& rng) {
+  const Vec3 direction = random_unit(rng);
+  return direction * log_uniform(rng, -12, -2);
 }
 
 // Q in the cone opposite P's corner p[0], at P's edge midpoint, or along P's edge (whole or half): exact
-// contact, half the time moved by a small lattice step (overlap or a coplanar gap).
+// contact, which coplanar_touching moves half the time by a small lattice step (overlap or a coplanar gap).
 Tri2 touching_q(Rng& rng, const Tri2& p) {
   const Eigen::Vector2d mid = (p[0] + p[1]) / 2.0;
   const auto beyond = [&]() -> Eigen::Vector2d {
@@ -381,94 +299,6 @@ Tri2 touching_q(Rng& rng, const Tri2& p) {
     default:
       return {p[0], mid, beyond()};
   }
-}
-Pair coplanar_touching(Rng& rng) {
-  const LatticePlane plane = LatticePlane::random(rng);
-  Tri2 p = random_tri2(rng, 20);
-  p = {2.0 * p[0], 2.0 * p[1], 2.0 * p[2]};  // even coordinates: edge midpoints are lattice points
-  Tri2 q;
-  do q = touching_q(rng, p);
-  while (degenerate2(q));
-  if (coin(rng)) {
-    Eigen::Vector2d step = Eigen::Vector2d::Zero();
-    do step = lattice2(rng, 2);
-    while (step.isZero(0.0));
-    q = shifted2(q, step);
-  }
-  return {permuted(on_plane(plane, p), rng), permuted(on_plane(plane, q), rng)};
-}
-
-// Sharing a vertex or an edge, half the time Q moved by 1e-12..1e-2.
-Pair sharing(Rng& rng, int shared) {
-  const Pair base = general_pair(rng);
-  TrianglePoints q = base.q;
-  q[0] = base.p[0];
-  if (shared == 2) q[1] = base.p[1];
-  if (coin(rng)) {
-    const Vec3 direction = random_unit(rng);
-    q = translated(q, direction * log_uniform(rng, -12, -2));
-  }
-  return {permuted(base.p, rng), permuted(q, rng)};
-}
-
-// Q's vertex exactly on P's face or an edge (integer barycentrics), the rest on one side; half the time moved
-// by one unit along an axis. With `collapse`, Q is a point, a segment or a collinear triple containing that
-// vertex.
-Pair vertex_on_face(Rng& rng, bool collapse) {
-  std::array<Vec3, 3> g;
-  do g = {integer_point(rng, -40, 40), integer_point(rng, -40, 40), integer_point(rng, -40, 40)};
-  while (exactly_degenerate(g));
-  long long a, b, c;
-  do {
-    a = integer(rng, 0, 5);
-    b = integer(rng, 0, 5);
-    c = integer(rng, 0, 5);
-  } while (int(a > 0) + int(b > 0) + int(c > 0) < 2);
-  const double m = double(a + b + c);
-  const TrianglePoints p = {m * g[0], m * g[1], m * g[2]};
-  const Vec3 q0 = double(a) * g[0] + double(b) * g[1] + double(c) * g[2];
-  const Vec3 normal = (p[1] - p[0]).cross(p[2] - p[0]);
-  const double side = coin(rng) ? 1.0 : -1.0;
-  const auto off_plane = [&]() -> Vec3 {
-    Vec3 v = Vec3::Zero();
-    do v = integer_point(rng, -30, 30);
-    while (side * normal.dot(v) <= 0.0);
-    return q0 + v;
-  };
-  TrianglePoints q = {q0, off_plane(), off_plane()};
-  if (collapse) {
-    switch (integer(rng, 0, 2)) {
-      case 0:
-        q = {q0, q0, q0};
-        break;
-      case 1:
-        q = {q0, q[1], q[1]};
-        break;
-      default:
-        q = {q[1], q0 + 2.0 * (q[1] - q0), q0};
-    }
-  }
-  if (coin(rng)) {
-    Vec3 step = Vec3::Zero();
-    step[integer(rng, 0, 2)] = coin(rng) ? 1.0 : -1.0;
-    q = translated(q, step);
-  }
-  const double unit = std::ldexp(1.0, int(integer(rng, -30, 30)));
-  return {permuted(scaled(p, unit), rng), permuted(scaled(q, unit), rng)};
-}
-
-// Q's vertex at a barycentric point of P computed in double: on the face up to rounding.
-Pair vertex_near_face(Rng& rng) {
-  const TrianglePoints p = general_pair(rng).p;
-  const double a = uniform(rng, 0, 1), b = uniform(rng, 0, 1 - a);
-  const Vec3 on_face = p[0] + a * (p[1] - p[0]) + b * (p[2] - p[0]);
-  const Vec3 n = (p[1] - p[0]).cross(p[2] - p[0]);
-  const double side = coin(rng) ? 1.0 : -1.0;
-  TrianglePoints q = {on_face, on_face + uniform_point(rng, -0.5, 0.5),
-                      on_face + uniform_point(rng, -0.5, 0.5)};
-  for (int i = 1; i < 3; ++i)
-    if (side * n.dot(q[i] - on_face) < 0) q[i] = on_face - (q[i] - on_face);
-  return {p, permuted(q, rng)};
 }
 
 // Q in P's plane (vertices at barycentrics -0.5..1.2) lifted by `offset(rng)` per vertex along the normal.
@@ -523,61 +353,6 @@ Pair sliver_faces(Rng& rng) {
   return {permuted(pose(p), rng), permuted(pose(q), rng)};
 }
 
-// Degenerate "triangles" on a small integer grid: points, repeated vertices, collinear triples in any order.
-TrianglePoints degenerate_triangle(Rng& rng, long long grid) {
-  const Vec3 a = integer_point(rng, 0, grid);
-  switch (integer(rng, 0, 3)) {
-    case 0:
-      return {a, a, a};
-    case 1:
-      return {a, a, integer_point(rng, 0, grid)};
-    default: {
-      Vec3 d = Vec3::Zero();
-      do d = integer_point(rng, -1, 1);
-      while (d.isZero(0.0));
-      return {a + double(integer(rng, -2, 2)) * d, a + double(integer(rng, -2, 2)) * d,
-              a + double(integer(rng, -2, 2)) * d};
-    }
-  }
-}
-TrianglePoints grid_triangle(Rng& rng, long long grid) {
-  TrianglePoints t;
-  do t = {integer_point(rng, 0, grid), integer_point(rng, 0, grid), integer_point(rng, 0, grid)};
-  while (exactly_degenerate(t));
-  return t;
-}
-
-// P's third vertex the rounded point a + t (b - a): almost, rarely exactly, a segment.
-Pair near_degenerate(Rng& rng) {
-  Pair pair = general_pair(rng);
-  pair.p[2] = pair.p[0] + uniform(rng, -0.5, 1.5) * (pair.p[1] - pair.p[0]);
-  return {permuted(pair.p, rng), pair.q};
-}
-
-// Triangles in axis planes (CAD-like): exact zeros in the normal, many exact contacts.
-TrianglePoints axis_aligned_triangle(Rng& rng) {
-  const int axis = int(integer(rng, 0, 2));
-  const double level = double(integer(rng, 0, 8)) / 2;
-  TrianglePoints t;
-  do {
-    for (Vec3& v : t) {
-      v = uniform(rng, 0, 1) < 0.5 ? integer_point(rng, 0, 4) : uniform_point(rng, 0, 4);
-      v[axis] = level;
-    }
-  } while ((t[1] - t[0]).cross(t[2] - t[0]).isZero(0.0));
-  return t;
-}
-
-Generator rescaled(const Generator& base, const std::function<double(Rng&)>& scale,
-                   const std::function<Vec3(Rng&)>& offset) {
-  return [=](Rng& rng) {
-    const Pair pair = base(rng);
-    const double s = scale(rng);
-    const Vec3 by = offset(rng);
-    return Pair{translated(scaled(pair.p, s), by), translated(scaled(pair.q, s), by)};
-  };
-}
-
 // ---- families ------------------------------------------------------------------------------------------
 
 TEST(TriangleDistanceFamilies, GeneralPosition) {
@@ -589,14 +364,14 @@ TEST(TriangleDistanceFamilies, Coplanar) {
   check_family("coplanar_overlapping", 3, kPairs, [](Rng& rng) {
     const LatticePlane plane = LatticePlane::random(rng);
     const Tri2 p = random_tri2(rng, 20), q = shifted2(random_tri2(rng, 20), lattice2(rng, 30));
-    return Pair{on_plane(plane, p), on_plane(plane, q)};
+    return Pair{plane.map(p), plane.map(q)};
   });
-  check_family("coplanar_touching", 4, kPairs, coplanar_touching);
+  check_family("coplanar_touching", 4, kPairs, [](Rng& rng) { return coplanar_touching(rng, touching_q); });
 }
 
 TEST(TriangleDistanceFamilies, Sharing) {
-  check_family("shared_edge", 5, kPairs, [](Rng& rng) { return sharing(rng, 2); });
-  check_family("shared_vertex", 6, kPairs, [](Rng& rng) { return sharing(rng, 1); });
+  check_family("shared_edge", 5, kPairs, [](Rng& rng) { return sharing(rng, 2, small_offset); });
+  check_family("shared_vertex", 6, kPairs, [](Rng& rng) { return sharing(rng, 1, small_offset); });
 }
 
 TEST(TriangleDistanceFamilies, VertexOnOrNearFace) {
@@ -641,12 +416,8 @@ TEST(TriangleDistanceFamilies, Scales) {
                rescaled(
                    separated_pair, [](Rng&) { return 1e-3; },
                    [](Rng& rng) { return Vec3(Vec3::Constant(1e6) + uniform_point(rng, -1e5, 1e5)); }));
-  check_family("scale_1e-6", 18, kCostlyPairs,
-               rescaled(
-                   separated_pair, [](Rng&) { return 1e-6; }, [](Rng&) { return Vec3(Vec3::Zero()); }));
-  check_family("scale_1e6", 19, kCostlyPairs,
-               rescaled(
-                   separated_pair, [](Rng&) { return 1e6; }, [](Rng&) { return Vec3(Vec3::Zero()); }));
+  check_family("scale_1e-6", 18, kCostlyPairs, rescaled(separated_pair, 1e-6, Vec3::Zero()));
+  check_family("scale_1e6", 19, kCostlyPairs, rescaled(separated_pair, 1e6, Vec3::Zero()));
   // Powers of two 2^-900..2^1000: squares under- or overflow without the local rescaling, and the largest
   // pairs' translation itself could overflow.
   check_family("scale_2^-900..2^1000", 20, kCostlyPairs,
