@@ -6,7 +6,9 @@
 //
 // Each iteration runs every pose of one distance, so `time_per_query` is the mean time per query.
 // Counters: BV tests and triangle-pair distances per query, the mean distance, and, on bvhlab's series, how
-// many poses' distances differ from FCL OBBRSS's by more than 1e-9 relative (`fcl_disagree`).
+// many poses' distances differ from FCL OBBRSS's by more than 1e-9 relative (`fcl_disagree`), and the
+// anytime distance's goal: the share of apart poses (distance > 0) whose interval, with a tenth of the full
+// query's BV tests, is at most a tenth of the distance wide (`anytime_tenth`; -1 when no pose is apart).
 #include "bench/core/bench_flags.hpp"
 #include "engine/mesh_catalog.hpp"
 #include "engine/protocol.hpp"
@@ -20,7 +22,9 @@
 #include <fcl/narrowphase/distance.h>
 #endif
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <deque>
 #include <memory>
@@ -65,6 +69,22 @@ std::size_t disagreements(const std::vector<double>& distances, const std::vecto
   return out;
 }
 
+/// Share of the poses apart where query_distance_anytime, capped at a tenth of the full query's BV tests,
+/// answers an interval at most a tenth of the distance wide; -1 when no pose is apart.
+template <class BV>
+double anytime_tenth_share(const Bvh<BV>& tree, const std::vector<RigidTransform>& poses) {
+  int apart = 0, narrow = 0;
+  for (const auto& pose : poses) {
+    const DistanceResult full = query_distance(tree, tree, pose);
+    if (!(full.distance > 0)) continue;
+    ++apart;
+    const Budget tenth{std::max<std::uint64_t>(1, full.counters.bv_tests / 10), 0};
+    const DistanceResult r = query_distance_anytime(tree, tree, pose, tenth);
+    narrow += r.distance - r.lower_bound <= 0.1 * full.distance;
+  }
+  return apart ? double(narrow) / apart : -1;
+}
+
 template <class BV>
 void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
                      const std::vector<PoseSet>& sets) {
@@ -73,8 +93,10 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
     std::vector<double> distances;
     for (const auto& pose : set.poses) distances.push_back(query_distance(*tree, *tree, pose).distance);
     const double disagree = static_cast<double>(disagreements(distances, set.reference));
+    const double anytime_tenth = anytime_tenth_share(*tree, set.poses);
     const std::string name = "distance/" + mesh_name + "/" + std::string(BV::name()) + "/d:" + set.label;
-    benchmark::RegisterBenchmark(name.c_str(), [tree, &set, disagree](benchmark::State& state) {
+    benchmark::RegisterBenchmark(name.c_str(), [tree, &set, disagree,
+                                                anytime_tenth](benchmark::State& state) {
       Counters pass;
       double sum = 0;
       for (auto _ : state) {
@@ -89,6 +111,7 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
       }
       set_counters(state, set.poses.size(), pass, sum);
       if (!set.reference.empty()) state.counters["fcl_disagree"] = disagree;
+      state.counters["anytime_tenth"] = anytime_tenth;
     })->Unit(benchmark::kMillisecond);
   }
 }
