@@ -71,16 +71,17 @@ std::size_t disagreements(const std::vector<double>& distances, const std::vecto
 
 /// Share of the poses apart where query_distance_anytime, capped at a tenth of the full query's BV tests,
 /// answers an interval at most a tenth of the distance wide; -1 when no pose is apart.
+/// `full` holds each pose's full query.
 template <class BV>
-double anytime_tenth_share(const Bvh<BV>& tree, const std::vector<RigidTransform>& poses) {
+double anytime_tenth_share(const Bvh<BV>& tree, const std::vector<RigidTransform>& poses,
+                           const std::vector<DistanceResult>& full) {
   int apart = 0, narrow = 0;
-  for (const auto& pose : poses) {
-    const DistanceResult full = query_distance(tree, tree, pose);
-    if (!(full.distance > 0)) continue;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    if (!(full[i].distance > 0)) continue;
     ++apart;
-    const Budget tenth{std::max<std::uint64_t>(1, full.counters.bv_tests / 10), 0};
-    const DistanceResult r = query_distance_anytime(tree, tree, pose, tenth);
-    narrow += r.distance - r.lower_bound <= 0.1 * full.distance;
+    const Budget tenth{std::max<std::uint64_t>(1, full[i].counters.bv_tests / 10), 0};
+    const DistanceResult r = query_distance_anytime(tree, tree, poses[i], tenth);
+    narrow += r.distance - r.lower_bound <= 0.1 * full[i].distance;
   }
   return apart ? double(narrow) / apart : -1;
 }
@@ -90,10 +91,14 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
                      const std::vector<PoseSet>& sets) {
   auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
   for (const auto& set : sets) {
+    std::vector<DistanceResult> full;
     std::vector<double> distances;
-    for (const auto& pose : set.poses) distances.push_back(query_distance(*tree, *tree, pose).distance);
+    for (const auto& pose : set.poses) {
+      full.push_back(query_distance(*tree, *tree, pose));
+      distances.push_back(full.back().distance);
+    }
     const double disagree = static_cast<double>(disagreements(distances, set.reference));
-    const double anytime_tenth = anytime_tenth_share(*tree, set.poses);
+    const double anytime_tenth = anytime_tenth_share(*tree, set.poses, full);
     const std::string name = "distance/" + mesh_name + "/" + std::string(BV::name()) + "/d:" + set.label;
     benchmark::RegisterBenchmark(name.c_str(), [tree, &set, disagree,
                                                 anytime_tenth](benchmark::State& state) {
