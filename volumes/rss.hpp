@@ -1,0 +1,480 @@
+// Rectangle swept sphere (RSS): the points within `radius` of a rectangle, the volume PQP and FCL use for
+// proximity queries. Its overlap test and its distance bound are one computation, the distance between the
+// two rectangles, so the bound is the distance between the volumes themselves (less the rounding slack), not
+// the gap on a few projection axes.
+//
+// Storage (40 bytes), as the OBB's: the frame as a float quaternion (columns 0 and 1 of Obb::axes_of span the
+// rectangle, column 2 is its normal), the centre, the two half-lengths and the radius as floats. The fit
+// measures the radius in double, then widens it by what rounding the frame and the centre to float can move
+// the rectangle (2^-21 of its half-diagonal, 2^-24 of |c|) and rounds it up, so the stored volume holds every
+// point; the half-lengths are rounded up, which only grows the rectangle.
+//
+// Fit: a frame from the points' covariance, or the coordinate axes when they give a smaller volume (as the
+// OBB's). The frame axis along which the points are thinnest is the normal and the radius spans their
+// thickness along it. The rectangle need not reach every point: one inside the slab may lie beyond an edge by
+// up to sqrt(r^2 - z^2) (z: its height over the mid-plane), so the sides are drawn in that far, and pushed
+// out again where a point beyond a corner needs it. The radius is then measured, so these choices affect the
+// volume's size only, never whether it holds the points.
+// Merge fits, the same way, the 8 corners of the two rectangles, each a ball of its volume's radius.
+//
+// No oriented_box() (FramedVolume): an RSS is no box, and the ADB estimate in the nodes' frames would take
+// the box around it, corners included, for the node; whether that is worth it is for when the RSS is
+// registered. Until then the ADB grid lies on bounding_box(), as for spheres and DOPs.
+//
+// Overlap and distance: in A's rectangle frame, the minimum over the 8 edges (4 per rectangle) of the edge's
+// distance to the other rectangle. That is the rectangles' distance: where they are apart some nearest pair
+// has a point on an edge (two nearest points interior to both rectangles are joined by a common normal, and
+// sliding both along the then parallel planes reaches an edge); where they meet, an edge of one meets the
+// other (an end of the segment both share on the planes' common line, or, coplanar, a crossing edge or a
+// vertex inside). A zero half-length makes a rectangle a segment or a point: its "edges" then cover it.
+// The squared distance from a point of an edge to the other rectangle is, along the edge, convex and
+// piecewise quadratic: its minimum is the best of a few stationary points, one per cell of the rectangle's
+// plane the edge crosses, each evaluated whole. An ill-conditioned one (an edge nearly parallel to the plane
+// or to a side) errs only where the function is flat, so parallel, coplanar and degenerate rectangles need no
+// special case, and the distance comes out within a few ulps of the coordinates (tests/volumes/test_rss.cpp
+// checks it against CGAL's exact distance).
+#pragma once
+
+#include "concept.hpp"
+#include "obb.hpp"
+#include "storage.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+
+namespace bvhlab {
+
+namespace rss {
+
+/// A closed rectangle: centre, two orthonormal axes and a half-length along each (0 allowed: then a segment
+/// or a point).
+struct Rectangle {
+  Vec3 center = Vec3::Zero();
+  Vec3 axis0 = Vec3::UnitX(), axis1 = Vec3::UnitY();
+  double half0 = 0, half1 = 0;
+};
+
+namespace detail {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+inline double square(double x) {
+  return x * x;
+}
+
+/// Squared distance from x to the interval [-h, h].
+inline double outside_squared(double x, double h) {
+  const double beyond = std::max(0.0, std::abs(x) - h);
+  return beyond * beyond;
+}
+
+/// Squared distance from the segment p + r d (|r| <= h, d unit) to the rectangle K = [-hx, hx] x [-hy, hy]
+/// x {0}, or `best` when it is not smaller. Along the segment it is F(r) = outside(X)^2 + outside(Y)^2 + Z^2:
+/// convex, and on each cell of K's plane (X below, within or above [-hx, hx], the same for Y) a quadratic.
+/// F's minimum is the stationary point of the cell holding it or an end of the segment, so it is among the
+/// cells' stationary points clamped to the segment. F is evaluated whole at each: a cell whose quadratic is
+/// nearly flat (a segment nearly parallel to K's plane or to one of its sides) has an ill-conditioned
+/// stationary point, but only along its flat direction, where F barely changes; a move that crosses into a
+/// neighbouring cell is caught by that cell's own, well-conditioned candidate.
+inline double segment_to_rectangle(const Vec3& p, const Vec3& d, double h, double hx, double hy,
+                                   double best) {
+  const double ex = h * std::abs(d.x()), ey = h * std::abs(d.y()), ez = h * std::abs(d.z());
+  // On each axis, the gap between the segment's extent and K's: their squares' sum is at most F.
+  const double gx = std::max(0.0, std::abs(p.x()) - ex - hx);
+  const double gy = std::max(0.0, std::abs(p.y()) - ey - hy);
+  const double gz = std::max(0.0, std::abs(p.z()) - ez);
+  if (gx * gx + gy * gy + gz * gz >= best) return best;
+  // The cells the segment reaches: on each axis a run of below, within, above. With a tolerance for the
+  // extents' rounding, as a cell too many only adds a candidate, and one too few could lose the minimum.
+  const double tolerance = 8 * kEps * (std::abs(p.x()) + std::abs(p.y()) + ex + ey + hx + hy);
+  const int x_first = p.x() - ex < tolerance - hx ? -1 : std::abs(p.x()) - ex <= hx + tolerance ? 0 : 1;
+  const int x_last = p.x() + ex > hx - tolerance ? 1 : std::abs(p.x()) - ex <= hx + tolerance ? 0 : -1;
+  const int y_first = p.y() - ey < tolerance - hy ? -1 : std::abs(p.y()) - ey <= hy + tolerance ? 0 : 1;
+  const int y_last = p.y() + ey > hy - tolerance ? 1 : std::abs(p.y()) - ey <= hy + tolerance ? 0 : -1;
+  const auto at = [&](double r) {
+    return outside_squared(p.x() + r * d.x(), hx) + outside_squared(p.y() + r * d.y(), hy) +
+           square(p.z() + r * d.z());
+  };
+  for (int sx = x_first; sx <= x_last; ++sx) {
+    // The cell's quadratic a r^2 + 2 b r + c: Z's term, and X's (Y's) where the cell lies beyond K's side.
+    const double ax = sx != 0 ? d.x() * d.x() : 0.0, bx = sx != 0 ? (p.x() - sx * hx) * d.x() : 0.0;
+    for (int sy = y_first; sy <= y_last; ++sy) {
+      const double a = d.z() * d.z() + ax + (sy != 0 ? d.y() * d.y() : 0.0);
+      const double b = p.z() * d.z() + bx + (sy != 0 ? (p.y() - sy * hy) * d.y() : 0.0);
+      // a == 0: F is constant on the cell; if the minimum lies there, the segment either stays in the cell
+      // (any point will do) or leaves it into a cell whose stationary point is the crossing.
+      const double r = a > 0 ? std::min(h, std::max(-h, -b / a)) : 0.0;
+      best = std::min(best, at(r));
+    }
+  }
+  return best;
+}
+
+/// A lower bound on the squared distance from the rectangle c + [-1, 1] u + [-1, 1] v (u, v scaled by the
+/// half-lengths) to K (as above): its bounding box's gaps to K's.
+inline double box_gap_squared(const Vec3& c, const Vec3& u, const Vec3& v, double hx, double hy) {
+  const Vec3 reach = u.cwiseAbs() + v.cwiseAbs();
+  return square(std::max(0.0, std::abs(c.x()) - reach.x() - hx)) +
+         square(std::max(0.0, std::abs(c.y()) - reach.y() - hy)) +
+         square(std::max(0.0, std::abs(c.z()) - reach.z()));
+}
+
+/// The squared distance between A = [-ha0, ha0] x [-ha1, ha1] x {0} and B, centred at t with the first two
+/// columns of m as axes (m: B's frame in A's, orthonormal) and half-lengths hb0, hb1, or `best` when it is
+/// not smaller; stops as soon as the answer is at most `enough`. B's edges are measured against A in A's
+/// frame, A's against B in B's frame.
+inline double squared_distance(const Vec3& t, const Mat3& m, double ha0, double ha1, double hb0, double hb1,
+                               double best, double enough) {
+  // In B's frame A is centred at -m^T t, and its axes are the first two rows of m.
+  const Vec3 t_in_b = -(m.transpose() * t);
+  const Vec3 bu = hb0 * m.col(0), bv = hb1 * m.col(1);
+  const Vec3 au = ha0 * m.row(0).transpose(), av = ha1 * m.row(1).transpose();
+  // Each box's gaps bound the distance from below: most pairs a test rejects stop here.
+  if (std::max(box_gap_squared(t, bu, bv, ha0, ha1), box_gap_squared(t_in_b, au, av, hb0, hb1)) >= best)
+    return best;
+  // The edges: B's (centre, unit direction, half-length) against A in A's frame, then A's against B in B's.
+  struct Edge {
+    Vec3 center, direction;
+    double half;
+  };
+  const Vec3 ua = m.row(0).transpose(), va = m.row(1).transpose();
+  const Edge edges[8] = {{t + bv, m.col(0), hb0}, {t - bv, m.col(0), hb0}, {t + bu, m.col(1), hb1},
+                         {t - bu, m.col(1), hb1}, {t_in_b + av, ua, ha0},  {t_in_b - av, ua, ha0},
+                         {t_in_b + au, va, ha1},  {t_in_b - au, va, ha1}};
+  for (int i = 0; i < 8; ++i) {
+    const Edge& e = edges[i];
+    best = i < 4 ? segment_to_rectangle(e.center, e.direction, e.half, ha0, ha1, best)
+                 : segment_to_rectangle(e.center, e.direction, e.half, hb0, hb1, best);
+    if (best <= enough) return best;
+  }
+  return best;
+}
+
+}  // namespace detail
+
+/// The distance between two closed rectangles, 0 where they meet. Computed in a frame at a's centre, so pairs
+/// far from the origin keep the digits of their offset. For tests and tools: Rss computes the same in place.
+inline double rectangle_distance(const Rectangle& a, const Rectangle& b) {
+  Mat3 to_a;
+  to_a.row(0) = a.axis0.transpose();
+  to_a.row(1) = a.axis1.transpose();
+  to_a.row(2) = a.axis0.cross(a.axis1).transpose();
+  Mat3 m;
+  m.col(0) = to_a * b.axis0;
+  m.col(1) = to_a * b.axis1;
+  m.col(2) = m.col(0).cross(m.col(1));
+  const Vec3 t = to_a * (b.center - a.center);
+  return std::sqrt(detail::squared_distance(t, m, a.half0, a.half1, b.half0, b.half1, detail::kInfinity, 0));
+}
+
+}  // namespace rss
+
+struct Rss {
+  std::array<float, 4> orientation{0, 0, 0, 1};  // quaternion (x, y, z, w), need not be unit
+  Float3 center{0, 0, 0};
+  std::array<float, 2> half{0, 0};  // the rectangle's half-lengths along the frame's first two axes
+  float radius = -1;                // negative: empty
+
+  struct PairContext {
+    PlainMat3 rotation;  // B -> A
+    Double3 translation;
+    double translation_magnitude;  // max |t_i|
+  };
+
+  static constexpr std::string_view name() { return "rss"; }
+
+  static Rss fit(std::span<const Vec3> points) {
+    if (std::any_of(points.begin(), points.end(), [](const Vec3& p) { return !p.allFinite(); }))
+      throw std::invalid_argument("rss::fit: a point has a NaN or infinite coordinate");
+    return fit_balls(points, {});
+  }
+
+  static Rss merge(const Rss& a, const Rss& b) {
+    if (a.empty()) return b;
+    if (b.empty()) return a;
+    std::array<Vec3, 8> corners;
+    a.write_corners(corners.data());
+    b.write_corners(corners.data() + 4);
+    std::array<double, 8> radii;
+    std::fill(radii.begin(), radii.begin() + 4, a.corner_radius());
+    std::fill(radii.begin() + 4, radii.end(), b.corner_radius());
+    return fit_balls(corners, radii);
+  }
+
+  static PairContext make_context(const RigidTransform& pose) {
+    return {PlainMat3::from(pose.rotation), to_double3(pose.translation),
+            pose.translation.cwiseAbs().maxCoeff()};
+  }
+
+  /// True when the rectangles are at most ra + rb (and the rounding slack) apart.
+  [[gnu::flatten]] static bool overlap(const Rss& a, const Rss& b, const PairContext& c) {
+    if (a.empty() || b.empty()) return false;
+    return overlapping(a, b, place(a, b, c));
+  }
+
+  /// DistanceVolume: the rectangles' distance less both radii and overlap()'s slack. overlap() itself is
+  /// tested first, so the bound is 0 wherever it is true: most pairs a proximity query tests near contact
+  /// overlap, and that test skips every edge whose gaps alone rule out a contact.
+  [[gnu::flatten]] static double distance_lower_bound(const Rss& a, const Rss& b, const PairContext& c) {
+    if (a.empty() || b.empty()) return 0;
+    const Placement p = place(a, b, c);
+    if (overlapping(a, b, p)) return 0;
+    const double squared = squared_gap(a, b, p, rss::detail::kInfinity, 0);
+    return std::max(0.0, std::sqrt(squared) - p.reach);
+  }
+
+  [[nodiscard]] bool empty() const { return radius < 0; }
+
+  /// For loaders of raw node bytes: finite, non-negative half-lengths and radius, and a quaternion that is
+  /// close to unit length (fit stores unit ones; axes_of divides by the squared norm).
+  [[nodiscard]] bool valid() const {
+    double norm2 = 0;
+    for (float q : orientation) {
+      if (!std::isfinite(q)) return false;
+      norm2 += double(q) * q;
+    }
+    for (float c : center)
+      if (!std::isfinite(c)) return false;
+    for (float h : half)
+      if (!(std::isfinite(h) && h >= 0)) return false;
+    return std::isfinite(radius) && radius >= 0 && norm2 > 0.5 && norm2 < 2;
+  }
+
+  /// Steiner's formula for a flat convex set swept by a ball: 2 r area + (pi r^2 / 2) perimeter + 4/3 pi r^3.
+  [[nodiscard]] Scalar volume() const {
+    if (empty()) return 0;
+    const double r = radius, a = half[0], b = half[1];
+    return 8 * r * a * b + 2 * std::numbers::pi * r * r * (a + b) + 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  }
+
+  [[nodiscard]] Box bounding_box() const {
+    if (empty()) return {};
+    const Mat3 axes = Obb::axes_of(orientation);
+    const Vec3 reach = axes.col(0).cwiseAbs() * double(half[0]) + axes.col(1).cwiseAbs() * double(half[1]) +
+                       Vec3::Constant(double(radius) + kFrameRounding * magnitude());
+    return {to_vec(center) - reach, to_vec(center) + reach};
+  }
+
+  [[nodiscard]] bool contains(const Vec3& p) const {
+    if (empty()) return false;
+    return distance_to_rectangle(Obb::axes_of(orientation), to_vec(center), half[0], half[1], p) <= radius;
+  }
+
+  /// The rectangle (the frame's first two axes, centre, half-lengths): what the volume sweeps.
+  [[nodiscard]] rss::Rectangle rectangle() const {
+    const Mat3 axes = Obb::axes_of(orientation);
+    return {to_vec(center), axes.col(0), axes.col(1), half[0], half[1]};
+  }
+
+ private:
+  // Frame and centre rounding, as for the OBB (obb.hpp, box_in_frame): the stored frame is within angle
+  // 2^-22 of the fitted one, so it moves a point of the rectangle by at most 2^-21 of the half-diagonal.
+  static constexpr double kFrameRounding = 0x1p-21;
+  static constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+  // B's rectangle in A's frame, and the sum of the radii and the rounding slack.
+  struct Placement {
+    Mat3 m;        // B's frame (columns) in A's
+    Vec3 t;        // B's centre in A's frame
+    double reach;  // ra + rb + slack
+  };
+  // The slack covers the rounding of the placement (absolute, so it grows with the centres' and the
+  // translation's magnitudes, not only with the rectangles') and of the rectangle distance (a few ulps of the
+  // coordinates in A's frame, which those magnitudes bound).
+  [[gnu::always_inline]] static Placement place(const Rss& a, const Rss& b, const PairContext& c) {
+    const Mat3 ra = Obb::axes_of(a.orientation), rb = Obb::axes_of(b.orientation);
+    const auto rotation = c.rotation.map();
+    const Mat3 m = ra.transpose() * (rotation * rb);
+    const Vec3 t = ra.transpose() * (rotation * to_vec(b.center) + to_vec(c.translation) - to_vec(a.center));
+    const double slack = 128 * kEps * (a.magnitude() + b.magnitude() + c.translation_magnitude);
+    return {m, t, double(a.radius) + double(b.radius) + slack};
+  }
+  // Whether the rectangles are at most `reach` apart. Starting just above the limit lets every edge whose
+  // gaps exceed it be skipped.
+  [[gnu::always_inline]] static bool overlapping(const Rss& a, const Rss& b, const Placement& p) {
+    const double limit = p.reach * p.reach;
+    return squared_gap(a, b, p, next_above(limit), limit) <= limit;
+  }
+  [[gnu::always_inline]] static double squared_gap(const Rss& a, const Rss& b, const Placement& p,
+                                                   double best, double enough) {
+    return rss::detail::squared_distance(p.t, p.m, a.half[0], a.half[1], b.half[0], b.half[1], best, enough);
+  }
+
+  // The next double above x (finite, >= 0): std::nextafter without the library call.
+  static double next_above(double x) { return std::bit_cast<double>(std::bit_cast<std::uint64_t>(x) + 1); }
+
+  [[nodiscard]] double magnitude() const {
+    return to_vec(center).cwiseAbs().maxCoeff() + double(half[0]) + double(half[1]) + double(radius);
+  }
+
+  void write_corners(Vec3* out) const {
+    const Mat3 axes = Obb::axes_of(orientation);
+    const Vec3 c = to_vec(center), u = double(half[0]) * axes.col(0), v = double(half[1]) * axes.col(1);
+    out[0] = c - u - v;
+    out[1] = c + u - v;
+    out[2] = c + u + v;
+    out[3] = c - u + v;
+  }
+  // The radius a corner carries into a merge: the volume's own, widened by the float rounding of its frame
+  // and centre (which the GCC 12 folding, see rounded(), may undo when the volume was just stored) and by the
+  // corners' own rounding.
+  [[nodiscard]] double corner_radius() const {
+    const Vec3 c = to_vec(center);
+    return double(radius) + kFrameRounding * std::hypot(double(half[0]), double(half[1])) +
+           0x1p-24 * c.norm() + 16 * kEps * magnitude();
+  }
+
+  // One expression for fit and contains, so a fitted point always tests as contained.
+  static double distance_to_rectangle(const Mat3& axes, const Vec3& center, double h0, double h1,
+                                      const Vec3& p) {
+    const Vec3 local = axes.transpose() * (p - center);
+    return std::sqrt(rss::detail::outside_squared(local.x(), h0) +
+                     rss::detail::outside_squared(local.y(), h1) + local.z() * local.z());
+  }
+
+  // The RSS holding every ball (points[i], radii[i]; no radii: points), in the better of two frames.
+  static Rss fit_balls(std::span<const Vec3> points, std::span<const double> radii) {
+    if (points.empty()) return {};
+    Vec3 mean = Vec3::Zero();
+    for (const Vec3& p : points) mean += p;
+    mean /= double(points.size());
+    Mat3 covariance = Mat3::Zero();
+    for (const Vec3& p : points) covariance += (p - mean) * (p - mean).transpose();
+    Mat3 pca = Mat3::Identity();
+    if (covariance.allFinite()) {
+      const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
+      if (solver.info() == Eigen::Success) pca = solver.eigenvectors();
+    }
+    const Rss by_pca = fit_in_frame(points, radii, mean, pca);
+    const Rss by_axes = fit_in_frame(points, radii, mean, Mat3::Identity());
+    return smaller(by_pca, by_axes) ? by_pca : by_axes;
+  }
+
+  // The RSS in the frame's axes (orthonormal columns), one of which becomes its normal. Coordinates are
+  // taken relative to `origin` (the points' mean), which keeps the digits of a small set far from the origin.
+  static Rss fit_in_frame(std::span<const Vec3> points, std::span<const double> radii, const Vec3& origin,
+                          const Mat3& frame) {
+    const auto radius_of = [&](std::size_t i) { return radii.empty() ? 0.0 : radii[i]; };
+    // The normal: the axis along which the balls are thinnest.
+    Vec3 lo = Vec3::Constant(rss::detail::kInfinity), hi = -lo;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Vec3 s = frame.transpose() * (points[i] - origin);
+      lo = lo.cwiseMin(s - Vec3::Constant(radius_of(i)));
+      hi = hi.cwiseMax(s + Vec3::Constant(radius_of(i)));
+    }
+    int normal = 0;
+    (hi - lo).minCoeff(&normal);
+    Mat3 axes;
+    axes.col(0) = frame.col((normal + 1) % 3);
+    axes.col(1) = frame.col((normal + 2) % 3);
+    axes.col(2) = axes.col(0).cross(axes.col(1));  // right-handed, so it is a rotation
+    const Mat3 to_local = axes.transpose();
+
+    // The slab: the radius spans the balls along the normal.
+    double z_lo = rss::detail::kInfinity, z_hi = -z_lo;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double z = axes.col(2).dot(points[i] - origin);
+      z_lo = std::min(z_lo, z - radius_of(i));
+      z_hi = std::max(z_hi, z + radius_of(i));
+    }
+    const double z_mid = (z_lo + z_hi) / 2, slab = (z_hi - z_lo) / 2;
+    // How far a ball's centre may lie beyond the rectangle, in its plane, for the ball to stay in the volume.
+    const auto allowance = [&](double z, double r) {
+      return std::sqrt(std::max(0.0, rss::detail::square(slab - r) - rss::detail::square(z - z_mid)));
+    };
+
+    // The rectangle: on each axis the smallest interval no centre exceeds by more than its allowance.
+    double side_lo[2], side_hi[2];
+    {
+      double lowest_high[2] = {rss::detail::kInfinity, rss::detail::kInfinity};    // min of x + allowance
+      double highest_low[2] = {-rss::detail::kInfinity, -rss::detail::kInfinity};  // max of x - allowance
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const Vec3 s = to_local * (points[i] - origin);
+        const double a = allowance(s.z(), radius_of(i));
+        for (int k = 0; k < 2; ++k) {
+          lowest_high[k] = std::min(lowest_high[k], s[k] + a);
+          highest_low[k] = std::max(highest_low[k], s[k] - a);
+        }
+      }
+      for (int k = 0; k < 2; ++k) {
+        if (lowest_high[k] <= highest_low[k]) {
+          side_lo[k] = lowest_high[k];
+          side_hi[k] = highest_low[k];
+        } else {  // any point between will do: no extent
+          side_lo[k] = side_hi[k] = (lowest_high[k] + highest_low[k]) / 2;
+        }
+      }
+    }
+    // A centre beyond a corner needs its distance to the corner, not only each axis's, within its allowance:
+    // push out the side whose move adds less volume.
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Vec3 s = to_local * (points[i] - origin);
+      const double a = allowance(s.z(), radius_of(i));
+      const double dx = std::max({0.0, side_lo[0] - s.x(), s.x() - side_hi[0]});
+      const double dy = std::max({0.0, side_lo[1] - s.y(), s.y() - side_hi[1]});
+      if (dx == 0 || dy == 0 || dx * dx + dy * dy <= a * a) continue;
+      const double keep_x = std::sqrt(std::max(0.0, a * a - dy * dy));  // what x may exceed by, y unchanged
+      const double keep_y = std::sqrt(std::max(0.0, a * a - dx * dx));
+      // Volume added per unit of a side's move: slab height times the other side, and the rounded edge.
+      const double cost_x =
+          (dx - keep_x) * (4 * slab * (side_hi[1] - side_lo[1]) + std::numbers::pi * slab * slab);
+      const double cost_y =
+          (dy - keep_y) * (4 * slab * (side_hi[0] - side_lo[0]) + std::numbers::pi * slab * slab);
+      const int k = cost_x <= cost_y ? 0 : 1;
+      const double keep = k == 0 ? keep_x : keep_y;
+      if (s[k] < side_lo[k])
+        side_lo[k] = s[k] + keep;
+      else
+        side_hi[k] = s[k] - keep;
+    }
+
+    // The radius, measured as contains() measures it.
+    const Vec3 center =
+        origin + axes * Vec3((side_lo[0] + side_hi[0]) / 2, (side_lo[1] + side_hi[1]) / 2, z_mid);
+    const double h0 = (side_hi[0] - side_lo[0]) / 2, h1 = (side_hi[1] - side_lo[1]) / 2;
+    double reach = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      reach = std::max(reach, distance_to_rectangle(axes, center, h0, h1, points[i]) + radius_of(i));
+    return rounded(axes, center, h0, h1, reach);
+  }
+
+  // The stored volume for the exact one (frame `axes`, a rotation; every point within `reach` of the
+  // rectangle). A point's nearest point on the rectangle, c + axes (x, y, 0), has its twin c' + axes' (x, y,
+  // 0) on the stored rectangle (the half-lengths are rounded up), at most 2^-24 |c| + 2^-21 |(h0, h1)| away;
+  // the radius grows by that and by a few ulps for contains()'s arithmetic. Bounding the rounding instead of
+  // re-measuring against the stored floats also keeps this correct under GCC 12's -O2 SLP vectoriser, which
+  // folds double(float(x)) back to x.
+  static Rss rounded(const Mat3& axes, const Vec3& center, double h0, double h1, double reach) {
+    Rss out;
+    Eigen::Quaterniond q(axes);
+    q.normalize();
+    out.orientation = {float(q.x()), float(q.y()), float(q.z()), float(q.w())};
+    out.center = {float(center.x()), float(center.y()), float(center.z())};
+    out.half = {float_up(h0), float_up(h1)};
+    const double moved = kFrameRounding * std::hypot(double(out.half[0]), double(out.half[1])) +
+                         0x1p-24 * center.norm() + 32 * kEps * (h0 + h1 + reach) + 1e-44;
+    out.radius = float_up((reach + moved) * (1 + 8 * kEps));
+    return out;
+  }
+
+  // Smaller volume wins; for (nearly) flat volumes, the smaller rectangle, then the smaller sizes.
+  static bool smaller(const Rss& a, const Rss& b) {
+    const double va = a.volume(), vb = b.volume();
+    if (std::abs(va - vb) > 1e-9 * std::max(va, vb)) return va < vb;
+    const double aa = double(a.half[0]) * a.half[1], ab = double(b.half[0]) * b.half[1];
+    if (std::abs(aa - ab) > 1e-9 * std::max(aa, ab)) return aa < ab;
+    return double(a.half[0]) + a.half[1] + a.radius <= double(b.half[0]) + b.half[1] + b.radius;
+  }
+};
+
+static_assert(BoundingVolume<Rss> && DistanceVolume<Rss>);
+
+}  // namespace bvhlab
