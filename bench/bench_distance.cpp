@@ -3,17 +3,20 @@
 // come from one run. Only volumes with a distance bound (DistanceVolume) run; the others are skipped by name.
 //
 //   bench_distance [--meshes=a.stl,b.obj] [--steps=100] [--volumes=aabb,obb] [benchmark flags]
+//   (--volumes also takes rss, the rectangle swept sphere, which is not in the registry yet)
 //
 // Each iteration runs every pose of one distance, so `time_per_query` is the mean time per query.
 // Counters: BV tests and triangle-pair distances per query, the mean distance, and, on bvhlab's series, how
 // many poses' distances differ from FCL OBBRSS's by more than 1e-9 relative (`fcl_disagree`), and the
 // anytime distance's goal: the share of apart poses (distance > 0) whose interval, with a tenth of the full
 // query's BV tests, is at most a tenth of the distance wide (`anytime_tenth`; -1 when no pose is apart).
+// Each bvhlab series has a `/coherent` twin: the poses in order through query_distance_coherent.
 #include "bench/core/bench_flags.hpp"
 #include "engine/mesh_catalog.hpp"
 #include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/distance.hpp"
+#include "volumes/rss.hpp"
 
 #include <benchmark/benchmark.h>
 #ifdef BVHLAB_HAVE_FCL
@@ -86,6 +89,33 @@ double anytime_tenth_share(const Bvh<BV>& tree, const std::vector<RigidTransform
   return apart ? double(narrow) / apart : -1;
 }
 
+/// The same poses in order through query_distance_coherent, a fresh state each pass (its first pose is
+/// cold); `coherent_disagree` counts poses whose distance is not the cold query's (it must be 0).
+template <class BV>
+void register_coherent(const std::string& name, const std::shared_ptr<const Bvh<BV>>& tree,
+                       const PoseSet& set, const std::vector<double>& cold) {
+  benchmark::RegisterBenchmark(name.c_str(), [tree, &set, cold](benchmark::State& state) {
+    Counters pass;
+    double sum = 0;
+    std::size_t disagree = 0;
+    for (auto _ : state) {
+      pass = {};
+      sum = 0;
+      disagree = 0;
+      CoherentState coherent;
+      for (std::size_t i = 0; i < set.poses.size(); ++i) {
+        const DistanceResult r = query_distance_coherent(*tree, *tree, set.poses[i], coherent);
+        pass += r.counters;
+        sum += r.distance;
+        disagree += r.distance != cold[i];
+      }
+      benchmark::DoNotOptimize(sum);
+    }
+    set_counters(state, set.poses.size(), pass, sum);
+    state.counters["coherent_disagree"] = static_cast<double>(disagree);
+  })->Unit(benchmark::kMillisecond);
+}
+
 template <class BV>
 void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
                      const std::vector<PoseSet>& sets) {
@@ -118,6 +148,7 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
       if (!set.reference.empty()) state.counters["fcl_disagree"] = disagree;
       state.counters["anytime_tenth"] = anytime_tenth;
     })->Unit(benchmark::kMillisecond);
+    register_coherent(name + "/coherent", tree, set, distances);
   }
 }
 
@@ -183,13 +214,19 @@ int main(int argc, char** argv) {
     for (auto& set : sets)
       for (const auto& pose : set.poses) set.reference.push_back(fcl_distance(*reference, pose));
 #endif
-    for (const auto& v : volumes)
+    for (const auto& v : volumes) {
+      // The RSS is not registered yet (volumes/shipped.hpp): selected here by name.
+      if (v == Rss::name()) {
+        register_bvhlab<Rss>(label, mesh, sets);
+        continue;
+      }
       with_volume(v, [&]<class BV>(std::type_identity<BV>) {
         if constexpr (DistanceVolume<BV>)
           register_bvhlab<BV>(label, mesh, sets);
         else
           std::fprintf(stderr, "bench_distance: skipping %s (no distance bound)\n", v.c_str());
       });
+    }
 #ifdef BVHLAB_HAVE_FCL
     register_fcl<fcl::RSSd>(label, "fcl_rss", mesh, sets);
     register_fcl<fcl::OBBRSSd>(label, "fcl_obbrss", mesh, sets);

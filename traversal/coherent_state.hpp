@@ -104,8 +104,9 @@ class CoherentState {
   /// The node pair that decided the last answer, if one did: the exact queries' colliding leaf pair, the
   /// ADB queries' deciding pair (traversal/coherent_adb.hpp).
   std::optional<std::pair<std::uint32_t, std::uint32_t>> witness;
-  /// What filled the state: an exact, ADB or guided exact query (their node pairs mean different things).
-  enum class Use : std::uint8_t { None, Exact, Adb, Guided };
+  /// What filled the state: an exact, ADB, guided exact, distance or tolerance query (their node pairs mean
+  /// different things).
+  enum class Use : std::uint8_t { None, Exact, Adb, Guided, Distance, Tolerance };
   /// Starts the state afresh (reset) when it was filled by another kind of query.
   void serve(Use use) {
     if (use_ == use) return;

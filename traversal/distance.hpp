@@ -9,11 +9,16 @@
 //               smallest bound left on the queue a lower one: the exact distance lies between them.
 //   tolerance   ToleranceHooks, depth first: a pair is kept while its bound is at most eps, and the first
 //               triangle pair within eps decides. eps = 0 is the exact intersection query itself.
+// Each runs coherent too (a CoherentState per pair of trees, as traversal/coherent.hpp): the leaf pair that
+// held the nearest triangles (or the pair within eps) is tried first at the next pose. Its distance seeds the
+// best found, which prunes every pair whose bound is no nearer; the answer is still proven from the root.
 // The volumes need a distance bound (the DistanceVolume refinement, volumes/concept.hpp); a tree of volumes
 // without one does not compile here, and the run-time layer refuses it by name.
 #pragma once
 
 #include "../bvh/triangle_distance.hpp"
+#include "coherent.hpp"
+#include "coherent_state.hpp"
 #include "driver.hpp"
 #include "exact.hpp"
 
@@ -29,6 +34,7 @@ struct NearestPair {
   double distance = std::numeric_limits<double>::infinity();
   Vec3 on_a = Vec3::Zero(), on_b = Vec3::Zero();
   TrianglePair triangles;
+  std::pair<std::uint32_t, std::uint32_t> leaves{};  ///< the leaf pair (node indices) that holds them
 };
 
 namespace distance_detail {
@@ -48,7 +54,8 @@ bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t 
       ++trees.counters.triangle_tests;
       const TriangleDistance d = triangle_distance(tri_a[ta], moved);
       if (d.distance >= nearest.distance) continue;
-      nearest = {d.distance, d.on_p, d.on_q, {trees.a.triangle_ids()[ta], trees.b.triangle_ids()[tb]}};
+      nearest = {
+          d.distance, d.on_p, d.on_q, {trees.a.triangle_ids()[ta], trees.b.triangle_ids()[tb]}, {i, j}};
       if (d.distance == 0) return true;
     }
   }
@@ -123,16 +130,30 @@ void check_query(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_
   TriangleLeaves::require(a, b, who);
 }
 
-/// The distance traversal under `limit` (Unlimited or BudgetLimit).
+/// Refuses a deadline that is negative, NaN or infinite (an unlimited budget is the caller's to judge).
+inline void check_anytime_budget(const Budget& budget) {
+  if (!(budget.deadline_us >= 0) || std::isinf(budget.deadline_us))
+    throw std::invalid_argument(
+        "anytime distance: the deadline must be a finite number of microseconds >= 0");
+}
+
+/// The distance traversal under `limit` (Unlimited or BudgetLimit). With `seed` (a coherent query's
+/// remembered leaf pair), that pair's triangles are measured first; `seed` then names the nearest leaf pair.
 template <DistanceVolume BV, class Limit>
-DistanceResult run(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, Limit& limit) {
+DistanceResult run(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, Limit& limit,
+                   std::optional<std::pair<std::uint32_t, std::uint32_t>>* seed = nullptr) {
   DistanceResult result;
-  if (a.empty() || b.empty()) return result;  // no pair at all: infinitely far, and exactly so
+  if (a.empty() || b.empty()) {  // no pair at all: infinitely far, and exactly so
+    result.lower_bound = result.distance;
+    return result;
+  }
   const auto context = VolumeWalker<BV>::make_context(b_to_a);
   const TreePair<BV> trees(a, b, b_to_a, context, result.counters);
   NearestPair nearest;
+  if (seed && *seed) nearer_triangles(trees, (*seed)->first, (*seed)->second, nearest);
   DistanceHooks<BV> hooks(trees, nearest);
   traverse<BestFirst, SplitLarger>(trees, hooks, limit);
+  if (seed) *seed = std::isfinite(nearest.distance) ? std::optional(nearest.leaves) : std::nullopt;
   result.distance = nearest.distance;
   result.on_a = nearest.on_a;
   result.on_b = nearest.on_b;
@@ -163,9 +184,7 @@ DistanceResult query_distance(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTra
 template <DistanceVolume BV>
 DistanceResult query_distance_anytime(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
                                       const Budget& budget) {
-  if (!(budget.deadline_us >= 0) || std::isinf(budget.deadline_us))
-    throw std::invalid_argument(
-        "anytime distance: the deadline must be a finite number of microseconds >= 0");
+  distance_detail::check_anytime_budget(budget);
   if (budget.unlimited())
     throw std::invalid_argument(
         "anytime distance: the budget is 0 (no BV-test cap and no deadline); give one, or ask for the full "
@@ -173,6 +192,49 @@ DistanceResult query_distance_anytime(const Bvh<BV>& a, const Bvh<BV>& b, const 
   distance_detail::check_query(a, b, b_to_a, "anytime distance query");
   BudgetLimit limit(budget);
   return distance_detail::run(a, b, b_to_a, limit);
+}
+
+namespace distance_detail {
+
+/// The distance traversal of a coherent query: `state` bound to these trees and held for the query, its
+/// remembered leaf pair measured first and replaced by this query's nearest.
+template <DistanceVolume BV, class Limit>
+DistanceResult run_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, Limit& limit,
+                            CoherentState& state) {
+  const CoherentState::InUse in_use(state);
+  coherent_detail::attach(state, a, b);
+  state.serve(CoherentState::Use::Distance);
+  return run(a, b, b_to_a, limit, &state.witness);
+}
+
+}  // namespace distance_detail
+
+/// query_distance starting from `state` (traversal/coherent_state.hpp), the memory of the previous queries
+/// on the same two trees: the leaf pair nearest last time is measured first. Same answer as query_distance
+/// (the distance is proven from the root); the counters say what this query did. Throws as query_distance,
+/// std::invalid_argument for a state made for other trees, std::logic_error for one another query is using.
+template <DistanceVolume BV>
+DistanceResult query_distance_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
+                                       CoherentState& state) {
+  distance_detail::check_query(a, b, b_to_a, "coherent distance query");
+  Unlimited limit;
+  return distance_detail::run_coherent(a, b, b_to_a, limit, state);
+}
+
+/// query_distance_anytime starting from `state`, as query_distance_coherent: the remembered pair's distance
+/// is an upper bound before the first BV test.
+template <DistanceVolume BV>
+DistanceResult query_distance_anytime_coherent(const Bvh<BV>& a, const Bvh<BV>& b,
+                                               const RigidTransform& b_to_a, const Budget& budget,
+                                               CoherentState& state) {
+  distance_detail::check_anytime_budget(budget);
+  if (budget.unlimited())
+    throw std::invalid_argument(
+        "anytime distance: the budget is 0 (no BV-test cap and no deadline); give one, or ask for the full "
+        "distance query");
+  distance_detail::check_query(a, b, b_to_a, "coherent anytime distance query");
+  BudgetLimit limit(budget);
+  return distance_detail::run_coherent(a, b, b_to_a, limit, state);
 }
 
 /// The tolerance strategy's hooks: a pair is kept while its volumes may hold points within eps; the first
@@ -190,24 +252,68 @@ class ToleranceHooks {
     return BV::distance_lower_bound(trees_.a.volume(p.a), trees_.b.volume(p.b), trees_.context) <= tolerance_;
   }
   static Admission admit(Pair&, bool near) { return near ? Admission::Queue : Admission::Drop; }
-  [[gnu::always_inline]] Step leaf_pair(const Pair& p) {
+  [[gnu::always_inline]] Step leaf_pair(const Pair& p) { return within(p.a, p.b); }
+  /// Decides when a triangle pair of leaf pair (i, j) lies within the tolerance.
+  Step within(std::uint32_t i, std::uint32_t j) {
     NearestPair nearest;
     nearest.distance = std::nextafter(tolerance_, std::numeric_limits<double>::infinity());
-    distance_detail::nearer_triangles(trees_, p.a, p.b, nearest);
+    distance_detail::nearer_triangles(trees_, i, j, nearest);
     if (!(nearest.distance <= tolerance_)) return Step::Continue;
     result_.collides = true;
     result_.probability = 1;
     result_.witness = nearest.triangles;
+    deciding_ = nearest.leaves;
     return Step::Decided;
   }
   template <class Queue>
   static void finish(const Queue&, Ended) {}
+  /// The leaf pair that decided "within", if one did.
+  [[nodiscard]] const std::optional<std::pair<std::uint32_t, std::uint32_t>>& deciding() const {
+    return deciding_;
+  }
 
  private:
   const TreePair<BV>& trees_;
   double tolerance_;
   Result& result_;
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> deciding_;
 };
+
+namespace distance_detail {
+
+/// query_within, coherent when `state` is given.
+template <DistanceVolume BV>
+Result within(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, double tolerance,
+              CoherentState* state) {
+  if (!(tolerance >= 0) || std::isinf(tolerance))
+    throw std::invalid_argument("tolerance query: the tolerance must be finite and >= 0, not " +
+                                std::to_string(tolerance));
+  if (tolerance == 0) return state ? query_exact_coherent(a, b, b_to_a, *state) : query_exact(a, b, b_to_a);
+  check_query(a, b, b_to_a, "tolerance query");
+  std::optional<CoherentState::InUse> in_use;
+  if (state) {
+    in_use.emplace(*state);
+    coherent_detail::attach(*state, a, b);
+    state->serve(CoherentState::Use::Tolerance);
+  }
+  Result result;
+  result.exact = true;
+  if (a.empty() || b.empty()) return result;
+  const auto context = VolumeWalker<BV>::make_context(b_to_a);
+  const TreePair<BV> trees(a, b, b_to_a, context, result.counters);
+  ToleranceHooks<BV> hooks(trees, tolerance, result);
+  if (state && state->witness &&
+      hooks.within(state->witness->first, state->witness->second) == Step::Decided) {
+    state->count_witness_hit();
+    return result;
+  }
+  Unlimited limit;
+  traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
+  if (state) state->witness = hooks.deciding();
+  return result;
+}
+
+}  // namespace distance_detail
 
 /// Are the two trees' triangles within `tolerance` of each other (distance <= tolerance)? `collides` says
 /// so, and `witness` names a triangle pair within it. With tolerance 0 this is query_exact. Throws
@@ -215,20 +321,16 @@ class ToleranceHooks {
 /// tree without triangles.
 template <DistanceVolume BV>
 Result query_within(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, double tolerance) {
-  if (!(tolerance >= 0) || std::isinf(tolerance))
-    throw std::invalid_argument("tolerance query: the tolerance must be finite and >= 0, not " +
-                                std::to_string(tolerance));
-  if (tolerance == 0) return query_exact(a, b, b_to_a);
-  distance_detail::check_query(a, b, b_to_a, "tolerance query");
-  Result result;
-  result.exact = true;
-  if (a.empty() || b.empty()) return result;
-  const auto context = VolumeWalker<BV>::make_context(b_to_a);
-  const TreePair<BV> trees(a, b, b_to_a, context, result.counters);
-  ToleranceHooks<BV> hooks(trees, tolerance, result);
-  Unlimited limit;
-  traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
-  return result;
+  return distance_detail::within(a, b, b_to_a, tolerance, nullptr);
+}
+
+/// query_within starting from `state`, as query_distance_coherent: the leaf pair that was within the
+/// tolerance last time is tried first (with tolerance 0: query_exact_coherent). Same answers. Throws as
+/// query_within, and as query_distance_coherent for the state.
+template <DistanceVolume BV>
+Result query_within_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
+                             double tolerance, CoherentState& state) {
+  return distance_detail::within(a, b, b_to_a, tolerance, &state);
 }
 
 }  // namespace bvhlab

@@ -157,6 +157,54 @@ TYPED_TEST(DistanceQuery, KeepsItsPrecisionFarFromTheOrigin) {
   }
 }
 
+/// A sequence of poses, each a small step from the last: where a coherent query has something to reuse.
+std::vector<RigidTransform> small_steps() {
+  std::vector<RigidTransform> out;
+  for (int k = 0; k < 30; ++k)
+    out.push_back(RigidTransform{Eigen::AngleAxisd(0.02 * k, Vec3(0, 0, 1)).toRotationMatrix(),
+                                 Vec3(1.6 - 0.04 * k, 0.1, 0)});
+  return out;
+}
+
+TYPED_TEST(DistanceQuery, CoherentQueriesAnswerAsColdOnesWithLessWork) {
+  CoherentState distance_state, anytime_state, within_state;
+  std::uint64_t cold_bv = 0, coherent_bv = 0;
+  int touching = 0;
+  for (const RigidTransform& pose : small_steps()) {
+    const DistanceResult cold = query_distance(this->tree_a, this->tree_b, pose);
+    const DistanceResult warm = query_distance_coherent(this->tree_a, this->tree_b, pose, distance_state);
+    ASSERT_EQ(warm.distance, cold.distance);
+    ASSERT_EQ(warm.lower_bound, cold.lower_bound);
+    ASSERT_TRUE(warm.exact);
+    EXPECT_NEAR((warm.on_a - warm.on_b).norm(), warm.distance, 1e-12);
+    cold_bv += cold.counters.bv_tests;
+    coherent_bv += warm.counters.bv_tests;
+    touching += cold.distance == 0;
+    // The anytime interval still holds the distance when the remembered pair seeds it.
+    const DistanceResult stopped =
+        query_distance_anytime_coherent(this->tree_a, this->tree_b, pose, Budget{10, 0}, anytime_state);
+    ASSERT_LE(stopped.lower_bound, cold.distance);
+    ASSERT_GE(stopped.distance, cold.distance);
+    for (double eps : {0.0, cold.distance * 0.9, cold.distance * 1.1}) {
+      const Result within = query_within_coherent(this->tree_a, this->tree_b, pose, eps, within_state);
+      ASSERT_EQ(within.collides, cold.distance <= eps) << "eps " << eps;
+    }
+  }
+  EXPECT_GT(touching, 0);  // the steps cross into contact
+  EXPECT_LT(coherent_bv, cold_bv);
+}
+
+TEST(DistanceQueryInput, ACoherentStateServesOnePairOfTrees) {
+  const Mesh m = testing::make_torus(0.7, 0.25, 12, 6);
+  const auto tree = Bvh<Aabb>::build(m);
+  const auto other = Bvh<Aabb>::build(m);
+  const RigidTransform pose = translated(RigidTransform{}, Vec3(3, 0, 0));
+  CoherentState state;
+  (void)query_distance_coherent(tree, tree, pose, state);
+  EXPECT_THROW(query_distance_coherent(tree, other, pose, state), std::invalid_argument);
+  EXPECT_THROW(query_within_coherent(other, tree, pose, 0.5, state), std::invalid_argument);
+}
+
 TEST(DistanceQueryInput, RefusesNonsenseBeforeWork) {
   const Mesh m = testing::make_torus(0.7, 0.25, 12, 6);
   const auto tree = Bvh<Aabb>::build(m);
