@@ -30,6 +30,9 @@ StrategyInfo strategy_row() {
   with_each_density([&]<class D>(std::type_identity<D>) {
     if constexpr (S::template accepts<D>) info.densities.emplace_back(D::name());
   });
+  with_each_volume([&]<class BV>(std::type_identity<BV>) {
+    if constexpr (kAcceptsVolume<S, BV>) info.volumes.emplace_back(BV::name());
+  });
   const auto specs = S::parameters();
   info.parameters.assign(specs.begin(), specs.end());
   return info;
@@ -80,6 +83,12 @@ std::string StrategyInfo::refusal(std::string_view density) const {
   if (accepts(density)) return {};
   return "strategy " + name + " does not run on trees with density '" + std::string(density) +
          "' (it runs on: " + joined_names(densities) + ")";
+}
+
+std::string StrategyInfo::volume_refusal(std::string_view bv) const {
+  if (std::find(volumes.begin(), volumes.end(), bv) != volumes.end()) return {};
+  return "strategy " + name + " does not run on trees of volume '" + std::string(bv) +
+         "', which has no distance bound (it runs on: " + joined_names(volumes) + ")";
 }
 
 std::string StrategyInfo::coherent_refusal() const {
@@ -155,6 +164,7 @@ nlohmann::json policies_json() {
                           {"needs_density", s.needs_density},
                           {"coherent", s.coherent},
                           {"densities", s.densities},
+                          {"volumes", s.volumes},
                           {"parameters", parameters_json(s.parameters)}});
   return {{"densities", densities}, {"strategies", strategies}};
 }

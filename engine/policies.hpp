@@ -29,11 +29,15 @@ struct StrategyInfo {
   bool needs_density = false;          ///< does not run on trees without a density
   bool coherent = false;               ///< runs coherent over a sequence of poses (traversal/coherent.hpp)
   std::vector<std::string> densities;  ///< the registered densities it runs on
+  std::vector<std::string> volumes;    ///< the registered volumes it runs on
   std::vector<ParamSpec> parameters;
   [[nodiscard]] bool accepts(std::string_view density) const;
   /// Empty when it runs on `density`; else the one message every caller gives: "strategy adb does not run
   /// on trees with density 'none' (it runs on: adb, adb_paper, adb_normal)".
   [[nodiscard]] std::string refusal(std::string_view density) const;
+  /// Empty when it runs on trees of volume `bv`; else the one message every caller gives: "strategy distance
+  /// does not run on trees of volume 'rbox', which has no distance bound (it runs on: aabb, ...)".
+  [[nodiscard]] std::string volume_refusal(std::string_view bv) const;
   [[nodiscard]] const ParamSpec* parameter(std::string_view name) const;
   /// Empty when it runs coherent; else the one message every caller gives: "strategy adb does not run
   /// coherent (the strategies that do: exact, all_contacts)".

@@ -41,7 +41,8 @@ using RegisteredVolumes = ShippedVolumes;
 using RegisteredDensities = TypeList<NoDensity, AdbDensity, AdbPaperDensity, AdbNormalDensity>;
 using RegisteredStrategies =
     TypeList<ExactStrategy, AllContactsStrategy, GuidedExactStrategy, AdbStrategy, TimeCriticalStrategy,
-             GuidedExactDfsStrategy, AdbDfsStrategy, AdbLargerStrategy>;
+             GuidedExactDfsStrategy, AdbDfsStrategy, AdbLargerStrategy, DistanceStrategy, ToleranceStrategy,
+             AnytimeDistanceStrategy>;
 #else
 /// The test variant adds one density and one strategy next to a few shipped ones: enough to show that a new
 /// policy needs nothing but its header and its line, while each left-out policy saves its instantiations

@@ -177,7 +177,9 @@ struct TypedBase : TreeModel {
     auto a = std::static_pointer_cast<const TypedBase>(std::move(self));
     std::unique_ptr<PreparedQuery> out;
     with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
-      if constexpr (S::template accepts<D>)
+      if constexpr (!kAcceptsVolume<S, BV>)
+        throw std::invalid_argument(strategy_info(variant.strategy).volume_refusal(BV::name()));
+      else if constexpr (S::template accepts<D>)
         out = prepare_typed<S>(std::move(a), std::move(other), variant);
       else
         throw std::invalid_argument(strategy_info(variant.strategy).refusal(D::name()));

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <span>
 
 namespace bvhlab::python {
@@ -84,6 +85,28 @@ struct QueryResult {
     }
     return out;
   }
+  /// The distance strategies' fields; None for the others.
+  py::object distance() const {
+    if (!result.proximity) return py::none();
+    return py::float_(result.proximity->distance);
+  }
+  py::object lower_bound() const {
+    if (!result.proximity) return py::none();
+    return py::float_(result.proximity->lower_bound);
+  }
+  py::object points() const {
+    if (!result.proximity || !result.proximity->triangles) return py::none();
+    py::array_t<double> out({py::ssize_t{2}, py::ssize_t{3}});
+    for (int k = 0; k < 3; ++k) {
+      out.mutable_at(0, k) = result.proximity->on_a[k];
+      out.mutable_at(1, k) = result.proximity->on_b[k];
+    }
+    return out;
+  }
+  py::object nearest() const {
+    if (!result.proximity || !result.proximity->triangles) return py::none();
+    return py::make_tuple(result.proximity->triangles->a, result.proximity->triangles->b);
+  }
   py::dict counters() const {
     const Counters& c = result.counters;
     return py::dict(py::arg("bv_tests") = c.bv_tests, py::arg("triangle_tests") = c.triangle_tests,
@@ -118,19 +141,27 @@ struct BatchColumns {
         bv_tests(k),
         triangle_tests(k),
         nodes_visited(k),
-        probability_evaluations(k) {}
+        probability_evaluations(k),
+        distance(k),
+        lower_bound(k),
+        points({k, py::ssize_t{2}, py::ssize_t{3}}),
+        nearest_a(k),
+        nearest_b(k) {}
   py::array_t<bool> collides, exact, budget_exhausted;
   py::array_t<double> probability;
   py::array_t<std::int64_t> witness_a, witness_b, contacts, bv_tests, triangle_tests, nodes_visited,
       probability_evaluations;
+  py::array_t<double> distance, lower_bound, points;  ///< NaN for the strategies that measure no distance
+  py::array_t<std::int64_t> nearest_a, nearest_b;
 
   /// Writes result `i` (called without the GIL: raw pointers into arrays this object keeps alive).
   ResultSink sink() {
     return [c = collides.mutable_data(), e = exact.mutable_data(), x = budget_exhausted.mutable_data(),
             p = probability.mutable_data(), wa = witness_a.mutable_data(), wb = witness_b.mutable_data(),
             n = contacts.mutable_data(), bv = bv_tests.mutable_data(), tri = triangle_tests.mutable_data(),
-            nodes = nodes_visited.mutable_data(),
-            est = probability_evaluations.mutable_data()](std::size_t i, const Result& r) {
+            nodes = nodes_visited.mutable_data(), est = probability_evaluations.mutable_data(),
+            d = distance.mutable_data(), lo = lower_bound.mutable_data(), pts = points.mutable_data(),
+            na = nearest_a.mutable_data(), nb = nearest_b.mutable_data()](std::size_t i, const Result& r) {
       c[i] = r.collides;
       e[i] = r.exact;
       x[i] = r.budget_exhausted;
@@ -142,15 +173,32 @@ struct BatchColumns {
       tri[i] = static_cast<std::int64_t>(r.counters.triangle_tests);
       nodes[i] = static_cast<std::int64_t>(r.counters.nodes_visited);
       est[i] = static_cast<std::int64_t>(r.counters.probability_evaluations);
+      write_proximity(r, i, d, lo, pts, na, nb);
     };
   }
+  static void write_proximity(const Result& r, std::size_t i, double* d, double* lo, double* pts,
+                              std::int64_t* na, std::int64_t* nb) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const Proximity* p = r.proximity ? &*r.proximity : nullptr;
+    const bool pair = p && p->triangles;
+    d[i] = p ? p->distance : nan;
+    lo[i] = p ? p->lower_bound : nan;
+    for (int k = 0; k < 3; ++k) {
+      pts[6 * i + k] = pair ? p->on_a[k] : nan;
+      pts[6 * i + 3 + k] = pair ? p->on_b[k] : nan;
+    }
+    na[i] = pair ? std::int64_t{p->triangles->a} : -1;
+    nb[i] = pair ? std::int64_t{p->triangles->b} : -1;
+  }
   py::dict dict() const {
-    return py::dict(py::arg("collides") = collides, py::arg("probability") = probability,
-                    py::arg("exact") = exact, py::arg("budget_exhausted") = budget_exhausted,
-                    py::arg("witness_a") = witness_a, py::arg("witness_b") = witness_b,
-                    py::arg("contact_count") = contacts, py::arg("bv_tests") = bv_tests,
-                    py::arg("triangle_tests") = triangle_tests, py::arg("nodes_visited") = nodes_visited,
-                    py::arg("probability_evaluations") = probability_evaluations);
+    return py::dict(
+        py::arg("collides") = collides, py::arg("probability") = probability, py::arg("exact") = exact,
+        py::arg("budget_exhausted") = budget_exhausted, py::arg("witness_a") = witness_a,
+        py::arg("witness_b") = witness_b, py::arg("contact_count") = contacts, py::arg("bv_tests") = bv_tests,
+        py::arg("triangle_tests") = triangle_tests, py::arg("nodes_visited") = nodes_visited,
+        py::arg("probability_evaluations") = probability_evaluations, py::arg("distance") = distance,
+        py::arg("lower_bound") = lower_bound, py::arg("points") = points, py::arg("nearest_a") = nearest_a,
+        py::arg("nearest_b") = nearest_b);
   }
 };
 
@@ -239,6 +287,14 @@ void bind_queries(py::module_& m) {
                              "(triangle of A, triangle of B) that intersect, as mesh indices, or None")
       .def_property_readonly("contacts", &QueryResult::contacts,
                              "(K, 2) array of intersecting triangle pairs (strategy all_contacts)")
+      .def_property_readonly("distance", &QueryResult::distance,
+                             "the distance (strategies distance, distance_anytime: an upper bound), or None")
+      .def_property_readonly("lower_bound", &QueryResult::lower_bound,
+                             "what is proven: the distance lies in [lower_bound, distance]; or None")
+      .def_property_readonly("points", &QueryResult::points,
+                             "(2, 3): the closest points on A and on B, in A's frame; or None")
+      .def_property_readonly("nearest", &QueryResult::nearest,
+                             "(triangle of A, triangle of B) the points lie on, as mesh indices, or None")
       .def_property_readonly("counters", &QueryResult::counters)
       .def("__repr__", [](const QueryResult& q) {
         return std::string("<bvhlab.Result collides=") + (q.result.collides ? "True" : "False") +
@@ -271,7 +327,9 @@ void bind_queries(py::module_& m) {
            "pose where the previous one ended: less work on poses close to each other (traversal/README.md, "
            "\"Coherent queries\"); state (a CoherentState) carries that over to the next call. "
            "Returns a dict of arrays of length K: collides, probability, exact, budget_exhausted, "
-           "witness_a and witness_b (-1: none), contact_count and the counters.") +
+           "witness_a and witness_b (-1: none), contact_count and the counters; for the distance "
+           "strategies distance, lower_bound, points (K, 2, 3: on A, on B, in A's frame) and nearest_a, "
+           "nearest_b (NaN and -1 for the others).") +
        strategy_help)
           .c_str());
   m.def(

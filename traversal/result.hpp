@@ -1,7 +1,9 @@
 // Result: the one currency of every strategy. Tests, benchmarks and the report read only this.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -31,6 +33,16 @@ struct TrianglePair {
   friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
 };
 
+/// What the distance strategies answer (traversal/distance.hpp): the exact distance lies in
+/// [lower_bound, distance], both equal unless a budget stopped the query. `distance` is that of the nearest
+/// triangle pair found, `triangles` (source-mesh indices); its points are in A's frame.
+struct Proximity {
+  double distance = std::numeric_limits<double>::infinity();
+  double lower_bound = 0;
+  std::array<double, 3> on_a{}, on_b{};
+  std::optional<TrianglePair> triangles;  ///< empty when no triangle pair was reached
+};
+
 struct Result {
   bool collides = false;
   /// Estimated probability of collision; exactly 1 or 0 when `exact`.
@@ -45,6 +57,7 @@ struct Result {
   bool budget_exhausted = false;
   std::optional<TrianglePair> witness;  ///< set by exact strategies when collides
   std::vector<TrianglePair> contacts;   ///< all-contacts mode only
+  std::optional<Proximity> proximity;   ///< the distance strategies only
   Counters counters;
 };
 

@@ -6,6 +6,7 @@
 #include "adb.hpp"
 #include "coherent.hpp"
 #include "coherent_adb.hpp"
+#include "distance_strategies.hpp"
 #include "exact.hpp"
 #include "strategy.hpp"
 #include "strategy_names.hpp"

@@ -16,6 +16,8 @@
 //   S::accepts<D>          constexpr bool (a variable template): it runs on trees with density D, e.g.
 //                          only ProbabilityDensity models for the ADB strategies.
 //   S::Options             What one configured query needs.
+//   S::accepts_volume<BV>  Optional constexpr bool (a variable template): it runs on trees of volume BV
+//                          (the distance strategies need DistanceVolume); every volume when absent.
 // Operations
 //   S::parameters()                 std::span<const ParamSpec>: its parameters (adb/parameters.hpp). A
 //                                   `sweep` parameter may be given as a list: one variant per value.
@@ -64,6 +66,15 @@ template <class S>
 inline constexpr bool kRunsCoherent = requires {
   requires S::coherent;
 };
+
+/// Whether S runs on trees of volume BV (S::accepts_volume, above).
+template <class S, class BV>
+inline constexpr bool kAcceptsVolume = [] {
+  if constexpr (requires { S::template accepts_volume<BV>; })
+    return bool(S::template accepts_volume<BV>);
+  else
+    return true;
+}();
 
 /// "bv_tests=200", "deadline_us=20", "bv_tests=200;deadline_us=20", or "" when unlimited.
 /// Appends in place: GCC 12 warns (-Wrestrict, falsely) on the temporaries of string concatenation here.

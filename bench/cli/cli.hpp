@@ -65,6 +65,8 @@ class ParameterOptions {
   void finish_help();
   /// The values given on the command line for the parameters in `specs`.
   [[nodiscard]] ParamValues pick(const std::vector<ParamSpec>& specs) const;
+  /// Whether parameter `name` was given on the command line.
+  [[nodiscard]] bool given(std::string_view name) const;
   /// Throws CLI::ValidationError for a value given that none of `specs` takes: `what` says what is in use.
   void refuse_others(const std::vector<const std::vector<ParamSpec>*>& specs, const std::string& what) const;
 

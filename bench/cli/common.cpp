@@ -110,6 +110,11 @@ ParamValues ParameterOptions::pick(const std::vector<ParamSpec>& specs) const {
   return out;
 }
 
+bool ParameterOptions::given(std::string_view name) const {
+  const auto it = options_.find(std::string(name));
+  return it != options_.end() && it->second->count() > 0;
+}
+
 void ParameterOptions::refuse_others(const std::vector<const std::vector<ParamSpec>*>& specs,
                                      const std::string& what) const {
   for (const auto& [name, option] : options_) {

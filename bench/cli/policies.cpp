@@ -33,8 +33,10 @@ int policies_command(bool json) {
   }
   std::printf("strategies\n");
   for (const StrategyInfo& s : strategy_table()) {
-    std::printf("  %-14s %s; %s, budget %s, densities: %s%s\n", s.name.c_str(), s.description.c_str(),
+    const bool every_volume = s.volumes.size() == volume_names().size();
+    std::printf("  %-14s %s; %s, budget %s, densities: %s%s%s\n", s.name.c_str(), s.description.c_str(),
                 s.exact ? "exact" : "inexact", budget_text(s.budget), join(s.densities).c_str(),
+                every_volume ? "" : ("; volumes: " + join(s.volumes)).c_str(),
                 s.needs_polygons ? "; needs polygons" : "");
     print_parameters(s.parameters);
   }

@@ -30,6 +30,7 @@ struct QueryArgs {
   bool all = false, json = false, normalize = false, no_cache = false, coherent = false;
   ParameterOptions parameters;
   const CLI::Option* bv_option = nullptr;
+  const CLI::Option* strategy_option = nullptr;
   const CLI::Option* bv_tests_option = nullptr;
   const CLI::Option* deadline_option = nullptr;
   const CLI::Option* cache_option = nullptr;
@@ -133,13 +134,16 @@ void refuse_tree_building_options(const QueryArgs& args) {
                                "saved trees are read as they are; the cache does not apply");
 }
 
-/// The strategy and density names a query runs with: --all-contacts and the default density applied.
+/// The strategy and density names a query runs with: --all-contacts, --tolerance without --strategy and the
+/// default density applied.
 struct QueryPolicies {
   std::string strategy, density;
 };
 
 QueryPolicies query_policies(const QueryArgs& args) {
   QueryPolicies out{args.strategy, args.density};
+  if (!args.strategy_option->count() && args.parameters.given(kToleranceStrategyName))
+    out.strategy = kToleranceStrategyName;
   if (args.all) {
     if (out.strategy != kExactStrategyName && out.strategy != kAllContactsStrategyName)
       throw CLI::ValidationError("--all-contacts",
@@ -267,6 +271,19 @@ Spread spread_of(std::vector<double> times) {
   return {n % 2 ? times[n / 2] : 0.5 * (times[n / 2 - 1] + times[n / 2]), times.front(), times.back()};
 }
 
+/// A distance strategy's answer; JSON has no infinity: trees without a triangle pair give null.
+nlohmann::json proximity_json(const Proximity& p) {
+  const auto finite_or_null = [](double x) {
+    return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json();
+  };
+  nlohmann::json j = {{"distance", finite_or_null(p.distance)},
+                      {"lower_bound", finite_or_null(p.lower_bound)},
+                      {"on_a", p.on_a},
+                      {"on_b", p.on_b}};
+  if (p.triangles) j["triangles"] = {p.triangles->a, p.triangles->b};
+  return j;
+}
+
 nlohmann::json answer_json(const PoseAnswer& answer, bool all_contacts) {
   const Result& r = answer.result;
   nlohmann::json j = {{"collides", r.collides},
@@ -288,6 +305,7 @@ nlohmann::json answer_json(const PoseAnswer& answer, bool all_contacts) {
     j["contacts"] = nlohmann::json::array();
     for (const auto& c : r.contacts) j["contacts"].push_back({c.a, c.b});
   }
+  if (r.proximity) j["distance"] = proximity_json(*r.proximity);
   return j;
 }
 
@@ -313,6 +331,16 @@ void print_times(const PoseAnswer& answer) {
               s.min, s.max, answer.warm_micros.size());
 }
 
+void print_proximity(const Proximity& p) {
+  std::printf("  distance          %.17g\n", p.distance);
+  if (p.lower_bound != p.distance)
+    std::printf("  lower bound       %.17g (the distance lies between the two)\n", p.lower_bound);
+  if (!p.triangles) return;
+  std::printf("  nearest           triangle %u of A, triangle %u of B\n", p.triangles->a, p.triangles->b);
+  std::printf("  point on A        %.17g %.17g %.17g\n", p.on_a[0], p.on_a[1], p.on_a[2]);
+  std::printf("  point on B        %.17g %.17g %.17g (in A's frame)\n", p.on_b[0], p.on_b[1], p.on_b[2]);
+}
+
 void print_answer(const PoseAnswer& answer, bool all_contacts, bool counters) {
   const Result& r = answer.result;
   std::printf("  collides          %s\n  probability       %g\n  exact             %s\n",
@@ -327,6 +355,7 @@ void print_answer(const PoseAnswer& answer, bool all_contacts, bool counters) {
                 r.contacts.empty() ? "" : " (triangle of A, triangle of B):");
     for (const auto& c : r.contacts) std::printf("    %u %u\n", c.a, c.b);
   }
+  if (r.proximity) print_proximity(*r.proximity);
   print_times(answer);
   if (counters)
     std::printf("  BV tests          %ju\n  triangle tests    %ju\n  nodes visited     %ju\n",
@@ -338,9 +367,10 @@ void print_answer(const PoseAnswer& answer, bool all_contacts, bool counters) {
 
 /// A pose list: one row per pose; --json (or a single --pose) has every detail.
 void print_table(const QueryRun& run, bool all_contacts, bool repeat) {
-  std::printf("  %6s  %-8s  %11s  %-5s  %10s  %10s  %14s%s%s\n", run.index, "collides", "probability",
+  const bool distances = !run.outcome.answers.empty() && run.outcome.answers.front().result.proximity;
+  std::printf("  %6s  %-8s  %11s  %-5s  %10s  %10s  %14s%s%s%s\n", run.index, "collides", "probability",
               "exact", "time_us", "bv_tests", "triangle_tests", repeat ? "  warm_median_us" : "",
-              all_contacts ? "  contacts" : "");
+              all_contacts ? "  contacts" : "", distances ? "      distance   lower_bound" : "");
   for (std::size_t k = 0; k < run.poses.size(); ++k) {
     const PoseAnswer& answer = run.outcome.answers[k];
     const Result& r = answer.result;
@@ -349,6 +379,7 @@ void print_table(const QueryRun& run, bool all_contacts, bool repeat) {
                 std::uintmax_t(r.counters.bv_tests), std::uintmax_t(r.counters.triangle_tests));
     if (repeat) std::printf("  %14.3f", spread_of(answer.warm_micros).median);
     if (all_contacts) std::printf("  %8zu", r.contacts.size());
+    if (r.proximity) std::printf("  %12.9g  %12.9g", r.proximity->distance, r.proximity->lower_bound);
     std::printf("\n");
   }
 }
@@ -411,9 +442,9 @@ void add_policy_options(CLI::App* query, QueryArgs& args) {
   args.bv_option = query->add_option("--bv", args.bv, "Hierarchy: a bvhlab BV, or fcl_obb / fcl_obbrss")
                        ->check(CLI::IsMember(hierarchy_bv_names()))
                        ->capture_default_str();
-  query->add_option("--strategy", args.strategy, "Strategy (`bvhlab policies`)")
-      ->check(CLI::IsMember(strategy_names()))
-      ->capture_default_str();
+  args.strategy_option = query->add_option("--strategy", args.strategy, "Strategy (`bvhlab policies`)")
+                             ->check(CLI::IsMember(strategy_names()))
+                             ->capture_default_str();
   query
       ->add_option(
           "--density", args.density,

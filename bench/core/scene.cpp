@@ -61,6 +61,9 @@ bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec&
     if (scene.hierarchy(name)->is_fcl() && !runs_on_fcl(spec))
       hs.child(k).fail("\"" + spec.name + "\"" + (spec.coherent ? " coherent" : "") +
                        " needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only, not coherent");
+    if (const HierarchySpec& h = *scene.hierarchy(name); !h.is_fcl())
+      if (std::string refusal = strategy_info(spec.name).volume_refusal(h.bv); !refusal.empty())
+        hs.child(k).fail(refusal);
     spec.hierarchies.push_back(name);
   }
   return !spec.hierarchies.empty();
@@ -240,7 +243,8 @@ bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
   if (!s.hierarchies.empty() &&
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
-  return !h.is_fcl() || runs_on_fcl(s);
+  if (h.is_fcl()) return runs_on_fcl(s);
+  return strategy_info(s.name).volume_refusal(h.bv).empty();  // e.g. distance on a volume without a bound
 }
 
 const DensitySpec& Scene::density_of(const HierarchySpec& h) const {

@@ -305,6 +305,43 @@ TEST_F(Cli, AllContactsListsThePairsInTextToo) {
   EXPECT_EQ(named["contacts"], contacts);
 }
 
+// Two unit cubes 3 apart along x face each other across a gap of exactly 2.
+TEST_F(Cli, DistanceAndToleranceAnswerWithTheirPoints) {
+  const nlohmann::json j =
+      nlohmann::json::parse(ok("query small.obj small.obj --pose 3,0,0 --strategy distance --json").out);
+  EXPECT_FALSE(j["collides"].get<bool>());
+  EXPECT_EQ(j["distance"]["distance"].get<double>(), 2.0) << j;
+  EXPECT_EQ(j["distance"]["lower_bound"].get<double>(), 2.0) << j;
+  EXPECT_EQ(j["distance"]["on_a"][0].get<double>(), 0.5) << j;
+  EXPECT_EQ(j["distance"]["on_b"][0].get<double>(), 2.5) << j;
+  EXPECT_EQ(j["distance"]["triangles"].size(), 2u) << j;
+  const std::string text = ok("query small.obj small.obj --pose 3,0,0 --strategy distance").out;
+  EXPECT_NE(text.find("  distance          2\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  point on B        2.5 "), std::string::npos) << text;
+  // In contact the distance is 0 with a witness; a pose list prints a distance column.
+  const nlohmann::json touching = nlohmann::json::parse(
+      ok("query small.obj small.obj --pose 0.5,0.2,0.1 --strategy distance --json").out);
+  EXPECT_TRUE(touching["collides"].get<bool>());
+  EXPECT_EQ(touching["distance"]["distance"].get<double>(), 0.0);
+  EXPECT_TRUE(touching.contains("witness"));
+  // --tolerance alone asks the tolerance query.
+  EXPECT_TRUE(nlohmann::json::parse(
+                  ok("query small.obj small.obj --pose 3,0,0 --tolerance 2.5 --json").out)["collides"]
+                  .get<bool>());
+  EXPECT_FALSE(nlohmann::json::parse(
+                   ok("query small.obj small.obj --pose 3,0,0 --tolerance 1.5 --json").out)["collides"]
+                   .get<bool>());
+  expect_refused("query small.obj small.obj --pose 3,0,0 --tolerance -1",
+                 "tolerance must be a number in [0, ");
+  expect_refused("query small.obj small.obj --pose 3,0,0 --strategy exact --tolerance 1", "--tolerance");
+  expect_refused("query small.obj small.obj --pose 3,0,0 --strategy distance --bv rbox",
+                 "does not run on trees of volume 'rbox'");
+  expect_refused("query small.obj small.obj --pose 3,0,0 --strategy distance_anytime", "needs --bv-tests");
+  const nlohmann::json anytime = nlohmann::json::parse(
+      ok("query small.obj small.obj --pose 3,0,0 --strategy distance_anytime --bv-tests 1 --json").out);
+  EXPECT_LE(anytime["distance"]["lower_bound"].get<double>(), 2.0) << anytime;
+}
+
 TEST_F(Cli, PoseListsAreQueriedInOrder) {
   testing::write_text(dir / "poses.txt",
                       "# a pose per line\n0.5 0 0\n\n3,0,0\n0.9 0 0 0 0 1 45\n1 0 0 0  0 1 0 0  0 0 1 0\n");

@@ -3,6 +3,7 @@
 // choice the same way.
 #include "adb/update.hpp"
 #include "engine/any_tree.hpp"
+#include "engine/policies.hpp"
 #include "support/errors.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/broad_phase/registry.hpp"
@@ -10,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -91,6 +93,75 @@ TEST(AnyTree, PrepareRefusesWhatCannotRun) {
   EXPECT_NE(error_of([&] { (void)plain.prepare(obb, StrategyVariant{}); }).find("differ in BV or density"),
             std::string::npos);
   EXPECT_NE(error_of([&] { (void)plain.prepare(adb, StrategyVariant{}); }).find("differ in BV or density"),
+            std::string::npos);
+}
+
+/// Every pose's result of `variant` between a and b.
+std::vector<Result> results_of(const AnyTree& a, const AnyTree& b, const StrategyVariant& variant,
+                               const std::vector<RigidTransform>& poses) {
+  std::vector<Result> out(poses.size());
+  a.prepare(b, variant)->run(poses, [&](std::size_t i, const Result& r) { out[i] = r; });
+  return out;
+}
+
+TEST(AnyTree, TheDistanceStrategiesRunThroughTheRegistry) {
+  const AnyTree a = torus_tree("dop24", "adb"), b = torus_tree("dop24", "adb");  // any density serves
+  std::vector<RigidTransform> poses;
+  for (int i = 0; i < 40; ++i) poses.push_back(RigidTransform::translate(Vec3(0.1 * i, 0.02 * i, 0)));
+  const auto exact = results_of(a, b, StrategyVariant{}, poses);
+  const auto distance = results_of(a, b, strategy_variant("distance", {}, Budget{}), poses);
+  StrategyVariant coherent = strategy_variant("distance", {}, Budget{});
+  coherent.coherent = true;
+  const auto warm = results_of(a, b, coherent, poses);
+  const auto within = results_of(a, b, strategy_variant("tolerance", {{"tolerance", 0.2}}, Budget{}), poses);
+  const auto anytime = results_of(a, b, strategy_variant("distance_anytime", {}, Budget{20, 0}), poses);
+  int touching = 0, apart = 0;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    ASSERT_TRUE(distance[i].proximity.has_value()) << i;
+    const Proximity& p = *distance[i].proximity;
+    EXPECT_EQ(distance[i].collides, exact[i].collides) << i;
+    EXPECT_EQ(p.distance == 0, exact[i].collides) << i;
+    EXPECT_EQ(p.lower_bound, p.distance) << i;
+    EXPECT_EQ(distance[i].witness.has_value(), exact[i].collides) << i;
+    ASSERT_TRUE(p.triangles.has_value()) << i;
+    const Vec3 gap(p.on_a[0] - p.on_b[0], p.on_a[1] - p.on_b[1], p.on_a[2] - p.on_b[2]);
+    EXPECT_NEAR(gap.norm(), p.distance, 1e-12) << i;
+    EXPECT_EQ(warm[i].proximity->distance, p.distance) << i;
+    EXPECT_EQ(within[i].collides, p.distance <= 0.2) << i;
+    EXPECT_FALSE(within[i].proximity.has_value());
+    ASSERT_TRUE(anytime[i].proximity.has_value()) << i;
+    EXPECT_LE(anytime[i].proximity->lower_bound, p.distance) << i;
+    EXPECT_GE(anytime[i].proximity->distance, p.distance) << i;
+    EXPECT_LE(anytime[i].counters.bv_tests, 20u) << i;
+    (p.distance == 0 ? touching : apart) += 1;
+  }
+  EXPECT_GT(touching, 5);
+  EXPECT_GT(apart, 5);
+}
+
+TEST(AnyTree, TheDistanceStrategiesRefuseAVolumeWithoutADistanceBound) {
+  const AnyTree rbox = torus_tree("rbox", "none");
+  for (const char* name : {"distance", "tolerance"}) {
+    const ParamValues values =
+        std::string(name) == "tolerance" ? ParamValues{{"tolerance", 0.1}} : ParamValues{};
+    const std::string message =
+        error_of([&] { (void)rbox.prepare(rbox, strategy_variant(name, values, Budget{})); });
+    EXPECT_EQ(message.rfind("strategy " + std::string(name) +
+                                " does not run on trees of volume 'rbox', which has no distance bound "
+                                "(it runs on: aabb, ",
+                            0),
+              0u)
+        << message;
+  }
+  const StrategyInfo& info = strategy_info("distance");
+  EXPECT_EQ(std::count(info.volumes.begin(), info.volumes.end(), "rbox"), 0);
+  EXPECT_EQ(std::count(info.volumes.begin(), info.volumes.end(), "obb"), 1);
+  // The tolerance is checked before any pose, as every parameter is.
+  EXPECT_NE(error_of([] {
+              (void)strategy_variant("tolerance", {{"tolerance", -1}}, Budget{});
+            }).find("tolerance"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { (void)strategy_variant("distance_anytime", {}, Budget{}); }).find("needs a budget"),
             std::string::npos);
 }
 

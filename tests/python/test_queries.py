@@ -18,6 +18,9 @@ STRATEGIES = [  # (strategy, its parameters, density the trees need)
     ("adb_dfs", {"p_min": 0.9}, "adb"),
     ("adb_larger", {"p_min": 0.9}, "adb"),
     ("time_critical", {"p_min": 0.9, "bv_tests": 40}, "adb"),
+    ("distance", {}, "none"),
+    ("tolerance", {"tolerance": 0.05}, "none"),
+    ("distance_anytime", {"bv_tests": 30}, "none"),
 ]
 EXACT = [("exact", "none"), ("all_contacts", "none"), ("guided_exact", "adb"), ("guided_exact_dfs", "adb")]
 
@@ -148,6 +151,35 @@ def test_every_volume_equals_the_cli(cli, gear_file, gear, bv):
     r = bvhlab.query(tree, tree, bvhlab.protocol_pose(1.5, 11, 50))
     assert (r.collides, r.counters["bv_tests"], r.counters["triangle_tests"]) == (
         expected["collides"], expected["bv_tests"], expected["triangle_tests"])
+
+
+def test_distances_follow_the_geometry(cube_trees):
+    """Unit cubes d apart along x face each other across a gap of d - 1; rotated, the batch gives the same."""
+    runs_on = next(s for s in bvhlab.policies()["strategies"] if s["name"] == "distance")["volumes"]
+    assert "aabb" in runs_on and "rbox" not in runs_on
+    poses = np.stack([matrix(rotation_z(a), [2.5, 0.1, 0]) for a in range(0, 90, 10)])
+    for bv in bvhlab.volumes():
+        tree = cube_trees[(bv, "none")]
+        if bv not in runs_on:
+            with pytest.raises(ValueError, match=f"volume '{bv}', which has no distance bound"):
+                bvhlab.query(tree, tree, translation=[2, 0, 0], strategy="distance")
+            continue
+        for d in (0.5, 1.25, 3.0):
+            r = bvhlab.query(tree, tree, translation=[d, 0, 0], strategy="distance")
+            assert r.distance == pytest.approx(max(d - 1, 0), abs=1e-15), (bv, d)
+            assert r.lower_bound == r.distance and r.collides == (d < 1)
+            assert r.points.shape == (2, 3) and len(r.nearest) == 2
+            assert np.linalg.norm(r.points[1] - r.points[0]) == pytest.approx(r.distance, abs=1e-15)
+        batch = bvhlab.query_batch(tree, tree, poses, strategy="distance")
+        assert batch["points"].shape == (len(poses), 2, 3)
+        for k, pose in enumerate(poses):
+            r = bvhlab.query(tree, tree, pose, strategy="distance")
+            assert batch["distance"][k] == r.distance and (batch["nearest_a"][k], batch["nearest_b"][k]) == r.nearest
+            np.testing.assert_array_equal(batch["points"][k], r.points)
+    tree = cube_trees[("aabb", "none")]
+    exact = bvhlab.query_batch(tree, tree, poses)
+    assert np.isnan(exact["distance"]).all() and (exact["nearest_a"] == -1).all()
+    assert bvhlab.query(tree, tree, translation=[3, 0, 0]).distance is None
 
 
 def test_budget_is_kept(gear_trees):
