@@ -41,6 +41,8 @@ namespace distance_detail {
 
 /// The one triangle-pair loop of a distance traversal: every triangle pair of leaf pair (i, j) whose
 /// distance is below `nearest`'s replaces it. True when the triangles touch (distance 0: nothing is nearer).
+/// The same loop as TreePair::intersecting_triangles, written out again: sharing it through a visitor made
+/// GCC stop inlining the pose's transform there, and the exact query ran 4% more instructions (callgrind).
 template <TreeVolume BV>
 bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t j, NearestPair& nearest) {
   const TreeNode& na = trees.a.node(i);
@@ -65,7 +67,9 @@ bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t 
 }  // namespace distance_detail
 
 /// The distance strategy's hooks: a pair's score is its volumes' lower bound (one BV test), the queue key
-/// its negation (BestFirst takes the highest key: the nearest pair first).
+/// its negation (BestFirst takes the highest key: the nearest pair first). Pairs whose bound is 0 (their
+/// volumes overlap) tie; among them the last admitted goes first, a positive key counting admissions: a dive
+/// to the leaves, as the exact traversal's, finds a touching pair without visiting every overlapping one.
 template <DistanceVolume BV>
 class DistanceHooks {
  public:
@@ -79,12 +83,12 @@ class DistanceHooks {
   }
   [[gnu::always_inline]] Admission admit(Pair& p, double bound) {
     if (bound >= nearest_.distance) return Admission::Drop;
-    p.key = -bound;
+    p.key = bound > 0 ? -bound : ++overlapping_;
     return Admission::Queue;
   }
   /// Every pair still queued is at least as far as this one: none can hold a nearer triangle pair.
   [[gnu::always_inline]] Step taken(const Pair& p) const {
-    return -p.key >= nearest_.distance ? Step::Decided : Step::Continue;
+    return bound_of(p.key) >= nearest_.distance ? Step::Decided : Step::Continue;
   }
   [[gnu::always_inline]] Step leaf_pair(const Pair& p) {
     return distance_detail::nearer_triangles(trees_, p.a, p.b, nearest_) ? Step::Decided : Step::Continue;
@@ -95,7 +99,7 @@ class DistanceHooks {
     if (ended != Ended::BudgetExhausted) return;
     stopped_ = true;
     // An empty queue here means the budget refused the root's test: nothing is known.
-    unexamined_bound_ = queue.empty() ? 0 : -queue.top().key;
+    unexamined_bound_ = queue.empty() ? 0 : bound_of(queue.top().key);
   }
 
   [[nodiscard]] bool stopped() const { return stopped_; }
@@ -103,8 +107,12 @@ class DistanceHooks {
   [[nodiscard]] double unexamined_bound() const { return unexamined_bound_; }
 
  private:
+  /// The bound a queue key stands for (admit).
+  static double bound_of(double key) { return key > 0 ? 0 : -key; }
+
   const TreePair<BV>& trees_;
   NearestPair& nearest_;
+  double overlapping_ = 0;  ///< bound-0 pairs admitted so far: their keys
   bool stopped_ = false;
   double unexamined_bound_ = std::numeric_limits<double>::infinity();
 };
