@@ -43,10 +43,20 @@ inline constexpr ParamSpec kTolerance[] = {
      .in_label = true},
 };
 
+/// What the proximity strategies share: triangles measured, any density, volumes with a distance bound.
+struct ProximityTraits {
+  static constexpr bool needs_polygons = true;
+  template <class D>
+  static constexpr bool accepts = true;
+  template <class BV>
+  static constexpr bool accepts_volume = DistanceVolume<BV>;
+  static constexpr bool coherent = true;
+};
+
 }  // namespace distance_strategy_detail
 
 /// The distance between the two meshes, its closest points and triangles; 0 with a witness when they touch.
-struct DistanceStrategy {
+struct DistanceStrategy : distance_strategy_detail::ProximityTraits {
   struct Options {};
   static constexpr std::string_view name() { return "distance"; }
   static constexpr std::string_view description() {
@@ -54,18 +64,12 @@ struct DistanceStrategy {
   }
   static constexpr bool exact = true;
   static constexpr BudgetUse budget = BudgetUse::None;
-  static constexpr bool needs_polygons = true;
-  template <class D>
-  static constexpr bool accepts = true;
-  template <class BV>
-  static constexpr bool accepts_volume = DistanceVolume<BV>;
   static std::span<const ParamSpec> parameters() { return {}; }
   static Options configure(const ParamValues&, const Budget&) { return {}; }
   template <class TreeA, class TreeB>
   static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options) {
     return distance_strategy_detail::as_result(query_distance(a.bvh, b.bvh, b_to_a));
   }
-  static constexpr bool coherent = true;
   template <class TreeA, class TreeB>
   static Result query_coherent(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options,
                                CoherentState& state) {
@@ -100,7 +104,7 @@ struct AnytimeDistanceStrategy : DistanceStrategy {
 
 /// Are the meshes within a tolerance of each other? Stops at the first triangle pair within it, or once
 /// every pair is farther. Its "collision" is "within": exact as the intersection answer only at tolerance 0.
-struct ToleranceStrategy {
+struct ToleranceStrategy : distance_strategy_detail::ProximityTraits {
   using Options = double;
   static constexpr std::string_view name() { return kToleranceStrategyName; }
   static constexpr std::string_view description() {
@@ -108,11 +112,6 @@ struct ToleranceStrategy {
   }
   static constexpr bool exact = false;
   static constexpr BudgetUse budget = BudgetUse::None;
-  static constexpr bool needs_polygons = true;
-  template <class D>
-  static constexpr bool accepts = true;
-  template <class BV>
-  static constexpr bool accepts_volume = DistanceVolume<BV>;
   static std::span<const ParamSpec> parameters() { return distance_strategy_detail::kTolerance; }
   static Options configure(const ParamValues& values, const Budget&) {
     return parameter(values, "tolerance");
@@ -121,7 +120,6 @@ struct ToleranceStrategy {
   static Result query(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options tolerance) {
     return answered(query_within(a.bvh, b.bvh, b_to_a, tolerance), tolerance);
   }
-  static constexpr bool coherent = true;
   template <class TreeA, class TreeB>
   static Result query_coherent(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a,
                                Options tolerance, CoherentState& state) {

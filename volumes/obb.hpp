@@ -17,9 +17,8 @@
 #pragma once
 
 #include "concept.hpp"
+#include "principal_axes.hpp"
 #include "storage.hpp"
-
-#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -276,19 +275,7 @@ struct Obb {
     if (std::any_of(points.begin(), points.end(), [](const Vec3& p) { return !p.allFinite(); }))
       throw std::invalid_argument("obb::fit: a point has a NaN or infinite coordinate");
     if (points.empty()) return {};
-    Vec3 mean = Vec3::Zero();
-    for (const Vec3& p : points) mean += p;
-    mean /= double(points.size());
-    Mat3 covariance = Mat3::Zero();
-    for (const Vec3& p : points) covariance += (p - mean) * (p - mean).transpose();
-    Mat3 pca = Mat3::Identity();
-    if (covariance.allFinite()) {
-      const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
-      if (solver.info() == Eigen::Success) {
-        pca = solver.eigenvectors();
-        pca.col(2) = pca.col(0).cross(pca.col(1));  // right-handed, so it is a rotation
-      }
-    }
+    const Mat3 pca = principal_axes(points, mean_point(points));
     const Obb by_pca = box_in_frame(points, pca, margin);
     const Obb by_axes = box_in_frame(points, Mat3::Identity(), margin);
     return smaller(by_pca, by_axes) ? by_pca : by_axes;

@@ -37,9 +37,8 @@
 
 #include "concept.hpp"
 #include "obb.hpp"
+#include "principal_axes.hpp"
 #include "storage.hpp"
-
-#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <array>
@@ -343,17 +342,8 @@ struct Rss {
   // The RSS holding every ball (points[i], radii[i]; no radii: points), in the better of two frames.
   static Rss fit_balls(std::span<const Vec3> points, std::span<const double> radii) {
     if (points.empty()) return {};
-    Vec3 mean = Vec3::Zero();
-    for (const Vec3& p : points) mean += p;
-    mean /= double(points.size());
-    Mat3 covariance = Mat3::Zero();
-    for (const Vec3& p : points) covariance += (p - mean) * (p - mean).transpose();
-    Mat3 pca = Mat3::Identity();
-    if (covariance.allFinite()) {
-      const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
-      if (solver.info() == Eigen::Success) pca = solver.eigenvectors();
-    }
-    const Rss by_pca = fit_in_frame(points, radii, mean, pca);
+    const Vec3 mean = mean_point(points);
+    const Rss by_pca = fit_in_frame(points, radii, mean, principal_axes(points, mean));
     const Rss by_axes = fit_in_frame(points, radii, mean, Mat3::Identity());
     return smaller(by_pca, by_axes) ? by_pca : by_axes;
   }
