@@ -1,5 +1,6 @@
 // Proximity queries (traversal/distance.hpp) against a brute force over every triangle pair, for every
 // volume with a distance bound.
+#include "support/brute_force_distance.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/distance.hpp"
 #include "volumes/shipped.hpp"
@@ -13,19 +14,9 @@
 namespace bvhlab {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using testing::brute_force_distance;
 
-/// The smallest triangle_distance over every triangle pair, B moved by the pose: what the query must find.
-double brute_force_distance(const Mesh& a, const Mesh& b, const RigidTransform& pose) {
-  double best = kInf;
-  for (std::size_t j = 0; j < b.triangles.size(); ++j) {
-    const TrianglePoints t = b.triangle(static_cast<std::uint32_t>(j));
-    const TrianglePoints moved = {pose.apply(t[0]), pose.apply(t[1]), pose.apply(t[2])};
-    for (std::size_t i = 0; i < a.triangles.size(); ++i)
-      best = std::min(best, triangle_distance(a.triangle(static_cast<std::uint32_t>(i)), moved).distance);
-  }
-  return best;
-}
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// Distance from point p to triangle t (both in one frame): how far a reported closest point is off it.
 double off_triangle(const Vec3& p, const TrianglePoints& t) {

@@ -2,14 +2,13 @@
 // above the distance of the points a volume holds, 0 exactly where overlap() is true, useful for separated
 // objects, and computed as precisely at coordinates around 1e6 as at the origin. The restricted boxtree has
 // no bound (a distance strategy refuses it by name).
-#include "support/random_draws.hpp"
+#include "support/random_clouds.hpp"
 #include "support/test_volumes.hpp"
 #include "support/volume_lists.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -21,8 +20,13 @@
 namespace bvhlab::distance_tests {
 namespace {
 
-using testing::draw_quaternion;
-using testing::draw_vec3;
+using testing::diameter_of;
+using testing::log_uniform;
+using testing::mean_of;
+using testing::point_distance;
+using testing::random_cloud;
+using testing::random_direction;
+using testing::random_pose_rotation;
 
 // ---------------------------------------------------------------------------------------------------------
 // Which models have the bound (compile time).
@@ -62,97 +66,11 @@ TYPED_TEST_SUITE(DistanceBound, DistanceVolumes, VolumeName);
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-Mat3 random_rotation(std::mt19937_64& rng) {
-  std::normal_distribution<double> normal;
-  return draw_quaternion(normal, rng).normalized().toRotationMatrix();
-}
-
-Vec3 random_direction(std::mt19937_64& rng) {
-  std::normal_distribution<double> normal;
-  for (;;) {
-    const Vec3 v = draw_vec3(normal, rng);
-    if (v.norm() > 1e-3) return v.normalized();
-  }
-}
-
-/// 10^u with u uniform in [lo, hi].
-double log_uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::pow(10.0, std::uniform_real_distribution<double>(lo, hi)(rng));
-}
-
-/// 1 to 30 points of extent about `scale` around `center`: random shape (stretched, sometimes flat) and
-/// orientation.
-std::vector<Vec3> random_cloud(std::mt19937_64& rng, const Vec3& center, double scale) {
-  std::normal_distribution<double> normal;
-  std::uniform_real_distribution<double> unit(0, 1);
-  const int count = 1 + int(rng() % 30);
-  Vec3 spread(1, log_uniform(rng, -2, 0), log_uniform(rng, -2, 0));
-  if (unit(rng) < 0.1) spread[2] = 0;  // flat
-  const Mat3 shape = random_rotation(rng);
-  std::vector<Vec3> points;
-  for (int i = 0; i < count; ++i)
-    points.push_back(center + scale * (shape * draw_vec3(normal, rng).cwiseProduct(spread)));
-  return points;
-}
-
-Vec3 mean_of(const std::vector<Vec3>& points) {
-  Vec3 sum = Vec3::Zero();
-  for (const Vec3& p : points) sum += p;
-  return sum / double(points.size());
-}
-
-double diameter_of(const std::vector<Vec3>& points) {
-  double d = 0;
-  for (const Vec3& p : points)
-    for (const Vec3& q : points) d = std::max(d, (p - q).norm());
-  return d;
-}
-
-/// A rotation: random, or (one time in five) one that keeps the coordinate axes, where the boxes' and DOPs'
-/// bounds are tight and a missing slack would show.
-Mat3 random_pose_rotation(std::mt19937_64& rng) {
-  if (std::uniform_real_distribution<double>(0, 1)(rng) >= 0.2) return random_rotation(rng);
-  Mat3 r = Mat3::Zero();
-  const int shift = int(rng() % 3);
-  for (int k = 0; k < 3; ++k) r((k + shift) % 3, k) = rng() % 2 ? 1 : -1;
-  if (r.determinant() < 0) r.col(0) = -r.col(0);
-  return r;
-}
-
 /// Two clouds (A's in A's frame, B's in B's) and the pose mapping B's frame into A's.
 struct Pair {
   std::vector<Vec3> a, b;
   RigidTransform pose;
 };
-
-/// min over point pairs of |p - (R q + t)|: the distance the bound must not exceed (the points are
-/// contained in the fitted volumes). In long double, whose rounding is far below the bounds' slack, so even a
-/// bound that left out its slack can show (on x86-64 a 64-bit mantissa; elsewhere at least double's). The
-/// inputs are doubles, exact in long double. `magnitude` receives the largest coordinate involved.
-double point_distance(const Pair& pair, double* magnitude = nullptr) {
-  using Long = long double;
-  const Mat3& r = pair.pose.rotation;
-  const Vec3& t = pair.pose.translation;
-  std::vector<std::array<Long, 3>> placed;
-  double largest = t.cwiseAbs().maxCoeff();
-  for (const Vec3& q : pair.b) {
-    std::array<Long, 3> x;
-    for (int i = 0; i < 3; ++i)
-      x[i] = Long(r(i, 0)) * q[0] + Long(r(i, 1)) * q[1] + Long(r(i, 2)) * q[2] + Long(t[i]);
-    placed.push_back(x);
-    largest = std::max(largest, q.cwiseAbs().maxCoeff());
-  }
-  Long best = std::numeric_limits<Long>::infinity();
-  for (const Vec3& p : pair.a) {
-    largest = std::max(largest, p.cwiseAbs().maxCoeff());
-    for (const auto& x : placed) {
-      const Long dx = p[0] - x[0], dy = p[1] - x[1], dz = p[2] - x[2];
-      best = std::min(best, std::sqrt(dx * dx + dy * dy + dz * dz));
-    }
-  }
-  if (magnitude) *magnitude = largest;
-  return double(best);
-}
 
 /// Clouds of sizes 1e-3 to 1e3, centred near the origin or (one pair in four) at coordinates around 1e6
 /// in their own frames, placed from overlapping to far apart (centre distance 0 to 30 times the sizes).
@@ -212,7 +130,7 @@ TYPED_TEST(DistanceBound, NeverExceedsThePointDistance) {
     for (const Vec3& q : pair.b) ASSERT_TRUE(b.contains(q)) << "case " << k;
     const double bound = BV::distance_lower_bound(a, b, BV::make_context(pair.pose));
     double magnitude = 0;
-    const double distance = point_distance(pair, &magnitude);
+    const double distance = point_distance(pair.a, pair.b, pair.pose, &magnitude);
     ASSERT_GE(bound, 0) << "case " << k;
     // Rounding the long double distance to double moves it by half an ulp; its own rounding is ~1e-19.
     ASSERT_LE(bound, distance + kEps * distance + 1e-17 * magnitude)
@@ -330,7 +248,7 @@ TYPED_TEST(DistanceBound, UsefulForSeparatedClouds) {
     // Centre distance 3.5 to 10 times the diameters (the point distance is then at least ~3 times them).
     pair.pose.translation = mean_of(pair.a) + diameters * (3.5 + 6.5 * unit(rng)) * random_direction(rng) -
                             pair.pose.rotation * mean_of(pair.b);
-    const double distance = point_distance(pair);
+    const double distance = point_distance(pair.a, pair.b, pair.pose);
     if (distance < 3 * diameters) continue;
     const BV a = BV::fit(pair.a), b = BV::fit(pair.b);
     const double bound = BV::distance_lower_bound(a, b, BV::make_context(pair.pose));
@@ -414,7 +332,7 @@ TYPED_TEST(DistanceBound, SameAtCoordinatesAround1e6) {
     pair.b = random_cloud(rng, Vec3::Zero(), 0.02 + 0.08 * unit(rng));
     pair.pose.rotation = random_pose_rotation(rng);
     pair.pose.translation = (1 + 0.5 * unit(rng)) * random_direction(rng);
-    const double distance = point_distance(pair);
+    const double distance = point_distance(pair.a, pair.b, pair.pose);
     if (distance < 0.8 || distance > 1.6) continue;
     ++cases;
     const Vec3 offset_a = far_offset(), offset_b = far_offset();
