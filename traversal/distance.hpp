@@ -70,12 +70,17 @@ bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t 
 /// its negation (BestFirst takes the highest key: the nearest pair first). Pairs whose bound is 0 (their
 /// volumes overlap) tie; among them the last admitted goes first, a positive key counting admissions: a dive
 /// to the leaves, as the exact traversal's, finds a touching pair without visiting every overlapping one.
-template <DistanceVolume BV>
+/// Under a budget (Limit other than Unlimited) the search also dives: at its 1st, 2nd, 4th, 8th ... pair
+/// taken, from that pair into the child of smallest bound down to a leaf pair, whose triangles bring the
+/// upper end down early. Best first alone reaches its first leaf pair only after every pair of smaller
+/// bound, which a small budget does not allow; the dives cost a few tests per level, counted and capped.
+template <DistanceVolume BV, class Limit = Unlimited>
 class DistanceHooks {
  public:
   using Pair = QueuedPair<BV, double>;
 
-  DistanceHooks(const TreePair<BV>& trees, NearestPair& nearest) : trees_(trees), nearest_(nearest) {}
+  DistanceHooks(const TreePair<BV>& trees, NearestPair& nearest, const Limit& limit = {})
+      : trees_(trees), nearest_(nearest), limit_(limit) {}
 
   [[gnu::always_inline]] double evaluate(const Pair& p) {
     ++trees_.counters.bv_tests;
@@ -87,8 +92,15 @@ class DistanceHooks {
     return Admission::Queue;
   }
   /// Every pair still queued is at least as far as this one: none can hold a nearer triangle pair.
-  [[gnu::always_inline]] Step taken(const Pair& p) const {
-    return bound_of(p.key) >= nearest_.distance ? Step::Decided : Step::Continue;
+  [[gnu::always_inline]] Step taken(const Pair& p) {
+    if (bound_of(p.key) >= nearest_.distance) return Step::Decided;
+    if constexpr (!Limit::never_stops)
+      if (trees_.counters.bv_tests >= kDiveShare * dive_tests_) {
+        const std::uint64_t before = trees_.counters.bv_tests;
+        dive(p);
+        dive_tests_ += trees_.counters.bv_tests - before + 1;
+      }
+    return Step::Continue;
   }
   [[gnu::always_inline]] Step leaf_pair(const Pair& p) {
     return distance_detail::nearer_triangles(trees_, p.a, p.b, nearest_) ? Step::Decided : Step::Continue;
@@ -110,9 +122,38 @@ class DistanceHooks {
   /// The bound a queue key stands for (admit).
   static double bound_of(double key) { return key > 0 ? 0 : -key; }
 
+  /// From `p` into the child pair of smallest bound, down to a leaf pair, whose triangles are measured;
+  /// stops where the budget's cap does.
+  void dive(Pair p) {
+    while (!trees_.is_leaf_pair(p)) {
+      NearestChild children{*this};
+      if (!SplitLarger::expand(trees_, p, children) || !(children.bound < nearest_.distance)) return;
+      p = children.pair;
+    }
+    distance_detail::nearer_triangles(trees_, p.a, p.b, nearest_);
+  }
+  /// The expansion's sink: each child bounded while the cap allows, the nearest kept.
+  struct NearestChild {
+    DistanceHooks& hooks;
+    Pair pair{};
+    double bound = std::numeric_limits<double>::infinity();
+    bool child(Pair&& c) {
+      if (!hooks.limit_.allows_test(hooks.trees_.counters)) return false;
+      if (const double b = hooks.evaluate(c); b < bound) {
+        bound = b;
+        pair = c;
+      }
+      return true;
+    }
+  };
+
   const TreePair<BV>& trees_;
   NearestPair& nearest_;
-  double overlapping_ = 0;  ///< bound-0 pairs admitted so far: their keys
+  const Limit& limit_;
+  /// The dives take at most about 1 / kDiveShare of the tests: the search's own lift the lower end.
+  static constexpr std::uint64_t kDiveShare = 4;
+  std::uint64_t dive_tests_ = 0;  ///< BV tests the dives spent (plus one per dive)
+  double overlapping_ = 0;        ///< bound-0 pairs admitted so far: their keys
   bool stopped_ = false;
   double unexamined_bound_ = std::numeric_limits<double>::infinity();
 };
@@ -159,7 +200,7 @@ DistanceResult run(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_t
   const TreePair<BV> trees(a, b, b_to_a, context, result.counters);
   NearestPair nearest;
   if (seed && *seed) nearer_triangles(trees, (*seed)->first, (*seed)->second, nearest);
-  DistanceHooks<BV> hooks(trees, nearest);
+  DistanceHooks<BV, Limit> hooks(trees, nearest, limit);
   traverse<BestFirst, SplitLarger>(trees, hooks, limit);
   if (seed) *seed = std::isfinite(nearest.distance) ? std::optional(nearest.leaves) : std::nullopt;
   result.distance = nearest.distance;
