@@ -70,10 +70,11 @@ bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t 
 /// its negation (BestFirst takes the highest key: the nearest pair first). Pairs whose bound is 0 (their
 /// volumes overlap) tie; among them the last admitted goes first, a positive key counting admissions: a dive
 /// to the leaves, as the exact traversal's, finds a touching pair without visiting every overlapping one.
-/// Under a budget (Limit other than Unlimited) the search also dives: at its 1st, 2nd, 4th, 8th ... pair
-/// taken, from that pair into the child of smallest bound down to a leaf pair, whose triangles bring the
-/// upper end down early. Best first alone reaches its first leaf pair only after every pair of smaller
-/// bound, which a small budget does not allow; the dives cost a few tests per level, counted and capped.
+/// Under a budget (Limit other than Unlimited) the search also dives, whenever the dives so far have spent
+/// less than a quarter of the tests: from the pair taken into the child of smallest bound down to a leaf
+/// pair, whose triangles bring the upper end down early. Best first alone reaches its first leaf pair only
+/// after every pair of smaller bound, which a small budget does not allow; the dives cost a few tests per
+/// level, counted and capped.
 template <DistanceVolume BV, class Limit = Unlimited>
 class DistanceHooks {
  public:
@@ -179,11 +180,15 @@ void check_query(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_
   TriangleLeaves::require(a, b, who);
 }
 
-/// Refuses a deadline that is negative, NaN or infinite (an unlimited budget is the caller's to judge).
+/// Refuses a deadline that is negative, NaN or infinite, and a budget that allows nothing.
 inline void check_anytime_budget(const Budget& budget) {
   if (!(budget.deadline_us >= 0) || std::isinf(budget.deadline_us))
     throw std::invalid_argument(
         "anytime distance: the deadline must be a finite number of microseconds >= 0");
+  if (budget.unlimited())
+    throw std::invalid_argument(
+        "anytime distance: the budget is 0 (no BV-test cap and no deadline); give one, or ask for the full "
+        "distance query");
 }
 
 /// The distance traversal under `limit` (Unlimited or BudgetLimit). With `seed` (a coherent query's
@@ -234,10 +239,6 @@ template <DistanceVolume BV>
 DistanceResult query_distance_anytime(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
                                       const Budget& budget) {
   distance_detail::check_anytime_budget(budget);
-  if (budget.unlimited())
-    throw std::invalid_argument(
-        "anytime distance: the budget is 0 (no BV-test cap and no deadline); give one, or ask for the full "
-        "distance query");
   distance_detail::check_query(a, b, b_to_a, "anytime distance query");
   BudgetLimit limit(budget);
   return distance_detail::run(a, b, b_to_a, limit);
@@ -277,10 +278,6 @@ DistanceResult query_distance_anytime_coherent(const Bvh<BV>& a, const Bvh<BV>& 
                                                const RigidTransform& b_to_a, const Budget& budget,
                                                CoherentState& state) {
   distance_detail::check_anytime_budget(budget);
-  if (budget.unlimited())
-    throw std::invalid_argument(
-        "anytime distance: the budget is 0 (no BV-test cap and no deadline); give one, or ask for the full "
-        "distance query");
   distance_detail::check_query(a, b, b_to_a, "coherent anytime distance query");
   BudgetLimit limit(budget);
   return distance_detail::run_coherent(a, b, b_to_a, limit, state);
