@@ -1,5 +1,6 @@
 #include "bvh/triangle_distance.hpp"
 
+#include "bvh/local_frame.hpp"
 #include "bvh/triangle_intersection.hpp"
 
 #include <algorithm>
@@ -14,66 +15,12 @@
 namespace bvhlab {
 namespace {
 
+using local_frame::accurate_cross;
+using local_frame::Frame;
+
 // Below this squared length (local coordinates, pair size ~1) a normal is no plane: the triangle or the edge
 // pair is then within 1e-70 of the vertex-edge candidates, which stand for it.
 constexpr double kTinySquared = 1e-280;
-
-// a * b - c * d within about one rounding (Kahan's scheme with fma). The plain difference cancels for nearly
-// parallel vectors, and a sliver's normal would tilt by eps / angle: its plane distances would be wrong.
-double difference_of_products(double a, double b, double c, double d) {
-  const double cd = c * d;
-  const double cd_error = std::fma(-c, d, cd);  // cd - c * d, exactly
-  return std::fma(a, b, -cd) + cd_error;
-}
-
-Vec3 accurate_cross(const Vec3& u, const Vec3& v) {
-  return {difference_of_products(u.y(), v.z(), u.z(), v.y()),
-          difference_of_products(u.z(), v.x(), u.x(), v.z()),
-          difference_of_products(u.x(), v.y(), u.y(), v.x())};
-}
-
-// Exact (barring underflow); ldexp per coordinate only where 2^exponent itself is out of range.
-Vec3 times_power_of_two(const Vec3& v, int exponent) {
-  if (exponent == 0) return v;
-  if (std::abs(exponent) <= 1000) return v * std::ldexp(1.0, exponent);
-  return {std::ldexp(v.x(), exponent), std::ldexp(v.y(), exponent), std::ldexp(v.z(), exponent)};
-}
-
-// Local coordinates y = (x 2^-pre - origin) 2^-exponent, all of magnitude below 1. Translating to p[0] keeps
-// the digits of a small pair far from the origin; the power-of-two scales are exact and keep the squares and
-// cross products of tiny or huge pairs clear of underflow and overflow. `pre` is non-zero only near overflow,
-// where the translation itself could overflow.
-struct Frame {
-  int pre = 0;
-  Vec3 origin = Vec3::Zero();
-  int exponent = 0;
-
-  static int exponent_above(double magnitude) { return magnitude > 0 ? std::ilogb(magnitude) + 1 : 0; }
-
-  // Sets the frame for the pair and returns the pair in it.
-  std::array<TrianglePoints, 2> enter(const TrianglePoints& p, const TrianglePoints& q) {
-    std::array<TrianglePoints, 2> local = {p, q};
-    double largest = 0;
-    for (const TrianglePoints& t : local)
-      for (const Vec3& v : t) largest = std::max(largest, v.cwiseAbs().maxCoeff());
-    if (largest > 0x1p1000) pre = exponent_above(largest);
-    origin = times_power_of_two(p[0], -pre);
-    double extent = 0;
-    for (TrianglePoints& t : local)
-      for (Vec3& v : t) {
-        v = times_power_of_two(v, -pre) - origin;
-        extent = std::max(extent, v.cwiseAbs().maxCoeff());
-      }
-    exponent = exponent_above(extent);
-    for (TrianglePoints& t : local)
-      for (Vec3& v : t) v = times_power_of_two(v, -exponent);
-    return local;
-  }
-  [[nodiscard]] Vec3 world(const Vec3& y) const {
-    return times_power_of_two(times_power_of_two(y, exponent) + origin, pre);
-  }
-  [[nodiscard]] double world_length(double d) const { return std::ldexp(d, exponent + pre); }
-};
 
 // A triangle with its normal. `flat` (collinear, repeated vertices, or a sliver narrower than 1e-70): no
 // plane, its edges are the point set.
