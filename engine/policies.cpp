@@ -99,6 +99,15 @@ std::string StrategyInfo::coherent_refusal() const {
   return "strategy " + name + " does not run coherent (the strategies that do: " + those + ")";
 }
 
+std::string StrategyInfo::contact_geometry_refusal() const {
+  if (needs_polygons) return "";
+  std::string those;
+  for (const StrategyInfo& s : strategy_table())
+    if (s.needs_polygons) those += (those.empty() ? "" : ", ") + s.name;
+  return "strategy " + name + " tests no triangles, so it names no contacts to give the geometry of (the " +
+         "strategies that do: " + those + ")";
+}
+
 const ParamSpec* StrategyInfo::parameter(std::string_view name) const {
   for (const ParamSpec& p : parameters)
     if (p.name == name) return &p;

@@ -42,6 +42,9 @@ struct StrategyInfo {
   /// Empty when it runs coherent; else the one message every caller gives: "strategy adb does not run
   /// coherent (the strategies that do: exact, all_contacts)".
   [[nodiscard]] std::string coherent_refusal() const;
+  /// Empty when its answers name intersecting triangle pairs (needs_polygons); else the one message every
+  /// caller gives for contact geometry asked of it.
+  [[nodiscard]] std::string contact_geometry_refusal() const;
 };
 
 /// In registration order.

@@ -102,6 +102,9 @@ void check_strategy_options(const StrategyVariant& variant) {
   if (variant.coherent)
     if (std::string refusal = strategy_info(variant.strategy).coherent_refusal(); !refusal.empty())
       throw std::invalid_argument(refusal);
+  if (variant.contact_geometry)
+    if (std::string refusal = strategy_info(variant.strategy).contact_geometry_refusal(); !refusal.empty())
+      throw std::invalid_argument(refusal);
   with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
     (void)strategy_options<S>(variant.values, variant.budget);
   });

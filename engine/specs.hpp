@@ -57,6 +57,9 @@ struct StrategyVariant {
   /// A query over a sequence of poses starts each pose where the previous one ended (traversal/coherent.hpp);
   /// only strategies that run coherent take it (StrategyInfo::coherent). Same answers, less work.
   bool coherent = false;
+  /// Each named contact also gets its geometry (Result::contact_geometry): only strategies that test
+  /// triangles take it, on trees with polygons.
+  bool contact_geometry = false;
   [[nodiscard]] std::string budget_label() const;  ///< "" or "bv_tests=200" or "deadline_us=20"
   [[nodiscard]] std::string label() const;         ///< e.g. "adb p_min=0.9", "exact coherent"
   /// The value of parameter `name`, or `fallback` when the strategy has none.

@@ -10,6 +10,7 @@
 #include "engine/refusals.hpp"
 #include "engine/registry.hpp"
 #include "engine/tree_model.hpp"
+#include "traversal/contact_geometry.hpp"
 #include "traversal/frame_budget.hpp"
 #include "traversal/strategies.hpp"
 
@@ -84,8 +85,12 @@ template <class S, class BV, class D, bool kSurfaces>
 class TypedQuery final : public PreparedQuery {
  public:
   TypedQuery(std::shared_ptr<const TypedBase<BV, D>> a, std::shared_ptr<const TypedBase<BV, D>> b,
-             typename S::Options options, bool coherent)
-      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)), coherent_(coherent) {}
+             typename S::Options options, bool coherent, bool contact_geometry = false)
+      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)), coherent_(coherent) {
+    if (contact_geometry)
+      geometry_.emplace(a_->tree.bvh.triangles(), a_->tree.bvh.triangle_ids(), b_->tree.bvh.triangles(),
+                        b_->tree.bvh.triangle_ids());
+  }
 
   void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
     if (coherent_) {
@@ -125,8 +130,12 @@ class TypedQuery final : public PreparedQuery {
       const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), pose);
       return S::query(a_->tree, b_->tree, pose, options_, leaves);
     } else {
-      return S::query(a_->tree, b_->tree, pose, options_);
+      return with_geometry(pose, S::query(a_->tree, b_->tree, pose, options_));
     }
+  }
+  Result with_geometry(const RigidTransform& pose, Result r) const {
+    if (geometry_) (*geometry_)(pose, r);
+    return r;
   }
   /// The coherent query (prepare lets coherent_ be set only for a strategy that has one).
   [[gnu::noinline]] Result query(const RigidTransform& pose, CoherentState& state) const {
@@ -136,12 +145,13 @@ class TypedQuery final : public PreparedQuery {
       const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), pose);
       return S::query_coherent(a_->tree, b_->tree, pose, options_, state, leaves);
     } else {
-      return S::query_coherent(a_->tree, b_->tree, pose, options_, state);
+      return with_geometry(pose, S::query_coherent(a_->tree, b_->tree, pose, options_, state));
     }
   }
   std::shared_ptr<const TypedBase<BV, D>> a_, b_;
   typename S::Options options_;
   bool coherent_ = false;
+  std::optional<ContactGeometryMaker> geometry_;  ///< when the variant asks for the contacts' geometry
 };
 
 /// A typed tree, of a mesh or of a point cloud (then with its surface): what a query needs of either.
@@ -232,7 +242,11 @@ struct TypedBase : TreeModel {
     auto options = strategy_options<S>(variant.values, variant.budget);
     if (variant.coherent && !kRunsCoherent<S>)
       throw std::invalid_argument(strategy_info(variant.strategy).coherent_refusal());
+    if (variant.contact_geometry && !S::needs_polygons)
+      throw std::invalid_argument(strategy_info(variant.strategy).contact_geometry_refusal());
     if (side().is_cloud() || b->side().is_cloud()) {
+      if (variant.contact_geometry)
+        throw std::invalid_argument("contact geometry needs triangles; a point cloud's tree has none");
       if constexpr (kCloudDensity<D>)
         return prepare_points<S>(std::move(a), std::move(b), std::move(options), variant);
       else
@@ -244,7 +258,7 @@ struct TypedBase : TreeModel {
           " tests triangles, and a tree was loaded without polygons (load it with its "
           "mesh)");
     return std::make_unique<TypedQuery<S, BV, D, false>>(std::move(a), std::move(b), std::move(options),
-                                                         variant.coherent);
+                                                         variant.coherent, variant.contact_geometry);
   }
 
   /// S with the surface test, after SurfaceLeaves' checks of the two sides (so running cannot fail).

@@ -73,6 +73,7 @@ RigidTransform pose_from(const py::object& pose, const py::object& rotation, con
 
 struct QueryResult {
   Result result;
+  bool geometry_asked = false;
   py::object witness() const {
     if (!result.witness) return py::none();
     return py::make_tuple(result.witness->a, result.witness->b);
@@ -107,6 +108,29 @@ struct QueryResult {
     if (!result.proximity || !result.proximity->triangles) return py::none();
     return py::make_tuple(result.proximity->triangles->a, result.proximity->triangles->b);
   }
+  /// Per named contact: its triangles, segment, midpoint, normal and whether it is an area contact.
+  py::object contact_geometry() const {
+    if (!geometry_asked) return py::none();
+    const auto k = static_cast<py::ssize_t>(result.contact_geometry.size());
+    py::array_t<std::int64_t> triangles({k, py::ssize_t{2}});
+    py::array_t<double> segments({k, py::ssize_t{2}, py::ssize_t{3}}), points({k, py::ssize_t{3}}),
+        normals({k, py::ssize_t{3}});
+    py::array_t<bool> coplanar(k);
+    for (py::ssize_t i = 0; i < k; ++i) {
+      const ContactGeometry& g = result.contact_geometry[static_cast<std::size_t>(i)];
+      triangles.mutable_at(i, 0) = g.triangles.a;
+      triangles.mutable_at(i, 1) = g.triangles.b;
+      for (py::ssize_t c = 0; c < 3; ++c) {
+        segments.mutable_at(i, 0, c) = g.from[c];
+        segments.mutable_at(i, 1, c) = g.to[c];
+        points.mutable_at(i, c) = g.point[c];
+        normals.mutable_at(i, c) = g.normal[c];
+      }
+      coplanar.mutable_at(i) = g.coplanar;
+    }
+    return py::dict(py::arg("triangles") = triangles, py::arg("segments") = segments,
+                    py::arg("points") = points, py::arg("normals") = normals, py::arg("coplanar") = coplanar);
+  }
   py::dict counters() const {
     const Counters& c = result.counters;
     return py::dict(py::arg("bv_tests") = c.bv_tests, py::arg("triangle_tests") = c.triangle_tests,
@@ -117,12 +141,15 @@ struct QueryResult {
 
 QueryResult query(const AnyTree& a, const AnyTree& b, const py::object& pose, const py::object& rotation,
                   const py::object& translation, const std::string& strategy, long long bv_tests,
-                  double deadline_us, const py::kwargs& parameters) {
-  const StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
+                  double deadline_us, bool contact_geometry, const py::kwargs& parameters) {
+  StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
+  variant.contact_geometry = contact_geometry;
+  check_strategy_options(variant);
   const RigidTransform checked = pose_from(pose, rotation, translation);
   check_same_kind_of_units(a.info(), b.info());
   const std::unique_ptr<PreparedQuery> prepared = a.prepare(b, variant);
   QueryResult out;
+  out.geometry_asked = contact_geometry;
   py::gil_scoped_release release;
   prepared->run({&checked, 1}, [&](std::size_t, const Result& r) { out.result = r; });
   return out;
@@ -295,6 +322,12 @@ void bind_queries(py::module_& m) {
                              "(2, 3): the closest points on A and on B, in A's frame; or None")
       .def_property_readonly("nearest", &QueryResult::nearest,
                              "(triangle of A, triangle of B) the points lie on, as mesh indices, or None")
+      .def_property_readonly(
+          "contact_geometry", &QueryResult::contact_geometry,
+          "with contact_geometry=True, per contact (all_contacts) or for the witness: a dict of arrays "
+          "triangles (K, 2), segments (K, 2, 3: where the two triangles meet), points (K, 3: the segments' "
+          "midpoints), normals (K, 3: unit, from A into B) and coplanar (K,: they meet in an area), in A's "
+          "frame; None when not asked for")
       .def_property_readonly("counters", &QueryResult::counters)
       .def("__repr__", [](const QueryResult& q) {
         return std::string("<bvhlab.Result collides=") + (q.result.collides ? "True" : "False") +
@@ -309,10 +342,11 @@ void bind_queries(py::module_& m) {
       "frame.";
   m.def("query", &query, py::arg("a"), py::arg("b"), py::arg("pose") = py::none(), py::kw_only(),
         py::arg("rotation") = py::none(), py::arg("translation") = py::none(), py::arg("strategy") = "exact",
-        py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0,
+        py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0, py::arg("contact_geometry") = false,
         (std::string(
              "One query between trees a and b at one pose: a 4 x 4 rigid matrix, or translation (3) and "
-             "rotation (3 x 3, default identity); a query without either is refused.") +
+             "rotation (3 x 3, default identity); a query without either is refused. contact_geometry=True "
+             "adds Result.contact_geometry (strategies that test triangles).") +
          strategy_help)
             .c_str());
   m.def(

@@ -43,6 +43,16 @@ struct Proximity {
   std::optional<TrianglePair> triangles;  ///< empty when no triangle pair was reached
 };
 
+/// Where an intersecting triangle pair meets (bvh/triangle_contact.hpp), in A's frame: the segment common to
+/// both triangles (from == to at a single point), its midpoint, and a unit normal from A into B (the
+/// difference of the two faces' normals, whose sides the vertex order decides). Penetration depth is not
+/// measured.
+struct ContactGeometry {
+  TrianglePair triangles;
+  std::array<double, 3> from{}, to{}, point{}, normal{};
+  bool coplanar = false;  ///< the triangles overlap in an area; from and to are its two farthest corners
+};
+
 struct Result {
   bool collides = false;
   /// Estimated probability of collision; exactly 1 or 0 when `exact`.
@@ -58,6 +68,9 @@ struct Result {
   std::optional<TrianglePair> witness;  ///< set by exact strategies when collides
   std::vector<TrianglePair> contacts;   ///< all-contacts mode only
   std::optional<Proximity> proximity;   ///< the distance strategies only
+  /// Asked for (StrategyVariant::contact_geometry): one entry per contact in all-contacts mode, else one for
+  /// the witness, if any.
+  std::vector<ContactGeometry> contact_geometry;
   Counters counters;
 };
 

@@ -27,7 +27,7 @@ struct QueryArgs {
   std::string a, b, pose, protocol, poses_file, bv = "aabb", strategy = "exact", cache, density, cloud;
   double deadline = 0, bv_tests = 0;
   int repeat = 0;
-  bool all = false, json = false, normalize = false, no_cache = false, coherent = false;
+  bool all = false, json = false, normalize = false, no_cache = false, coherent = false, geometry = false;
   ParameterOptions parameters;
   const CLI::Option* bv_option = nullptr;
   const CLI::Option* strategy_option = nullptr;
@@ -112,6 +112,8 @@ void refuse_cloud_options(const QueryArgs& args) {
     throw CLI::ValidationError("--cache/--no-cache", "trees over clouds are not cached; it does not apply");
   if (args.bv.rfind("fcl_", 0) == 0)
     throw CLI::ValidationError("--bv", "FCL hierarchies hold no point clouds; give a bvhlab volume");
+  if (args.geometry)
+    throw CLI::ValidationError("--contact-geometry", "a point cloud has no triangles to meet in a segment");
 }
 
 /// Whether A and B are saved trees (else meshes); refuses one of each.
@@ -201,6 +203,15 @@ QueryRequest query_request(const QueryArgs& args, bool trees) {
     if (args.bv.rfind("fcl_", 0) == 0)
       throw CLI::ValidationError("--coherent", "FCL hierarchies do not run coherent; give a bvhlab volume");
   }
+  request.strategy.contact_geometry = args.geometry;
+  if (args.geometry) {
+    if (std::string refusal = strategy.contact_geometry_refusal(); !refusal.empty())
+      throw CLI::ValidationError("--contact-geometry", refusal);
+    if (args.bv.rfind("fcl_", 0) == 0)
+      throw CLI::ValidationError("--contact-geometry",
+                                 "FCL hierarchies give no contact geometry here; give a "
+                                 "bvhlab volume");
+  }
   request.repeat = args.repeat;
   return request;
 }
@@ -284,6 +295,15 @@ nlohmann::json proximity_json(const Proximity& p) {
   return j;
 }
 
+nlohmann::json geometry_json(const ContactGeometry& g) {
+  return {{"triangles", {g.triangles.a, g.triangles.b}},
+          {"from", g.from},
+          {"to", g.to},
+          {"point", g.point},
+          {"normal", g.normal},
+          {"coplanar", g.coplanar}};
+}
+
 nlohmann::json answer_json(const PoseAnswer& answer, bool all_contacts) {
   const Result& r = answer.result;
   nlohmann::json j = {{"collides", r.collides},
@@ -306,6 +326,10 @@ nlohmann::json answer_json(const PoseAnswer& answer, bool all_contacts) {
     for (const auto& c : r.contacts) j["contacts"].push_back({c.a, c.b});
   }
   if (r.proximity) j["distance"] = proximity_json(*r.proximity);
+  if (!r.contact_geometry.empty()) {
+    j["contact_geometry"] = nlohmann::json::array();
+    for (const ContactGeometry& g : r.contact_geometry) j["contact_geometry"].push_back(geometry_json(g));
+  }
   return j;
 }
 
@@ -341,6 +365,13 @@ void print_proximity(const Proximity& p) {
   std::printf("  point on B        %.17g %.17g %.17g (in A's frame)\n", p.on_b[0], p.on_b[1], p.on_b[2]);
 }
 
+void print_geometry(const std::vector<ContactGeometry>& geometry, const char* indent) {
+  for (const ContactGeometry& g : geometry)
+    std::printf("%striangles %u %u: %s %.9g %.9g %.9g to %.9g %.9g %.9g, normal %.6g %.6g %.6g\n", indent,
+                g.triangles.a, g.triangles.b, g.coplanar ? "coplanar, across" : "segment", g.from[0],
+                g.from[1], g.from[2], g.to[0], g.to[1], g.to[2], g.normal[0], g.normal[1], g.normal[2]);
+}
+
 void print_answer(const PoseAnswer& answer, bool all_contacts, bool counters) {
   const Result& r = answer.result;
   std::printf("  collides          %s\n  probability       %g\n  exact             %s\n",
@@ -356,6 +387,10 @@ void print_answer(const PoseAnswer& answer, bool all_contacts, bool counters) {
     for (const auto& c : r.contacts) std::printf("    %u %u\n", c.a, c.b);
   }
   if (r.proximity) print_proximity(*r.proximity);
+  if (!r.contact_geometry.empty()) {
+    std::printf("  contact geometry  in A's frame, normals from A into B:\n");
+    print_geometry(r.contact_geometry, "    ");
+  }
   print_times(answer);
   if (counters)
     std::printf("  BV tests          %ju\n  triangle tests    %ju\n  nodes visited     %ju\n",
@@ -381,6 +416,7 @@ void print_table(const QueryRun& run, bool all_contacts, bool repeat) {
     if (all_contacts) std::printf("  %8zu", r.contacts.size());
     if (r.proximity) std::printf("  %12.9g  %12.9g", r.proximity->distance, r.proximity->lower_bound);
     std::printf("\n");
+    print_geometry(r.contact_geometry, "          ");
   }
 }
 
@@ -485,6 +521,9 @@ Command add_query_command(CLI::App& app) {
                   "Start each pose where the previous one ended (less work on poses close to each other; "
                   "traversal/README.md, \"Coherent queries\"): the poses of --poses or a --protocol turn in "
                   "order, and each --repeat pass");
+  query->add_flag("--contact-geometry", args->geometry,
+                  "Also give each contact's geometry: the segment where its two triangles meet, its midpoint "
+                  "and a normal from A into B (in A's frame; no penetration depth)");
   query->add_flag("--normalize", args->normalize,
                   "Apply the protocol normalisation to each mesh (centre to the origin, longest side 2); "
                   "default: the mesh files' own units");

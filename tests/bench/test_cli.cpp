@@ -342,6 +342,34 @@ TEST_F(Cli, DistanceAndToleranceAnswerWithTheirPoints) {
   EXPECT_LE(anytime["distance"]["lower_bound"].get<double>(), 2.0) << anytime;
 }
 
+TEST_F(Cli, ContactGeometryGivesEachContactItsSegment) {
+  // B, the unit cube moved by (0.5, 0.2, 0.1), overlaps A in [0, 0.5] x [-0.3, 0.5] x [-0.4, 0.5].
+  const nlohmann::json j = nlohmann::json::parse(
+      ok("query small.obj small.obj --pose 0.5,0.2,0.1 --all-contacts --contact-geometry --json").out);
+  ASSERT_GT(j["contacts"].size(), 0u) << j;
+  ASSERT_EQ(j["contact_geometry"].size(), j["contacts"].size()) << j;
+  for (std::size_t k = 0; k < j["contacts"].size(); ++k) {
+    const nlohmann::json& g = j["contact_geometry"][k];
+    EXPECT_EQ(g["triangles"], j["contacts"][k]);
+    for (const char* end : {"from", "to", "point"}) {
+      const auto p = g[end].get<std::array<double, 3>>();
+      for (int c = 0; c < 3; ++c) {
+        const double low = std::array{0.0, -0.3, -0.4}[c];
+        EXPECT_GE(p[c], low - 1e-12) << g;
+        EXPECT_LE(p[c], 0.5 + 1e-12) << g;
+      }
+    }
+    const auto n = g["normal"].get<std::array<double, 3>>();
+    EXPECT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1, 1e-12) << g;
+  }
+  const std::string text = ok("query small.obj small.obj --pose 0.5,0.2,0.1 --contact-geometry").out;
+  EXPECT_NE(text.find("  contact geometry  in A's frame"), std::string::npos) << text;
+  expect_refused("query small.obj small.obj --pose 0.5,0,0 --strategy adb --contact-geometry",
+                 "strategy adb tests no triangles");
+  expect_refused("query small.obj small.obj --pose 0.5,0,0 --bv fcl_obb --contact-geometry",
+                 "FCL hierarchies give no contact geometry");
+}
+
 TEST_F(Cli, PoseListsAreQueriedInOrder) {
   testing::write_text(dir / "poses.txt",
                       "# a pose per line\n0.5 0 0\n\n3,0,0\n0.9 0 0 0 0 1 45\n1 0 0 0  0 1 0 0  0 0 1 0\n");

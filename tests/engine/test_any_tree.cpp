@@ -2,6 +2,7 @@
 // as the same tree, every check happens before a pose is queried, and every registry names an unknown
 // choice the same way.
 #include "adb/update.hpp"
+#include "bvh/triangle_distance.hpp"
 #include "engine/any_tree.hpp"
 #include "engine/policies.hpp"
 #include "support/errors.hpp"
@@ -163,6 +164,59 @@ TEST(AnyTree, TheDistanceStrategiesRefuseAVolumeWithoutADistanceBound) {
             std::string::npos);
   EXPECT_NE(error_of([] { (void)strategy_variant("distance_anytime", {}, Budget{}); }).find("needs a budget"),
             std::string::npos);
+}
+
+/// How far `p` lies from triangle `t` (a point is a degenerate triangle).
+double gap(const std::array<double, 3>& p, const TrianglePoints& t) {
+  const Vec3 v(p[0], p[1], p[2]);
+  return triangle_distance({v, v, v}, t).distance;
+}
+
+TEST(AnyTree, ContactGeometryLiesOnBothTrianglesOfEachContact) {
+  const Mesh torus = testing::make_torus(0.7, 0.25, 24, 12);
+  const AnyTree a = AnyTree::build(torus, MeshUnits{}, "obb", density_spec("none", {}), BuildOptions{});
+  StrategyVariant all = strategy_variant("all_contacts", {}, Budget{});
+  StrategyVariant first = StrategyVariant{};
+  all.contact_geometry = first.contact_geometry = true;
+  const auto poses = poses_along_x();
+  const auto plain = results_of(a, a, strategy_variant("all_contacts", {}, Budget{}), poses);
+  const auto listed = results_of(a, a, all, poses);
+  const auto witnessed = results_of(a, a, first, poses);
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    EXPECT_TRUE(plain[i].contact_geometry.empty()) << i;  // only when asked for
+    ASSERT_EQ(listed[i].contacts, plain[i].contacts) << i;
+    ASSERT_EQ(listed[i].contact_geometry.size(), listed[i].contacts.size()) << i;
+    ASSERT_EQ(witnessed[i].contact_geometry.size(), witnessed[i].witness ? 1u : 0u) << i;
+    if (witnessed[i].witness) {
+      EXPECT_EQ(witnessed[i].contact_geometry[0].triangles, *witnessed[i].witness);
+    }
+    for (std::size_t k = 0; k < listed[i].contacts.size(); ++k) {
+      const ContactGeometry& g = listed[i].contact_geometry[k];
+      ASSERT_EQ(g.triangles, listed[i].contacts[k]);
+      const TrianglePoints ta = torus.triangle(g.triangles.a);
+      const TrianglePoints source = torus.triangle(g.triangles.b);
+      const TrianglePoints tb = {poses[i].apply(source[0]), poses[i].apply(source[1]),
+                                 poses[i].apply(source[2])};
+      for (const auto& end : {g.from, g.to, g.point}) {
+        EXPECT_LE(gap(end, ta), 1e-12) << i << " " << k;
+        EXPECT_LE(gap(end, tb), 1e-12) << i << " " << k;
+      }
+      const Vec3 n(g.normal[0], g.normal[1], g.normal[2]);
+      EXPECT_NEAR(n.norm(), 1, 1e-12) << i << " " << k;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100u);  // the poses cross the torus: many contacts are checked
+}
+
+TEST(AnyTree, ContactGeometryIsRefusedWhereNoTrianglesMeet) {
+  const AnyTree adb = torus_tree("aabb", "adb");
+  StrategyVariant estimate = strategy_variant("adb", {}, Budget{});
+  estimate.contact_geometry = true;
+  const std::string message = error_of([&] { check_strategy_options(estimate); });
+  EXPECT_EQ(message.rfind("strategy adb tests no triangles", 0), 0u) << message;
+  EXPECT_EQ(error_of([&] { (void)adb.prepare(adb, estimate); }), message);
 }
 
 TEST(AnyTree, AFrameBudgetRunsOnOneTypeOfTreesWithProbabilities) {

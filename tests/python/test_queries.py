@@ -182,6 +182,29 @@ def test_distances_follow_the_geometry(cube_trees):
     assert bvhlab.query(tree, tree, translation=[3, 0, 0]).distance is None
 
 
+def test_contact_geometry_lies_where_the_cubes_meet(cube_trees):
+    """Unit cubes half overlapping: every contact's segment lies in the overlap box, its normal is unit."""
+    tree = cube_trees[("aabb", "none")]
+    shift = np.array([0.5, 0.2, 0.1])
+    r = bvhlab.query(tree, tree, translation=shift, strategy="all_contacts", contact_geometry=True)
+    g = r.contact_geometry
+    k = len(r.contacts)
+    assert k > 0 and g["triangles"].shape == (k, 2) and g["segments"].shape == (k, 2, 3)
+    np.testing.assert_array_equal(g["triangles"], r.contacts)
+    low, high = np.maximum(-0.5, shift - 0.5), np.minimum(0.5, shift + 0.5)
+    for points in (g["segments"][:, 0], g["segments"][:, 1], g["points"]):
+        assert (points >= low - 1e-12).all() and (points <= high + 1e-12).all()
+    np.testing.assert_allclose(g["points"], g["segments"].mean(axis=1), atol=1e-15)
+    np.testing.assert_allclose(np.linalg.norm(g["normals"], axis=1), 1, atol=1e-12)
+    first = bvhlab.query(tree, tree, translation=shift, contact_geometry=True)
+    assert first.contact_geometry["triangles"].tolist() == [list(first.witness)]
+    assert bvhlab.query(tree, tree, translation=shift).contact_geometry is None
+    assert len(bvhlab.query(tree, tree, translation=[3, 0, 0], contact_geometry=True).contact_geometry["points"]) == 0
+    with pytest.raises(ValueError, match="strategy adb tests no triangles"):
+        adb = cube_trees[("aabb", "adb")]
+        bvhlab.query(adb, adb, translation=shift, strategy="adb", contact_geometry=True)
+
+
 def test_budget_is_kept(gear_trees):
     tree = gear_trees["adb"]
     poses = bvhlab.protocol_poses(1.6, 40)
