@@ -23,7 +23,6 @@
 #ifdef BVHLAB_HAVE_FCL
 #include "bench/core/fcl_model.hpp"
 
-#include <fcl/narrowphase/distance.h>
 #endif
 
 #include <algorithm>
@@ -157,14 +156,6 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
 
 #ifdef BVHLAB_HAVE_FCL
 template <class FclBV>
-double fcl_distance(const fcl::BVHModel<FclBV>& model, const RigidTransform& pose) {
-  const fcl::DistanceRequestd request(true);  // nearest points too, as bvhlab computes them
-  fcl::DistanceResultd result;
-  fcl::distance(&model, fcl::Transform3d::Identity(), &model, fcl_transform(pose), request, result);
-  return std::max(result.min_distance, 0.0);  // FCL answers -1 for intersecting models
-}
-
-template <class FclBV>
 void register_fcl(const std::string& mesh_name, const std::string& bv_name,
                   const std::shared_ptr<const Mesh>& mesh, const std::vector<PoseSet>& sets) {
   const auto model = make_fcl_model<FclBV>(*mesh);
@@ -174,7 +165,7 @@ void register_fcl(const std::string& mesh_name, const std::string& bv_name,
       double sum = 0;
       for (auto _ : state) {
         sum = 0;
-        for (const auto& pose : set.poses) sum += fcl_distance(*model, pose);
+        for (const auto& pose : set.poses) sum += fcl_distance(*model, *model, pose).distance;
         benchmark::DoNotOptimize(sum);
       }
       set_counters(state, set.poses.size(), {}, sum);
@@ -215,7 +206,8 @@ int main(int argc, char** argv) {
 #ifdef BVHLAB_HAVE_FCL
     const auto reference = make_fcl_model<fcl::OBBRSSd>(*mesh);
     for (auto& set : sets)
-      for (const auto& pose : set.poses) set.reference.push_back(fcl_distance(*reference, pose));
+      for (const auto& pose : set.poses)
+        set.reference.push_back(fcl_distance(*reference, *reference, pose).distance);
 #endif
     for (const auto& v : volumes) {
       // The RSS is not registered yet (volumes/shipped.hpp): selected here by name.

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <span>
 #include <string>
 #include <string_view>
@@ -93,6 +94,14 @@ struct ResultRow {
   /// report's bootstrap intervals resample them (not written to results.csv).
   std::vector<double> pose_times_us;
   double model_bytes = 0, bytes_per_triangle = 0;  ///< of one object's tree (A's)
+  /// Distance series (results with an interval [lower_bound, distance]) against each pose's reference
+  /// distance: the first exact distance series of the plan, bvhlab's before FCL's. NaN for other series,
+  /// or when the scene runs no exact distance series.
+  double distance_error = kNoValue;  ///< max over poses of |distance - reference| / reference (absolute at 0)
+  double width_median = kNoValue;    ///< median over poses apart of (distance - lower_bound) / reference
+  double width_tenth_rate = kNoValue;  ///< poses apart whose interval is at most a tenth of the reference
+  std::size_t interval_misses = 0;     ///< poses whose reference lies outside the interval beyond rounding
+  static constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// One probability bin of one ADB-type series, over all its distances.

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -29,6 +30,9 @@ struct QueryRecord {
   bool collides = false, exact = true, budget_exhausted = false;
   double probability = 0, micros = 0;
   Counters counters;
+  /// The distance strategies' interval [lower_bound, distance] (Result::proximity); NaN for the others.
+  double distance = std::numeric_limits<double>::quiet_NaN();
+  double lower_bound = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The timing loop: `warmup` untimed queries through `warm_up`, then each pose timed on its own through
@@ -45,8 +49,13 @@ void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector
     const auto start = Clock::now();
     const Result r = query(pose);
     const auto stop = Clock::now();
-    out.push_back({r.collides, r.exact, r.budget_exhausted, r.probability,
-                   std::chrono::duration<double, std::micro>(stop - start).count(), r.counters});
+    QueryRecord& record = out.emplace_back(
+        QueryRecord{r.collides, r.exact, r.budget_exhausted, r.probability,
+                    std::chrono::duration<double, std::micro>(stop - start).count(), r.counters});
+    if (r.proximity) {
+      record.distance = r.proximity->distance;
+      record.lower_bound = r.proximity->lower_bound;
+    }
   }
   if (sink && out.empty()) std::fputc(' ', stderr);  // keeps the warm-up from being optimised away
 }

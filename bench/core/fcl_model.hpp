@@ -1,7 +1,7 @@
 // FCL's side of the benchmarks and tests: a BVHModel built from a bvhlab Mesh, a pose as an FCL transform,
-// FCL's first-contact answer, and FCL's broad-phase managers over the instances of a world scene. The one
-// place the bench and the tests hand a mesh to the peer. Include only where FCL is found (BVHLAB_HAVE_FCL,
-// or a target that links fcl).
+// FCL's first-contact answer and distance, and FCL's broad-phase managers over the instances of a world
+// scene. The one place the bench and the tests hand a mesh to the peer. Include only where FCL is found
+// (BVHLAB_HAVE_FCL, or a target that links fcl).
 #pragma once
 
 #include "../../bvh/mesh.hpp"
@@ -11,6 +11,7 @@
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/distance.h>
 
 #include <algorithm>
 #include <array>
@@ -68,6 +69,21 @@ bool fcl_collides(const fcl::BVHModel<FclBV>& a, const fcl::BVHModel<FclBV>& b,
   fcl::CollisionResultd result;
   fcl::collide(&a, fcl::Transform3d::Identity(), &b, fcl_transform(b_to_a), request, result);
   return result.isCollision();
+}
+
+/// FCL's distance between A and B placed in A's frame by `b_to_a`, with its nearest points (in A's frame, as
+/// A sits at the identity); 0 when they intersect, as bvhlab answers (FCL says -1 then).
+struct FclDistance {
+  double distance;
+  Vec3 on_a, on_b;
+};
+template <class FclBV>
+FclDistance fcl_distance(const fcl::BVHModel<FclBV>& a, const fcl::BVHModel<FclBV>& b,
+                         const RigidTransform& b_to_a) {
+  const fcl::DistanceRequestd request(true);  // nearest points too, as bvhlab computes them
+  fcl::DistanceResultd result;
+  fcl::distance(&a, fcl::Transform3d::Identity(), &b, fcl_transform(b_to_a), request, result);
+  return {std::max(result.min_distance, 0.0), result.nearest_points[0], result.nearest_points[1]};
 }
 
 /// FCL's broad phase over the instances of a world: one CollisionObject per instance (copies of a mesh share

@@ -58,12 +58,11 @@ bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec&
   for (std::size_t k = 0, m = hs.array_size(); k < m; ++k) {
     if (skipped(hs.child(k).string())) continue;
     const std::string name = hs.child(k).choice(names);
-    if (scene.hierarchy(name)->is_fcl() && !runs_on_fcl(spec))
-      hs.child(k).fail("\"" + spec.name + "\"" + (spec.coherent ? " coherent" : "") +
-                       " needs a bvhlab hierarchy; FCL hierarchies run \"exact\" only, not coherent");
-    if (const HierarchySpec& h = *scene.hierarchy(name); !h.is_fcl())
-      if (std::string refusal = strategy_info(spec.name).volume_refusal(h.bv); !refusal.empty())
-        hs.child(k).fail(refusal);
+    if (const HierarchySpec& h = *scene.hierarchy(name); h.is_fcl()) {
+      if (std::string refusal = fcl_refusal(spec, h.bv); !refusal.empty()) hs.child(k).fail(refusal);
+    } else if (std::string refusal = strategy_info(spec.name).volume_refusal(h.bv); !refusal.empty()) {
+      hs.child(k).fail(refusal);
+    }
     spec.hierarchies.push_back(name);
   }
   return !spec.hierarchies.empty();
@@ -108,8 +107,8 @@ std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Sk
   if (std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
                    [&](const HierarchySpec& h) { return scene.applies(spec, h); }))
     s.fail("\"" + spec.name +
-           "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\" only, not "
-           "coherent)");
+           "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\", and fcl_obbrss "
+           "\"distance\", not coherent)");
   checked(s, [&] {
     for (const StrategyVariant& v : expand(spec)) check_strategy_options(v);
     return 0;
@@ -235,15 +234,19 @@ const HierarchySpec* Scene::hierarchy(std::string_view name) const {
   return nullptr;
 }
 
-bool runs_on_fcl(const StrategySpec& s) {
-  return s.name == kExactStrategyName && !s.coherent;
+std::string fcl_refusal(const StrategySpec& s, std::string_view fcl_bv) {
+  const bool runs =
+      !s.coherent && (s.name == kExactStrategyName || (s.name == "distance" && fcl_bv == "fcl_obbrss"));
+  if (runs) return "";
+  return "\"" + s.name + "\"" + (s.coherent ? " coherent" : "") + " does not run on " + std::string(fcl_bv) +
+         ": FCL hierarchies run \"exact\", and fcl_obbrss \"distance\", not coherent";
 }
 
 bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
   if (!s.hierarchies.empty() &&
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
-  if (h.is_fcl()) return runs_on_fcl(s);
+  if (h.is_fcl()) return fcl_refusal(s, h.bv).empty();
   return strategy_info(s.name).volume_refusal(h.bv).empty();  // e.g. distance on a volume without a bound
 }
 

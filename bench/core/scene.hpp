@@ -203,8 +203,9 @@ struct TimingSpec {
 };
 const char* statistic_name(TimingSpec::Statistic statistic);
 
-/// Whether `s` runs on FCL hierarchies: exact first contact, not coherent.
-bool runs_on_fcl(const StrategySpec& s);
+/// Empty when `s` runs on the FCL hierarchy of volume `fcl_bv`: exact first contact on both, distance on
+/// fcl_obbrss (FCL's OBB has no distance), never coherent; else the one message every caller gives.
+std::string fcl_refusal(const StrategySpec& s, std::string_view fcl_bv);
 
 struct Scene {
   std::string name;

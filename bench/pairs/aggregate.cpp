@@ -4,6 +4,7 @@
 #include "engine/policies.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace bvhlab {
@@ -32,6 +33,49 @@ ResultRow series_row(const std::string& label, const HierarchySpec& h, const Mod
   return row;
 }
 
+/// Per pose of the slice, the reference distance: the first exact distance series of the plan, bvhlab's
+/// before FCL's; empty when there is none.
+std::vector<double> reference_distances(const RunPlan& plan, const PoseSlice& slice,
+                                        const PairRecords& records) {
+  for (const bool fcl : {false, true})
+    for (std::size_t i = 0; i < plan.hierarchies.size(); ++i) {
+      if (plan.hierarchies[i].hierarchy->is_fcl() != fcl) continue;
+      for (std::size_t v = 0; v < plan.hierarchies[i].variants.size(); ++v) {
+        const StrategyVariant& variant = plan.hierarchies[i].variants[v];
+        if (!strategy_info(variant.strategy).exact || slice.poses.empty()) continue;
+        const auto& [g0, k0] = slice.poses.front();
+        if (std::isnan(records[g0][i][v][k0].distance)) continue;
+        std::vector<double> out;
+        for (const auto& [g, k] : slice.poses) out.push_back(records[g][i][v][k].distance);
+        return out;
+      }
+    }
+  return {};
+}
+
+/// A distance series' intervals against the reference (ResultRow::distance_error and what follows it).
+void tally_distances(const std::vector<QueryRecord>& records, const std::vector<double>& reference,
+                     ResultRow& row) {
+  if (records.empty() || reference.empty() || std::isnan(records.front().distance)) return;
+  constexpr double kRounding = 1e-9;  // relative: what two exact computations of one distance may differ by
+  double error = 0;
+  std::vector<double> widths;
+  std::size_t tenth = 0;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const double truth = reference[k], upper = records[k].distance, lower = records[k].lower_bound;
+    error = std::max(error, std::fabs(upper - truth) / (truth > 0 ? truth : 1));
+    const double slack = kRounding * truth;
+    row.interval_misses += lower > truth + slack || upper < truth - slack;
+    if (truth <= 0) continue;
+    widths.push_back((upper - lower) / truth);
+    tenth += upper - lower <= 0.1 * truth;
+  }
+  row.distance_error = error;
+  if (widths.empty()) return;
+  row.width_median = report_tables::median(widths);
+  row.width_tenth_rate = double(tenth) / double(widths.size());
+}
+
 }  // namespace
 
 TruthSummary summarize_truth(const std::string& label, const PoseSlice& slice, const Truth& truth) {
@@ -45,6 +89,7 @@ void Aggregation::add_slice(const PreparedPair& pair, const RunPlan& plan, const
                             const SeriesMaps& maps) {
   std::vector<std::uint8_t> slice_truth;
   for (const auto& [g, k] : slice.poses) slice_truth.push_back(truth[g][k]);
+  const std::vector<double> reference = reference_distances(plan, slice, records);
   std::vector<QueryRecord> slice_records;
   for (std::size_t i = 0; i < plan.hierarchies.size(); ++i) {
     const HierarchySpec& h = *plan.hierarchies[i].hierarchy;
@@ -56,6 +101,7 @@ void Aggregation::add_slice(const PreparedPair& pair, const RunPlan& plan, const
       ResultRow row = series_row(pair.label, h, hierarchy.model, variant, slice.distance);
       const std::string key = pair.label + "\x1f" + h.name + "\x1f" + variant.label();
       tally(slice_records, slice_truth, key, hierarchy.has_counters(), row, output.stats);
+      tally_distances(slice_records, reference, row);
       const CalibrationBin series{pair.label, h.name, row.strategy, row.budget, row.p_min};
       if (!row.exact_strategy) register_series(key, series);
       if (i < maps.size() && v < maps[i].size() && maps[i][v]) {

@@ -351,9 +351,17 @@ void readme_calibration(std::ostream& md, const RunOutput& run) {
   md << ".\n\n";
 }
 
+/// Which series a per-distance table lists.
+enum class Listed { all, inexact, distances, anytime_distances };
+
+/// Whether a row measures a distance (ResultRow::distance_error is set).
+bool measures_distance(const ResultRow& r) {
+  return !std::isnan(r.distance_error);
+}
+
 /// One table of a value per series (rows) and distance (columns).
 void per_distance_table(std::ostream& md, const RunOutput& run, const std::vector<double>& distances,
-                        const std::string& title, bool inexact_only,
+                        const std::string& title, Listed listed,
                         const std::function<std::string(const ResultRow&)>& cell) {
   md << "## " << title << "\n\n| mesh | hierarchy | strategy |";
   for (double d : distances) md << " d=" << fmt("%g", d) << " |";
@@ -361,27 +369,60 @@ void per_distance_table(std::ostream& md, const RunOutput& run, const std::vecto
   for (std::size_t i = 0; i < distances.size(); ++i) md << "---:|";
   md << "\n";
   for (const auto& s : summarize(run.rows, -1e300, 1e300)) {
-    if (inexact_only && s.exact_strategy) continue;
+    if (listed == Listed::inexact && s.exact_strategy) continue;
+    std::vector<const ResultRow*> rows(distances.size(), nullptr);
+    for (const auto& r : run.rows)
+      for (std::size_t i = 0; i < distances.size(); ++i)
+        if (r.distance == distances[i] && r.mesh == s.mesh && r.hierarchy == s.hierarchy &&
+            r.strategy == s.strategy && r.p_min == s.p_min && r.budget == s.budget && r.label == s.label)
+          rows[i] = &r;
+    const bool distance =
+        std::any_of(rows.begin(), rows.end(), [](auto* r) { return r && measures_distance(*r); });
+    if ((listed == Listed::distances || listed == Listed::anytime_distances) && !distance) continue;
+    if (listed == Listed::anytime_distances && s.exact_strategy) continue;
     md << "| " << table_cell(s.mesh) << " | " << s.hierarchy << " | " << series_name(s) << " |";
-    for (double d : distances) {
-      const ResultRow* row = nullptr;
-      for (const auto& r : run.rows)
-        if (r.distance == d && r.mesh == s.mesh && r.hierarchy == s.hierarchy && r.strategy == s.strategy &&
-            r.p_min == s.p_min && r.budget == s.budget)
-          row = &r;
-      md << " " << (row ? cell(*row) : std::string("")) << " |";
-    }
+    for (const ResultRow* row : rows) md << " " << (row ? cell(*row) : std::string("")) << " |";
     md << "\n";
   }
   md << "\n";
 }
 
+/// A relative error or width: "0", or two significant digits.
+std::string relative(double v) {
+  return std::isnan(v) ? "" : v == 0 ? "0" : fmt("%.2g", v);
+}
+
+/// The distance series against their reference (ResultRow::distance_error), when the scene runs any.
+void readme_distances(std::ostream& md, const RunOutput& run, const std::vector<double>& distances) {
+  if (std::none_of(run.rows.begin(), run.rows.end(), measures_distance)) return;
+  std::size_t misses = 0;
+  for (const ResultRow& r : run.rows) misses += r.interval_misses;
+  per_distance_table(
+      md, run, distances, "Distances: median time (µs) and largest relative error", Listed::distances,
+      [](const ResultRow& r) { return micros(r.median_time_us) + " (" + relative(r.distance_error) + ")"; });
+  md << "Each pose's reference is the first exact distance series (bvhlab's before FCL's); the error is "
+        "|distance - reference| / reference, the largest over the poses (absolute where the objects touch). "
+     << (misses == 0 ? std::string("Every interval [lower bound, distance] held its reference.")
+                     : "**" + std::to_string(misses) + " intervals missed their reference.**")
+     << "\n\n";
+  if (std::any_of(run.rows.begin(), run.rows.end(),
+                  [](const ResultRow& r) { return measures_distance(r) && !r.exact_strategy; }))
+    per_distance_table(
+        md, run, distances,
+        "Anytime distance: median interval width / distance, and poses within a tenth (%)",
+        Listed::anytime_distances, [](const ResultRow& r) {
+          return relative(r.width_median) + " (" +
+                 (std::isnan(r.width_tenth_rate) ? std::string("") : percent(r.width_tenth_rate)) + ")";
+        });
+}
+
 void readme_per_distance(std::ostream& md, const RunOutput& run, const std::vector<double>& distances) {
   per_distance_table(
-      md, run, distances, "Mean time per query (µs) and BV tests per query by distance", false,
+      md, run, distances, "Mean time per query (µs) and BV tests per query by distance", Listed::all,
       [](const ResultRow& r) { return micros(r.mean_time_us) + " (" + count(r.bv_tests_per_query) + ")"; });
   if (std::any_of(run.rows.begin(), run.rows.end(), [](const ResultRow& r) { return !r.exact_strategy; }))
-    per_distance_table(md, run, distances, "False positives / false negatives (%) by distance", true,
+    per_distance_table(md, run, distances, "False positives / false negatives (%) by distance",
+                       Listed::inexact,
                        [](const ResultRow& r) { return percent(r.fp_rate) + " / " + percent(r.fn_rate); });
 }
 
@@ -460,6 +501,7 @@ std::string report_readme(const RunOutput& run, bool figures_ok, const std::stri
 
   readme_calibration(md, run);
   readme_per_distance(md, run, distances);
+  readme_distances(md, run, distances);
   readme_models(md, run);
   readme_ground_truth(md, run, distances);
   readme_run(md, run.stats);

@@ -229,8 +229,9 @@ QueryOutcome run_query(const SceneObject& a, const SceneObject& b, const QueryRe
   const StrategyInfo& info = strategy_info(strategy.name);
   if (std::string refusal = info.refusal(request.density.name); !refusal.empty())
     throw std::invalid_argument(refusal);
-  if (request.hierarchy.is_fcl() && !runs_on_fcl(strategy))
-    throw std::invalid_argument("FCL hierarchies answer exact first-contact queries only, not coherent");
+  if (request.hierarchy.is_fcl())
+    if (std::string refusal = fcl_refusal(strategy, request.hierarchy.bv); !refusal.empty())
+      throw std::invalid_argument(refusal);
   Preparation preparation(options.cache_dir, outcome.stats, log_of(options), threads_of(options.threads));
   const ObjectData object_a = load_object(a);
   const ObjectData object_b = &a == &b ? ObjectData{} : load_object(b);

@@ -90,6 +90,10 @@ const std::vector<RowField>& row_fields() {
       {"in_summary", [](const ResultRow& r) { return json(r.in_summary); }},
       {"model_bytes", [](const ResultRow& r) { return json(r.model_bytes); }},
       {"bytes_per_triangle", [](const ResultRow& r) { return json(r.bytes_per_triangle); }},
+      {"distance_error", [](const ResultRow& r) { return optional_number(r.distance_error); }},
+      {"width_median", [](const ResultRow& r) { return optional_number(r.width_median); }},
+      {"width_tenth_rate", [](const ResultRow& r) { return optional_number(r.width_tenth_rate); }},
+      {"interval_misses", [](const ResultRow& r) { return json(r.interval_misses); }},
   };
   return fields;
 }

@@ -124,6 +124,67 @@ TEST_F(RunTest, FclModelsAreBuiltOnlyWhenAsked) {
 }
 #endif
 
+TEST_F(RunTest, DistanceSeriesAreMeasuredAgainstTheirReference) {
+  // At 0.8 the tori touch on some poses, at 1.6 they are apart: the exact series is its own reference (error
+  // 0); the anytime intervals hold the reference and are tighter with the larger budget.
+  const RunOutput run =
+      run_scene(scene(R"([{"bv": "obb"}, {"bv": "sphere"}])",
+                      R"([{"type": "distance"}, {"type": "distance_anytime", "budgets": [{"bv_tests": 4},
+                          {"bv_tests": 400}]}, {"type": "exact"}])"),
+                options);
+  std::size_t anytime_rows = 0;
+  for (const ResultRow& r : run.rows) {
+    SCOPED_TRACE(r.hierarchy + " " + r.label + " d=" + std::to_string(r.distance));
+    if (r.strategy == "exact") {
+      EXPECT_TRUE(std::isnan(r.distance_error));
+      continue;
+    }
+    EXPECT_EQ(r.interval_misses, 0u);
+    if (r.strategy == "distance") {
+      EXPECT_LE(r.distance_error, r.hierarchy == "obb" ? 0.0 : 1e-12);  // obb's is the reference
+      if (r.distance >= 1.6) {
+        EXPECT_EQ(r.width_median, 0.0);
+      }
+      continue;
+    }
+    ++anytime_rows;
+    EXPECT_GE(r.distance_error, 0.0);
+    if (r.distance >= 1.6 && r.budget == "bv_tests=4") {
+      EXPECT_GT(r.width_median, 0.0);  // 4 BV tests cannot close the interval; 400 may
+    }
+  }
+  EXPECT_EQ(anytime_rows, 2u * 2u * 3u);
+  const auto row_of = [&](const std::string& budget) {
+    for (const ResultRow& r : run.rows)
+      if (r.hierarchy == "obb" && r.strategy == "distance_anytime" && r.budget == budget && r.distance == 1.6)
+        return r;
+    return ResultRow{};
+  };
+  EXPECT_LT(row_of("bv_tests=400").width_median, row_of("bv_tests=4").width_median);
+  const std::string readme = report_readme(run, true, "");
+  EXPECT_NE(readme.find("## Distances: median time"), std::string::npos);
+  EXPECT_NE(readme.find("Every interval [lower bound, distance] held its reference."), std::string::npos);
+  EXPECT_NE(readme.find("## Anytime distance: median interval width"), std::string::npos);
+}
+
+#ifdef BVHLAB_HAVE_FCL
+TEST_F(RunTest, FclDistancesAgreeWithBvhlabs) {
+  const RunOutput run =
+      run_scene(scene(R"([{"bv": "fcl_obbrss"}, {"bv": "aabb"}])",
+                      R"([{"type": "distance"}, {"type": "exact", "hierarchies": ["aabb"]}])"),
+                options);
+  std::size_t fcl_rows = 0;
+  for (const ResultRow& r : run.rows) {
+    if (r.hierarchy != "fcl_obbrss") continue;
+    ++fcl_rows;
+    EXPECT_LE(r.distance_error, 1e-9) << r.distance;  // against bvhlab's aabb distance
+    EXPECT_EQ(r.fp_rate + r.fn_rate, 0.0) << r.distance;
+  }
+  EXPECT_EQ(fcl_rows, 3u);
+  EXPECT_THROW((void)scene(R"([{"bv": "fcl_obb"}])", R"([{"type": "distance"}])"), SceneError);
+}
+#endif
+
 TEST_F(RunTest, SecondRunComesFromTheCache) {
   const RunOutput first = run_scene(adb_scene(), options);
   EXPECT_EQ(first.stats.trees_annotated, 1u);
@@ -256,6 +317,10 @@ TEST_F(RunTest, CsvSchemaAndRates) {
                                         "in_summary",
                                         "model_bytes",
                                         "bytes_per_triangle",
+                                        "distance_error",
+                                        "width_median",
+                                        "width_tenth_rate",
+                                        "interval_misses",
                                         "machine",
                                         "compiler",
                                         "build_type",
