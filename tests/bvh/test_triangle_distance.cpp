@@ -411,19 +411,9 @@ TEST(TriangleDistanceFamilies, AxisAligned) {
 }
 
 TEST(TriangleDistanceFamilies, Scales) {
-  // Triangles of size 1e-3 around (1e6, 1e6, 1e6) +- 1e5: the translation to p[0] must keep their digits.
-  check_family("tiny_far", 17, kCostlyPairs,
-               rescaled(
-                   separated_pair, [](Rng&) { return 1e-3; },
-                   [](Rng& rng) { return Vec3(Vec3::Constant(1e6) + uniform_point(rng, -1e5, 1e5)); }));
-  check_family("scale_1e-6", 18, kCostlyPairs, rescaled(separated_pair, 1e-6, Vec3::Zero()));
-  check_family("scale_1e6", 19, kCostlyPairs, rescaled(separated_pair, 1e6, Vec3::Zero()));
-  // Powers of two 2^-900..2^1000: squares under- or overflow without the local rescaling, and the largest
-  // pairs' translation itself could overflow.
-  check_family("scale_2^-900..2^1000", 20, kCostlyPairs,
-               rescaled(
-                   separated_pair, [](Rng& rng) { return std::ldexp(1.0, int(integer(rng, -900, 1000))); },
-                   [](Rng&) { return Vec3(Vec3::Zero()); }));
+  for_each_scale_family(separated_pair, 17, [](const char* name, std::uint64_t seed, const Generator& make) {
+    check_family(name, seed, kCostlyPairs, make);
+  });
 }
 
 // ---- hand-written cases ----------------------------------------------------------------------------------

@@ -293,4 +293,21 @@ inline Generator rescaled(const Generator& base, double scale, const Vec3& offse
       base, [scale](Rng&) { return scale; }, [offset](Rng&) { return offset; });
 }
 
+/// The scale families of `base`: size 1e-3 around (1e6, 1e6, 1e6) +- 1e5 (the translation to a vertex must
+/// keep their digits), 1e-6, 1e6, and powers of two 2^-900..2^1000 (squares and products under- or overflow
+/// without a local rescaling). Each is handed to check(name, seed, generator), seeds first_seed onwards.
+template <class Check>
+void for_each_scale_family(const Generator& base, std::uint64_t first_seed, Check&& check) {
+  check("tiny_far", first_seed,
+        rescaled(
+            base, [](Rng&) { return 1e-3; },
+            [](Rng& rng) { return Vec3(Vec3::Constant(1e6) + generators::uniform_point(rng, -1e5, 1e5)); }));
+  check("scale_1e-6", first_seed + 1, rescaled(base, 1e-6, Vec3::Zero()));
+  check("scale_1e6", first_seed + 2, rescaled(base, 1e6, Vec3::Zero()));
+  check("scale_2^-900..2^1000", first_seed + 3,
+        rescaled(
+            base, [](Rng& rng) { return std::ldexp(1.0, int(integer(rng, -900, 1000))); },
+            [](Rng&) { return Vec3(Vec3::Zero()); }));
+}
+
 }  // namespace bvhlab::testing
