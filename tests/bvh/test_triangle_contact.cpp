@@ -10,9 +10,9 @@
 #include "bench/core/generators.hpp"
 #include "bvh/triangle_contact.hpp"
 #include "bvh/triangle_intersection.hpp"
+#include "support/exact_triangles.hpp"
 #include "support/triangle_families.hpp"
 
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/intersections.h>
 #include <CGAL/squared_distance_3.h>
 #include <gtest/gtest.h>
@@ -33,17 +33,10 @@
 namespace bvhlab {
 namespace {
 
-using namespace testing;  // the triangle families: support/triangle_families.hpp
+using namespace testing;  // support/triangle_families.hpp, support/exact_triangles.hpp
 using generators::random_unit;
 using generators::uniform;
 using generators::uniform_point;
-
-// Full counts in optimised builds; a tenth where assertions are on (Debug: CGAL checks everything).
-#ifdef NDEBUG
-constexpr std::size_t kScale = 1;
-#else
-constexpr std::size_t kScale = 10;
-#endif
 
 constexpr double kRelative = 1e-9;
 constexpr double kWellConditioned = 1e-3;
@@ -51,18 +44,6 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 // ---- exact ground truth ----------------------------------------------------------------------------------
 
-using K = CGAL::Exact_predicates_exact_constructions_kernel;
-using ExactPoint = K::Point_3;
-
-ExactPoint exact_point(const Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-// CGAL refines a lazy number only where its interval is wider than the relative precision asked for.
-double to_double(const K::FT& x, double relative_precision) {
-  K::FT::set_relative_precision_of_to_double(relative_precision);
-  return CGAL::to_double(x);
-}
 Vec3 approximate(const ExactPoint& x) {
   return {to_double(x.x(), 1e-15), to_double(x.y(), 1e-15), to_double(x.z(), 1e-15)};
 }
@@ -132,15 +113,6 @@ double distance_to(const Vec3& x, const Shape& s, double tolerance) {
 }
 
 // ---- pairs -----------------------------------------------------------------------------------------------
-
-double longest_edge(const TrianglePoints& t) {
-  return std::max({(t[1] - t[0]).stableNorm(), (t[2] - t[1]).stableNorm(), (t[0] - t[2]).stableNorm()});
-}
-double largest_coordinate(std::initializer_list<Vec3> points) {
-  double m = 0;
-  for (const Vec3& v : points) m = std::max(m, v.cwiseAbs().maxCoeff());
-  return m;
-}
 
 // The pair scaled by a power of two (exactly) to coordinates below 1, as CGAL is given it: its interval
 // filters would otherwise overflow or underflow at 2^-900..2^1000 and fall back to rationals.
@@ -287,7 +259,7 @@ void check_family(const char* name, std::uint64_t seed, std::size_t count, const
   Rng rng(seed);
   FamilyStats stats;
   const auto start = std::chrono::steady_clock::now();
-  for (std::size_t i = 0; i < count / kScale; ++i) check_pair(generate(rng), rng, stats);
+  for (std::size_t i = 0; i < count / kFamilyScale; ++i) check_pair(generate(rng), rng, stats);
   const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
   std::printf(
       "[family] %-24s pairs=%zu intersecting=%zu compared=%zu coplanar=%zu | over tolerance: off=%.3g "

@@ -10,10 +10,10 @@
 #include "bench/core/generators.hpp"
 #include "bvh/triangle_distance.hpp"
 #include "bvh/triangle_intersection.hpp"
+#include "support/exact_triangles.hpp"
 #include "support/random_draws.hpp"
 #include "support/triangle_families.hpp"
 
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/squared_distance_3.h>
 #include <gtest/gtest.h>
 
@@ -33,40 +33,15 @@
 namespace bvhlab {
 namespace {
 
-using namespace testing;  // the triangle families: support/triangle_families.hpp
+using namespace testing;  // support/triangle_families.hpp, support/exact_triangles.hpp
 using generators::random_unit;
 using generators::uniform;
 using generators::uniform_point;
-
-// Full counts in optimised builds; a tenth where assertions are on (Debug: CGAL checks everything).
-#ifdef NDEBUG
-constexpr std::size_t kScale = 1;
-#else
-constexpr std::size_t kScale = 10;
-#endif
 
 constexpr double kRelative = 1e-9;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 // ---- exact ground truth ----------------------------------------------------------------------------------
-
-using K = CGAL::Exact_predicates_exact_constructions_kernel;
-using ExactPoint = K::Point_3;
-
-ExactPoint exact_point(const Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-K::Triangle_3 exact_triangle(const TrianglePoints& t) {
-  return {exact_point(t[0]), exact_point(t[1]), exact_point(t[2])};
-}
-
-// CGAL's to_double refines a lazy number (exactly, in rationals) only where its interval is wider than a
-// relative precision, 1e-5 unless asked.
-double to_double(const K::FT& x, double relative_precision) {
-  K::FT::set_relative_precision_of_to_double(relative_precision);
-  return CGAL::to_double(x);
-}
 
 // Degenerate triangles included: CGAL treats them as the segments or points they are (it agreed with the
 // distances between their pieces on 40,000 degenerate grid pairs).
@@ -111,14 +86,6 @@ Membership within(const Vec3& x, const K::Triangle_3& t, double tolerance) {
 
 // ---- pairs and their transformations -----------------------------------------------------------------
 
-double longest_edge(const TrianglePoints& t) {
-  return std::max({(t[1] - t[0]).stableNorm(), (t[2] - t[1]).stableNorm(), (t[0] - t[2]).stableNorm()});
-}
-double largest_coordinate(std::initializer_list<Vec3> points) {
-  double m = 0;
-  for (const Vec3& v : points) m = std::max(m, v.cwiseAbs().maxCoeff());
-  return m;
-}
 Mat3 random_rotation(Rng& rng) {
   std::normal_distribution<double> normal;
   return testing::draw_quaternion(normal, rng).normalized().toRotationMatrix();
@@ -238,7 +205,7 @@ FamilyStats run_family(const char* name, std::uint64_t seed, std::size_t count, 
   Rng rng(seed);
   FamilyStats stats;
   const auto start = std::chrono::steady_clock::now();
-  for (std::size_t i = 0; i < count / kScale; ++i) check_pair(generate(rng), rng, stats);
+  for (std::size_t i = 0; i < count / kFamilyScale; ++i) check_pair(generate(rng), rng, stats);
   const std::chrono::duration<double, std::milli> elapsed = std::chrono::steady_clock::now() - start;
   std::printf(
       "[family] %-24s pairs=%zu intersecting=%.3f max_abs=%.3g max_rel=%.3g max_rel_resolved=%.3g "
