@@ -407,13 +407,13 @@ void readme_distances(std::ostream& md, const RunOutput& run, const std::vector<
      << "\n\n";
   if (std::any_of(run.rows.begin(), run.rows.end(),
                   [](const ResultRow& r) { return measures_distance(r) && !r.exact_strategy; }))
-    per_distance_table(
-        md, run, distances,
-        "Anytime distance: median interval width / distance, and poses within a tenth (%)",
-        Listed::anytime_distances, [](const ResultRow& r) {
-          return relative(r.width_median) + " (" +
-                 (std::isnan(r.width_tenth_rate) ? std::string("") : percent(r.width_tenth_rate)) + ")";
-        });
+    per_distance_table(md, run, distances,
+                       "Anytime distance: median interval width / distance, and poses within a tenth (%)",
+                       Listed::anytime_distances, [](const ResultRow& r) {
+                         if (std::isnan(r.width_median))
+                           return std::string();  // every pose in contact: no width
+                         return relative(r.width_median) + " (" + percent(r.width_tenth_rate) + ")";
+                       });
 }
 
 void readme_per_distance(std::ostream& md, const RunOutput& run, const std::vector<double>& distances) {
