@@ -324,7 +324,8 @@ void bind_queries(py::module_& m) {
                              "(triangle of A, triangle of B) the points lie on, as mesh indices, or None")
       .def_property_readonly(
           "contact_geometry", &QueryResult::contact_geometry,
-          "with contact_geometry=True, per contact (all_contacts) or for the witness: a dict of arrays "
+          "with contact_geometry=True, per contact (all_contacts) or for the witness where its triangles "
+          "meet: a dict of arrays "
           "triangles (K, 2), segments (K, 2, 3: where the two triangles meet), points (K, 3: the segments' "
           "midpoints), normals (K, 3: unit, from A into B) and coplanar (K,: they meet in an area), in A's "
           "frame; None when not asked for")

@@ -2,9 +2,6 @@
 
 #include "../bvh/triangle_contact.hpp"
 
-#include <stdexcept>
-#include <string>
-
 namespace bvhlab {
 
 namespace {
@@ -30,14 +27,13 @@ ContactGeometryMaker::ContactGeometryMaker(const std::vector<TrianglePoints>& tr
       position_a_(inverse(ids_a)),
       position_b_(inverse(ids_b)) {}
 
-ContactGeometry ContactGeometryMaker::of(const TrianglePair& pair, const RigidTransform& b_to_a) const {
+std::optional<ContactGeometry> ContactGeometryMaker::of(const TrianglePair& pair,
+                                                        const RigidTransform& b_to_a) const {
   const TrianglePoints& a = (*triangles_a_)[position_a_.at(pair.a)];
   const TrianglePoints& b = (*triangles_b_)[position_b_.at(pair.b)];
   const TrianglePoints moved = {b_to_a.apply(b[0]), b_to_a.apply(b[1]), b_to_a.apply(b[2])};
   const std::optional<TriangleContact> contact = triangle_contact(a, moved);
-  if (!contact)
-    throw std::logic_error("triangles " + std::to_string(pair.a) + " of A and " + std::to_string(pair.b) +
-                           " of B do not intersect at this pose");
+  if (!contact) return std::nullopt;
   ContactGeometry out;
   out.triangles = pair;
   out.from = array_of(contact->from);
@@ -50,11 +46,14 @@ ContactGeometry ContactGeometryMaker::of(const TrianglePair& pair, const RigidTr
 
 void ContactGeometryMaker::operator()(const RigidTransform& b_to_a, Result& result) const {
   result.contact_geometry.clear();
+  const auto add = [&](const TrianglePair& pair) {
+    if (std::optional<ContactGeometry> g = of(pair, b_to_a)) result.contact_geometry.push_back(*g);
+  };
   if (!result.contacts.empty()) {
     result.contact_geometry.reserve(result.contacts.size());
-    for (const TrianglePair& pair : result.contacts) result.contact_geometry.push_back(of(pair, b_to_a));
+    for (const TrianglePair& pair : result.contacts) add(pair);
   } else if (result.witness) {
-    result.contact_geometry.push_back(of(*result.witness, b_to_a));
+    add(*result.witness);
   }
 }
 

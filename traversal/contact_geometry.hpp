@@ -7,6 +7,7 @@
 #include "result.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace bvhlab {
@@ -22,12 +23,13 @@ class ContactGeometryMaker {
                        const std::vector<std::uint32_t>& ids_b);
 
   /// Fills result.contact_geometry with B placed by `b_to_a`: one entry per contact, or for the witness when
-  /// the result lists no contacts.
+  /// the result lists no contacts, each only if its triangles intersect (the tolerance strategy's witness
+  /// may lie apart, within the tolerance: it gets none).
   void operator()(const RigidTransform& b_to_a, Result& result) const;
 
-  /// The geometry of one intersecting pair (source-mesh indices); throws std::logic_error when its triangles
-  /// do not intersect at `b_to_a` (a result of another pose).
-  [[nodiscard]] ContactGeometry of(const TrianglePair& pair, const RigidTransform& b_to_a) const;
+  /// The geometry of one pair (source-mesh indices), or nullopt when its triangles do not intersect.
+  [[nodiscard]] std::optional<ContactGeometry> of(const TrianglePair& pair,
+                                                  const RigidTransform& b_to_a) const;
 
  private:
   const std::vector<TrianglePoints>* triangles_a_;

@@ -69,7 +69,7 @@ struct Result {
   std::vector<TrianglePair> contacts;   ///< all-contacts mode only
   std::optional<Proximity> proximity;   ///< the distance strategies only
   /// Asked for (StrategyVariant::contact_geometry): one entry per contact in all-contacts mode, else one for
-  /// the witness, if any.
+  /// the witness, if any, and if its triangles intersect (the tolerance strategy's may lie apart).
   std::vector<ContactGeometry> contact_geometry;
   Counters counters;
 };

@@ -210,6 +210,18 @@ TEST(AnyTree, ContactGeometryLiesOnBothTrianglesOfEachContact) {
   EXPECT_GT(checked, 100u);  // the poses cross the torus: many contacts are checked
 }
 
+TEST(AnyTree, ContactGeometryGoesOnlyToIntersectingPairs) {
+  // The tori (outer radius 0.95) 2 apart along x leave a gap of 0.1: the tolerance query names a witness
+  // within 0.2, whose triangles do not meet, so it gets no geometry.
+  const AnyTree a = torus_tree("obb", "none");
+  StrategyVariant within = strategy_variant("tolerance", {{"tolerance", 0.2}}, Budget{});
+  within.contact_geometry = true;
+  const auto r = results_of(a, a, within, {RigidTransform::translate(Vec3(2, 0, 0))});
+  ASSERT_TRUE(r[0].collides);
+  ASSERT_TRUE(r[0].witness.has_value());
+  EXPECT_TRUE(r[0].contact_geometry.empty());
+}
+
 TEST(AnyTree, ContactGeometryIsRefusedWhereNoTrianglesMeet) {
   const AnyTree adb = torus_tree("aabb", "adb");
   StrategyVariant estimate = strategy_variant("adb", {}, Budget{});
