@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 
@@ -341,6 +343,25 @@ TEST_F(Cli, DistanceAndToleranceAnswerWithTheirPoints) {
       ok("query small.obj small.obj --pose 3,0,0 --strategy distance_anytime --bv-tests 1 --json").out);
   EXPECT_LE(anytime["distance"]["lower_bound"].get<double>(), 2.0) << anytime;
 }
+
+#ifdef BVHLAB_HAVE_FCL
+TEST_F(Cli, FclAnswersTheDistanceToo) {
+  const std::string pose = " --pose 3,0.2,0.1,0,0,1,20 --strategy distance --json";
+  const nlohmann::json fcl =
+      nlohmann::json::parse(ok("query small.obj small.obj --bv fcl_obbrss" + pose).out);
+  const nlohmann::json own = nlohmann::json::parse(ok("query small.obj small.obj --bv obb" + pose).out);
+  const double d = own["distance"]["distance"].get<double>();
+  EXPECT_GT(d, 1.0);
+  EXPECT_NEAR(fcl["distance"]["distance"].get<double>(), d, 1e-12 * d) << fcl;
+  // FCL's nearest points realise its distance, the one on A on A's face x = 0.5 (B turned about z meets it
+  // with an edge: the points along it are not unique, so they are not compared with bvhlab's).
+  const auto on_a = fcl["distance"]["on_a"].get<std::array<double, 3>>();
+  const auto on_b = fcl["distance"]["on_b"].get<std::array<double, 3>>();
+  EXPECT_NEAR(std::hypot(on_b[0] - on_a[0], on_b[1] - on_a[1], on_b[2] - on_a[2]), d, 1e-12 * d) << fcl;
+  EXPECT_NEAR(on_a[0], 0.5, 1e-12) << fcl;
+  expect_refused("query small.obj small.obj --bv fcl_obb" + pose, "does not run on fcl_obb");
+}
+#endif
 
 TEST_F(Cli, ContactGeometryGivesEachContactItsSegment) {
   // B, the unit cube moved by (0.5, 0.2, 0.1), overlaps A in [0, 0.5] x [-0.3, 0.5] x [-0.4, 0.5].
