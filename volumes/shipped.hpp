@@ -7,12 +7,14 @@
 #include "kdop.hpp"
 #include "obb.hpp"
 #include "restricted_box.hpp"
+#include "rss.hpp"
 #include "sphere.hpp"
 #include "type_list.hpp"
 
 namespace bvhlab {
 
 /// Every shipped model, in the order tools list them. A new model is added here, and nowhere else.
-using ShippedVolumes = TypeList<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop24, Dop<26>, Obb, Sphere, RestrictedBox>;
+using ShippedVolumes =
+    TypeList<Aabb, Dop<6>, Dop<14>, Dop<18>, Dop24, Dop<26>, Obb, Sphere, Rss, RestrictedBox>;
 
 }  // namespace bvhlab

