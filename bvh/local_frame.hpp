@@ -8,6 +8,8 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <stdexcept>
+#include <string>
 
 namespace bvhlab::local_frame {
 
@@ -35,6 +37,15 @@ inline Vec3 times_power_of_two(const Vec3& v, int exponent) {
 /// The smallest e with magnitude < 2^e (0 for 0).
 inline int exponent_above(double magnitude) {
   return magnitude > 0 ? std::ilogb(magnitude) + 1 : 0;
+}
+
+/// Throws std::invalid_argument naming `function`, the triangle and the vertex with a NaN or infinite
+/// coordinate.
+inline void require_finite(const TrianglePoints& t, const char* function, const char* name) {
+  for (int i = 0; i < 3; ++i)
+    if (!t[i].allFinite())
+      throw std::invalid_argument(std::string(function) + ": triangle " + name + " vertex " +
+                                  std::to_string(i) + " has a NaN or infinite coordinate");
 }
 
 /// Local coordinates y = (x 2^-pre - origin) 2^-exponent, all of magnitude below 1. Translating to p[0] keeps

@@ -193,18 +193,11 @@ Vec3 contact_normal(const Face& p, const Face& q) {
   return length > kSameOrientation ? Vec3(difference / length) : p.unit;
 }
 
-void require_finite(const TrianglePoints& t, const char* name) {
-  for (int i = 0; i < 3; ++i)
-    if (!t[i].allFinite())
-      throw std::invalid_argument(std::string("triangle_contact: triangle ") + name + " vertex " +
-                                  std::to_string(i) + " has a NaN or infinite coordinate");
-}
-
 }  // namespace
 
 std::optional<TriangleContact> triangle_contact(const TrianglePoints& p, const TrianglePoints& q) {
-  require_finite(p, "P");
-  require_finite(q, "Q");
+  local_frame::require_finite(p, "triangle_contact", "P");
+  local_frame::require_finite(q, "triangle_contact", "Q");
   if (!triangles_intersect(p, q)) return std::nullopt;
   Frame frame;
   const auto local = frame.enter(p, q);

@@ -144,18 +144,11 @@ Vec3 common_point(const Face& p, const Face& q, const Pair& nearest) {
   return best;
 }
 
-void require_finite(const TrianglePoints& t, const char* name) {
-  for (int i = 0; i < 3; ++i)
-    if (!t[i].allFinite())
-      throw std::invalid_argument(std::string("triangle_distance: triangle ") + name + " vertex " +
-                                  std::to_string(i) + " has a NaN or infinite coordinate");
-}
-
 }  // namespace
 
 TriangleDistance triangle_distance(const TrianglePoints& p, const TrianglePoints& q) {
-  require_finite(p, "P");
-  require_finite(q, "Q");
+  local_frame::require_finite(p, "triangle_distance", "P");
+  local_frame::require_finite(q, "triangle_distance", "Q");
   const bool touching = triangles_intersect(p, q);
   Frame frame;
   const auto local = frame.enter(p, q);
