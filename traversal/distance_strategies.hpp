@@ -58,7 +58,7 @@ struct ProximityTraits {
 /// The distance between the two meshes, its closest points and triangles; 0 with a witness when they touch.
 struct DistanceStrategy : distance_strategy_detail::ProximityTraits {
   struct Options {};
-  static constexpr std::string_view name() { return "distance"; }
+  static constexpr std::string_view name() { return kDistanceStrategyName; }
   static constexpr std::string_view description() {
     return "the distance, its closest points and triangles (0 with a witness when they intersect)";
   }

@@ -235,8 +235,8 @@ const HierarchySpec* Scene::hierarchy(std::string_view name) const {
 }
 
 std::string fcl_refusal(const StrategySpec& s, std::string_view fcl_bv) {
-  const bool runs =
-      !s.coherent && (s.name == kExactStrategyName || (s.name == "distance" && fcl_bv == "fcl_obbrss"));
+  const bool runs = !s.coherent && (s.name == kExactStrategyName ||
+                                    (s.name == kDistanceStrategyName && fcl_bv == "fcl_obbrss"));
   if (runs) return "";
   return "\"" + s.name + "\"" + (s.coherent ? " coherent" : "") + " does not run on " + std::string(fcl_bv) +
          ": FCL hierarchies run \"exact\", and fcl_obbrss \"distance\", not coherent";

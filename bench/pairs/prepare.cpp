@@ -88,7 +88,7 @@ class FclHierarchy final : public PreparedHierarchy {
 
   void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
            std::vector<QueryRecord>& out) const override {
-    if (variant.strategy == "distance")
+    if (variant.strategy == kDistanceStrategyName)
       timed_series(poses, warmup, out, [&](const RigidTransform& p) { return distance(p); });
     else if (variant.strategy == kExactStrategyName)
       timed_series(poses, warmup, out, [&](const RigidTransform& p) { return query(p); });
@@ -104,7 +104,7 @@ class FclHierarchy final : public PreparedHierarchy {
         "FCL models give no world boxes here (bench_broad_phase times FCL's managers)");
   }
   [[nodiscard]] Result query(const StrategyVariant& variant, const RigidTransform& pose) const override {
-    if (variant.strategy == "distance") return distance(pose);
+    if (variant.strategy == kDistanceStrategyName) return distance(pose);
     if (variant.strategy != kExactStrategyName)
       throw std::invalid_argument("FCL hierarchies answer exact first-contact and distance queries only");
     return query(pose);
