@@ -23,31 +23,51 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 artifacts="$build/fuzz-artifacts"
 mkdir -p "$artifacts"
-status=0
-for target in "${targets[@]}"; do
-  exe="$build/tests/fuzz/$target"
+# One target's exploration; its summary line goes to $work/<target>.summary, its failure to the artifacts.
+fuzz_one() {
+  local target=$1 exe="$build/tests/fuzz/$1" log="$work/$1.log" result=ok
   if [ ! -x "$exe" ]; then
-    echo "fuzz: $target: not built ($exe missing)" >&2
-    status=1
-    continue
+    echo "fuzz: $target: not built ($exe missing)" >"$work/$target.summary"
+    return 1
   fi
   mkdir -p "$work/$target"
-  args=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -print_final_stats=1
-        -artifact_prefix="$artifacts/$target-")
+  local args=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -print_final_stats=1
+              -artifact_prefix="$artifacts/$target-")
   [ -f "$here/$target.dict" ] && args+=(-dict="$here/$target.dict")
   [ -n "${FUZZ_SEED:-}" ] && args+=(-seed="$FUZZ_SEED")
-  log="$work/$target.log"
-  if "$exe" "${args[@]}" "$work/$target" "$here/corpus/$target" >"$log" 2>&1; then
-    result=ok
-  else
+  if ! "$exe" "${args[@]}" "$work/$target" "$here/corpus/$target" >"$log" 2>&1; then
     result=FAILED
-    status=1
     cp "$log" "$artifacts/$target.log"
     rm -rf "$artifacts/$target-corpus" && cp -r "$work/$target" "$artifacts/$target-corpus"
-    grep -E "ERROR|SUMMARY|==[0-9]+==|broken|refusal|Test unit written" "$log" | head -40 >&2 || true
   fi
+  local runs corpus
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   corpus=$(ls "$work/$target" | wc -l)
-  echo "fuzz: $target: $result after ${seconds} s, ${runs:-?} executions, $corpus new corpus entries"
+  echo "fuzz: $target: $result after ${seconds} s, ${runs:-?} executions, $corpus new corpus entries" \
+    >"$work/$target.summary"
+  [ "$result" = ok ]
+}
+
+# The targets run side by side, FUZZ_JOBS at a time (default: one per core); each is single-threaded.
+jobs=${FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}
+status=0
+running=0
+for target in "${targets[@]}"; do
+  if [ "$running" -ge "$jobs" ]; then
+    wait -n || status=1
+    running=$((running - 1))
+  fi
+  fuzz_one "$target" &
+  running=$((running + 1))
+done
+while [ "$running" -gt 0 ]; do
+  wait -n || status=1
+  running=$((running - 1))
+done
+for target in "${targets[@]}"; do
+  cat "$work/$target.summary"
+  if [ -f "$artifacts/$target.log" ] && ! grep -q ": ok after" "$work/$target.summary"; then
+    grep -E "ERROR|SUMMARY|==[0-9]+==|broken|refusal|Test unit written" "$artifacts/$target.log" | head -40 >&2 || true
+  fi
 done
 exit $status
