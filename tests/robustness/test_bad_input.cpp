@@ -4,6 +4,7 @@
 // ASan build.
 #include "bench/core/scene.hpp"
 #include "bvh/mesh_io.hpp"
+#include "support/file_bytes.hpp"
 #include "support/meshes.hpp"
 #include "traversal/exact.hpp"
 #include "volumes/aabb.hpp"
@@ -30,10 +31,7 @@ fs::path source_dir() {
   return dir;
 }
 
-std::vector<std::uint8_t> read_bytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::read_bytes;
 
 // The fuzz target's input format: one selector byte (the format hint), then the file.
 constexpr const char* kFormats[] = {"obj", "ply", "stl", "off", "ms3d", "gltf", "glb", ""};

@@ -3,6 +3,7 @@
 // not build: the atomic write itself is sanitized with the saved trees (tests/adb/test_saved_tree.cpp).
 #include "bench/run.hpp"
 #include "bvh/mesh_io.hpp"
+#include "support/file_bytes.hpp"
 #include "support/meshes.hpp"
 
 #include <gtest/gtest.h>
@@ -20,10 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::uint8_t> read_bytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::read_bytes;
 
 class FailedBuild : public ::testing::Test {
  protected:
