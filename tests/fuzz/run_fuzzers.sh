@@ -23,7 +23,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 artifacts="$build/fuzz-artifacts"
 mkdir -p "$artifacts"
-# One target's exploration; its summary line goes to $work/<target>.summary, its failure to the artifacts.
+# One target's exploration; its summary line goes to $work/<target>.summary, the lines that tell a failure to
+# $work/<target>.failure, the whole failure to the artifacts.
 fuzz_one() {
   local target=$1 exe="$build/tests/fuzz/$1" log="$work/$1.log" result=ok
   if [ ! -x "$exe" ]; then
@@ -39,6 +40,8 @@ fuzz_one() {
     result=FAILED
     cp "$log" "$artifacts/$target.log"
     rm -rf "$artifacts/$target-corpus" && cp -r "$work/$target" "$artifacts/$target-corpus"
+    grep -E "ERROR|SUMMARY|==[0-9]+==|broken|refusal|Test unit written" "$log" | head -40 \
+      >"$work/$target.failure" || true
   fi
   local runs corpus
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
@@ -66,8 +69,6 @@ while [ "$running" -gt 0 ]; do
 done
 for target in "${targets[@]}"; do
   cat "$work/$target.summary"
-  if [ -f "$artifacts/$target.log" ] && ! grep -q ": ok after" "$work/$target.summary"; then
-    grep -E "ERROR|SUMMARY|==[0-9]+==|broken|refusal|Test unit written" "$artifacts/$target.log" | head -40 >&2 || true
-  fi
+  [ ! -f "$work/$target.failure" ] || cat "$work/$target.failure" >&2
 done
 exit $status
