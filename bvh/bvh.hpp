@@ -5,6 +5,7 @@
 #include "point_cloud.hpp"
 #include "topology.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <stdexcept>
@@ -28,6 +29,14 @@ struct BvhStats {
 /// How refit() bounds an inner node: merging its children's volumes, or fitting its triangles' vertices.
 enum class RefitMethod { Merge, Fit };
 
+namespace bvh_detail {
+/// Bvh::identity(): one count for every volume type, so that no two trees of a process share a number.
+inline std::uint64_t next_identity() {
+  static std::atomic<std::uint64_t> last{0};
+  return last.fetch_add(1, std::memory_order_relaxed) + 1;
+}
+}  // namespace bvh_detail
+
 template <TreeVolume BV>
 class Bvh {
  public:
@@ -48,6 +57,7 @@ class Bvh {
     Bvh out;
     Topology topology = build_topology(mesh, split_directions_of<BV>(), options);
     out.nodes_ = std::move(topology.nodes);
+    out.identity_ = bvh_detail::next_identity();
     out.triangle_ids_ = std::move(topology.triangle_order);
     out.triangles_.reserve(out.triangle_ids_.size());
     for (std::uint32_t id : out.triangle_ids_) out.triangles_.push_back(mesh.triangle(id));
@@ -70,6 +80,7 @@ class Bvh {
     Bvh out;
     Topology topology = build_topology(cloud.positions, split_directions_of<BV>(), options);
     out.nodes_ = std::move(topology.nodes);
+    out.identity_ = bvh_detail::next_identity();
     out.point_ids_ = std::move(topology.triangle_order);
     out.points_.reserve(out.point_ids_.size());
     for (std::uint32_t id : out.point_ids_) out.points_.push_back(cloud.positions[id]);
@@ -87,6 +98,7 @@ class Bvh {
     Bvh out;
     out.root_ = root;
     out.nodes_ = std::move(nodes);
+    out.identity_ = bvh_detail::next_identity();
     out.volumes_ = std::move(volumes);
     out.triangle_ids_ = std::move(ids);
     out.triangles_ = std::move(triangles);
@@ -148,6 +160,11 @@ class Bvh {
   [[nodiscard]] double degradation() const { return built_spread_ > 0 ? spread() / built_spread_ : 1.0; }
 
   [[nodiscard]] const std::vector<TreeNode>& nodes() const { return nodes_; }
+  /// Names this tree's topology within the process: a new number for each build and each from_parts (a
+  /// load), kept by copies and by refit(), 0 for an empty tree. What a coherent query's state is bound to
+  /// (traversal/coherent_state.hpp): its stored node pairs mean something only in the topology they came
+  /// from, and a new tree may be given the address of one that is gone.
+  [[nodiscard]] std::uint64_t identity() const { return identity_; }
   [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
   [[nodiscard]] const TreeNode& node(std::uint32_t i) const { return nodes_[i]; }
   [[nodiscard]] const BV& volume(std::uint32_t i) const { return volumes_[i]; }
@@ -377,6 +394,7 @@ class Bvh {
   double build_seconds_ = 0;
   std::uint64_t topology_ = 0;    ///< topology_fingerprint of the source mesh; 0 for a tree from saved parts
   std::size_t vertex_count_ = 0;  ///< of the source mesh; 0 for a tree from saved parts
+  std::uint64_t identity_ = 0;    ///< identity()
   double built_spread_ = 0;
 };
 

@@ -38,12 +38,16 @@ using LeafPair = std::pair<std::uint32_t, std::uint32_t>;
 /// Binds a new state to its trees (and B's root box: what a pose jump is measured against, in B's frame);
 /// throws std::invalid_argument for a state bound to other trees.
 template <TreeVolume BV>
+CoherentState::TreeKey key_of(const Bvh<BV>& tree) {
+  return {&tree, tree.identity(), tree.nodes().size()};
+}
+template <TreeVolume BV>
 void attach(CoherentState& state, const Bvh<BV>& a, const Bvh<BV>& b) {
   if (!state.bound() && !b.empty()) {
     const Box box = b.root_volume().bounding_box();
-    state.bind(&a, a.nodes().size(), &b, b.nodes().size(), box.center(), box.extent().norm() / 2);
+    state.bind(key_of(a), key_of(b), box.center(), box.extent().norm() / 2);
   }
-  state.check_trees(&a, a.nodes().size(), &b, b.nodes().size());
+  state.check_trees(key_of(a), key_of(b));
 }
 
 /// One walk over the stored traversal tree (`stored`, possibly empty: from the root), writing the new one

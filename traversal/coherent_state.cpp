@@ -29,21 +29,19 @@ std::size_t CoherentState::front_size() const {
       std::count_if(pairs_.begin(), pairs_.end(), [](const FrontPair& p) { return p.count == 0; }));
 }
 
-void CoherentState::bind(const void* a, std::size_t a_nodes, const void* b, std::size_t b_nodes,
-                         const Vec3& centre, double radius) {
-  check_trees(a, a_nodes, b, b_nodes);
-  a_ = a, b_ = b, a_nodes_ = a_nodes, b_nodes_ = b_nodes;
+void CoherentState::bind(const TreeKey& a, const TreeKey& b, const Vec3& centre, double radius) {
+  check_trees(a, b);
+  a_ = a, b_ = b;
   b_centre_ = centre;
   b_radius_ = radius;
 }
 
-void CoherentState::check_trees(const void* a, std::size_t a_nodes, const void* b,
-                                std::size_t b_nodes) const {
-  if (a_ == nullptr) return;
-  if (a != a_ || b != b_ || a_nodes != a_nodes_ || b_nodes != b_nodes_)
+void CoherentState::check_trees(const TreeKey& a, const TreeKey& b) const {
+  if (!bound()) return;
+  if (a != a_ || b != b_)
     throw std::invalid_argument(
-        "coherent query: the state was made for other trees (one state per pair of trees; reset() does not "
-        "rebind it)");
+        "coherent query: the state was made for other trees (one state per pair of trees; a tree rebuilt or "
+        "made anew needs a new state; reset() does not rebind it)");
 }
 
 CoherentState::InUse::InUse(CoherentState& state) : state_(state) {

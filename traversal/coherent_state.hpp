@@ -75,13 +75,21 @@ class CoherentState {
   [[nodiscard]] std::uint64_t cold_queries() const { return cold_queries_; }
 
   // ---- For the coherent queries (traversal/coherent.hpp) ----------------------------------------------
-  /// Binds the state to its trees (their addresses and sizes) and B's root box (its centre and radius in
-  /// B's frame: what a pose jump is measured against).
-  void bind(const void* a, std::size_t a_nodes, const void* b, std::size_t b_nodes, const Vec3& centre,
-            double radius);
-  [[nodiscard]] bool bound() const { return a_ != nullptr; }
-  /// Throws std::invalid_argument unless the state is unbound or bound to these trees.
-  void check_trees(const void* a, std::size_t a_nodes, const void* b, std::size_t b_nodes) const;
+  /// What a state is bound to of one tree: its address, its identity (Bvh::identity: the topology the
+  /// stored node pairs index) and its node count.
+  struct TreeKey {
+    const void* address = nullptr;
+    std::uint64_t identity = 0;
+    std::size_t nodes = 0;
+    friend bool operator==(const TreeKey&, const TreeKey&) = default;
+  };
+  /// Binds the state to its trees and B's root box (its centre and radius in B's frame: what a pose jump is
+  /// measured against).
+  void bind(const TreeKey& a, const TreeKey& b, const Vec3& centre, double radius);
+  [[nodiscard]] bool bound() const { return a_.address != nullptr; }
+  /// Throws std::invalid_argument unless the state is unbound or bound to these trees: the same objects,
+  /// with the topology they had (not rebuilt, not another tree made at the address of one that is gone).
+  void check_trees(const TreeKey& a, const TreeKey& b) const;
   /// Marks the state in use for one query; throws std::logic_error when another query holds it.
   class InUse {
    public:
@@ -126,9 +134,7 @@ class CoherentState {
 
  private:
   CoherenceOptions options_;
-  const void* a_ = nullptr;
-  const void* b_ = nullptr;
-  std::size_t a_nodes_ = 0, b_nodes_ = 0;
+  TreeKey a_, b_;
   Vec3 b_centre_ = Vec3::Zero();
   double b_radius_ = 0;
   std::vector<FrontPair> pairs_;  ///< the stored traversal tree; pairs_[0] is the root pair

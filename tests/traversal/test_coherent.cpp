@@ -5,6 +5,8 @@
 #include "coherent_suite.hpp"
 #include "support/errors.hpp"
 
+#include <optional>
+
 namespace bvhlab::coherent_tests {
 namespace {
 
@@ -101,6 +103,51 @@ TEST(Coherent, RefusesWhatItCannotServe) {
   EXPECT_THROW(CoherentState(CoherenceOptions{.max_pairs = 0}), std::invalid_argument);
   EXPECT_THROW(CoherentState(CoherenceOptions{.max_jump = std::nan("")}), std::invalid_argument);
   EXPECT_THROW(CoherentState(CoherenceOptions{.max_jump = -1}), std::invalid_argument);
+}
+
+TEST(Coherent, ATreeMadeAnewWhereTheOldOneWasIsRefused) {
+  // The same mesh, the same node count, the same address: still another tree, whose node pairs the stored
+  // front does not index (a deforming object rebuilt between frames).
+  const auto b = Bvh<Aabb>::build(soup());
+  std::optional<Bvh<Aabb>> a(Bvh<Aabb>::build(torus()));
+  const Bvh<Aabb>* address = &*a;
+  CoherentState state;
+  query_exact_coherent(*a, b, RigidTransform::identity(), state);
+  a.emplace(Bvh<Aabb>::build(torus()));
+  ASSERT_EQ(&*a, address);
+  EXPECT_NE(testing::error_of([&] {
+              query_exact_coherent(*a, b, RigidTransform::identity(), state);
+            }).find("made for other trees"),
+            std::string::npos);
+}
+
+TEST(Coherent, ARefittedTreeKeepsItsState) {
+  // The torus swells frame by frame into B, which stays where it is (at the last pose along x where they
+  // touch): refit keeps the topology, so the front carries over, and the answers are the cold query's on the
+  // refitted tree.
+  auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  RigidTransform pose = RigidTransform::translate(Vec3(1.0, 0.1, 0.05));
+  while (query_exact(a, b, pose).collides) pose.translation.x() += 0.01;
+  pose.translation.x() -= 0.01;
+  CoherentState state;
+  int colliding = 0;
+  Counters cold_work, coherent_work;
+  for (int frame = 0; frame < 40; ++frame) {
+    Mesh swollen = torus();
+    for (Vec3& v : swollen.vertices) v *= 0.97 + 0.0015 * frame;
+    a.refit(swollen);
+    const Result cold = query_exact(a, b, pose);
+    const Result r = query_exact_coherent(a, b, pose, state);
+    ASSERT_EQ(r.collides, cold.collides) << "frame " << frame;
+    colliding += r.collides;
+    cold_work += cold.counters;
+    coherent_work += r.counters;
+  }
+  EXPECT_GT(colliding, 3) << "frames in contact";  // both answers along the way
+  EXPECT_LT(colliding, 37) << "frames in contact";
+  EXPECT_EQ(state.jumps(), 0u);
+  EXPECT_LT(coherent_work.bv_tests, cold_work.bv_tests);
 }
 
 }  // namespace
