@@ -89,6 +89,12 @@ class PreparedQuery {
   /// Throws as run(..., state) does.
   virtual void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
                     CoherentState& state) const = 0;
+  /// The same with one state per pose, each carried from call to call: pose k continues `states[k]` (a
+  /// deforming object asked at the same poses frame after frame). The warm-up queries run on copies of the
+  /// first poses' states. Throws std::invalid_argument unless there is one state per pose, and as
+  /// run(..., state) does.
+  virtual void time_per_pose(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
+                             std::span<CoherentState> states) const = 0;
   [[nodiscard]] virtual bool coherent() const = 0;
 };
 

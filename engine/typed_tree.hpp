@@ -14,6 +14,7 @@
 #include "traversal/frame_budget.hpp"
 #include "traversal/strategies.hpp"
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -119,6 +120,20 @@ class TypedQuery final : public PreparedQuery {
     timed_series(
         poses, warmup, out, [&](const RigidTransform& pose) { return query(pose, scratch); },
         [&](const RigidTransform& pose) { return query(pose, state); });
+  }
+  void time_per_pose(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
+                     std::span<CoherentState> states) const override {
+    if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
+    if (states.size() != poses.size())
+      throw std::invalid_argument("time_per_pose: " + std::to_string(states.size()) + " states for " +
+                                  std::to_string(poses.size()) + " poses (one per pose)");
+    // timed_series warms up on poses 0, 1, ... and then times every pose, in order.
+    std::vector<CoherentState> scratch(
+        states.begin(), states.begin() + std::min<std::ptrdiff_t>(std::max(warmup, 0), std::ssize(states)));
+    std::size_t warmed = 0, timed = 0;
+    timed_series(
+        poses, warmup, out, [&](const RigidTransform& pose) { return query(pose, scratch[warmed++]); },
+        [&](const RigidTransform& pose) { return query(pose, states[timed++]); });
   }
   [[nodiscard]] bool coherent() const override { return coherent_; }
 

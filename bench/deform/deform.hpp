@@ -12,6 +12,8 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include <cstdint>
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -33,8 +35,9 @@ struct DeformRow {
   double query_micros = 0;    ///< median per query
   double query_total_micros = 0;  ///< every query of the frame
   std::size_t queries = 0, colliding = 0, answered = 0, missed = 0, false_pairs = 0;
-  double count_error = -1;    ///< mean |count - exact recount| per node; -1 where no density is kept
-  double under_counted = -1;  ///< share of nodes counted below the exact recount; -1 likewise
+  std::uint64_t bv_tests = 0;  ///< every query of the frame
+  double count_error = -1;     ///< mean |count - exact recount| per node; -1 where no density is kept
+  double under_counted = -1;   ///< share of nodes counted below the exact recount; -1 likewise
 };
 
 struct DeformOutput {

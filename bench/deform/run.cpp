@@ -6,6 +6,7 @@
 #include "bvh/mesh_sequence.hpp"
 #include "engine/deforming.hpp"
 #include "engine/policies.hpp"
+#include "traversal/coherent_state.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
 #include <fcl/narrowphase/collision.h>
@@ -59,6 +60,7 @@ void score(DeformRow& row, const FrameTruth& truth, const std::vector<QueryRecor
     row.missed += truth_k && !answer;
     row.false_pairs += !truth_k && answer;
     micros.push_back(answers[k].micros);
+    row.bv_tests += answers[k].counters.bv_tests;
   }
   row.queries = answers.size();
   for (double m : micros) row.query_total_micros += m;
@@ -76,12 +78,29 @@ std::vector<StrategyVariant> variants_on(const Scene& scene, const HierarchySpec
   return out;
 }
 
-/// Times `variant` with `a` fixed and `b` moved over the frame's poses.
+/// One state per pose for a coherent series, carried from frame to frame while its tree is refitted.
+using PoseStates = std::vector<CoherentState>;
+
+/// Times `variant` with `a` fixed and `b` moved over the frame's poses. A coherent variant continues each
+/// pose's state in `states` (made when empty): the same pose, one frame later.
 std::vector<QueryRecord> answer(const StrategyVariant& variant, const AnyTree& a, const AnyTree& b,
-                                const FrameTruth& truth, int warmup) {
+                                const FrameTruth& truth, int warmup, PoseStates& states) {
   std::vector<QueryRecord> out;
-  a.prepare(b, variant)->time(truth.poses, warmup, out);
+  const auto prepared = a.prepare(b, variant);
+  if (!prepared->coherent()) {
+    prepared->time(truth.poses, warmup, out);
+    return out;
+  }
+  if (states.empty()) states.resize(truth.poses.size());
+  prepared->time_per_pose(truth.poses, warmup, out, states);
   return out;
+}
+
+/// What a tree made anew this frame carries over: nothing.
+std::vector<QueryRecord> answer_fresh(const StrategyVariant& variant, const AnyTree& a, const AnyTree& b,
+                                      const FrameTruth& truth, int warmup) {
+  PoseStates fresh;
+  return answer(variant, a, b, truth, warmup, fresh);
 }
 
 /// One hierarchy of the scene, following the deforming object frame by frame.
@@ -133,7 +152,10 @@ class BvhDeform final : public DeformHierarchy {
     const double degradation =
         refit_.refit(*truth.mesh, scene_.deform->refit_by_fit ? RefitMethod::Fit : RefitMethod::Merge);
     const bool rebuilt = degradation > scene_.deform->rebuild_degradation;
-    if (rebuilt) refit_.rebuild(*truth.mesh);
+    if (rebuilt) {
+      refit_.rebuild(*truth.mesh);
+      states_.clear();  // their node pairs index the old topology
+    }
     const double refit_micros = micros_since(start);
     const auto rebuild_start = Clock::now();
     const AnyTree rebuilt_tree = AnyTree::build(*truth.mesh, {}, h_.bv, {}, h_.build);
@@ -143,11 +165,12 @@ class BvhDeform final : public DeformHierarchy {
       refit_row.degradation = degradation;
       refit_row.rebuilt = rebuilt;
       refit_row.tree_micros = refit_micros;
-      score(refit_row, truth, answer(v, refit_.tree(), other_, truth, warmup_));
+      score(refit_row, truth,
+            answer(v, refit_.tree(), other_, truth, warmup_, states_["refit " + v.label()]));
       rows.push_back(std::move(refit_row));
       DeformRow rebuild_row = row_of(truth, h_, "rebuild", v);
       rebuild_row.tree_micros = rebuild_micros;
-      score(rebuild_row, truth, answer(v, rebuilt_tree, other_, truth, warmup_));
+      score(rebuild_row, truth, answer_fresh(v, rebuilt_tree, other_, truth, warmup_));
       rows.push_back(std::move(rebuild_row));
     }
     if (!adb_.empty())
@@ -163,6 +186,7 @@ class BvhDeform final : public DeformHierarchy {
     double degradation = 1;
     bool rebuilt = false;
     double micros = 0;
+    bool fresh = false;  ///< the tree queried was made anew this frame
   };
 
   void adb_frame(const FrameTruth& truth, const Refit& refit, const AnyTree& rebuilt_tree,
@@ -171,7 +195,7 @@ class BvhDeform final : public DeformHierarchy {
     const AnyTree fresh = rebuilt_tree.annotated(density_, one_thread());
     const double annotate_micros = micros_since(annotate_start);
     // Counted anew: no error against an exact count.
-    add_adb_rows(truth, "rebuild + annotate", fresh, {1, false, rebuild_micros}, annotate_micros,
+    add_adb_rows(truth, "rebuild + annotate", fresh, {1, false, rebuild_micros, true}, annotate_micros,
                  CountError{}, rows);
     const AnyTree recount = refit_.tree().annotated(density_, one_thread());
     for (UpdatedCounts& u : updated_) {
@@ -198,7 +222,11 @@ class BvhDeform final : public DeformHierarchy {
       row.rebuilt = refit.rebuilt;
       row.count_error = error.mean_difference;
       row.under_counted = error.under_counted;
-      score(row, truth, answer(v, tree, *other_adb_, truth, warmup_));
+      // A tree annotated anew carries nothing over; the followers' trees keep their topology.
+      if (refit.fresh)
+        score(row, truth, answer_fresh(v, tree, *other_adb_, truth, warmup_));
+      else
+        score(row, truth, answer(v, tree, *other_adb_, truth, warmup_, states_[update + " " + v.label()]));
       rows.push_back(std::move(row));
     }
   }
@@ -212,6 +240,7 @@ class BvhDeform final : public DeformHierarchy {
   DensitySpec density_;
   std::optional<AnyTree> other_adb_;
   std::vector<UpdatedCounts> updated_;
+  std::map<std::string, PoseStates> states_;  ///< a coherent series' states, by update and series label
 };
 
 #ifdef BVHLAB_HAVE_FCL

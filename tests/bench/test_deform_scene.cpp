@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+
 namespace bvhlab {
 namespace {
 
@@ -127,6 +129,28 @@ TEST_F(DeformSceneTest, FrameFilesOfAnotherTopologyAreRefusedByName) {
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("f2.obj"), std::string::npos) << e.what();
   }
+}
+
+// A coherent series keeps each pose's state across the refitted frames: the exact answers, with fewer BV
+// tests than the cold series from the second frame on; on the trees built anew, the exact answers too.
+TEST_F(DeformSceneTest, CoherentSeriesFollowEachPoseAcrossFrames) {
+  const std::string head = R"("objects": [{"mesh": "torus.obj"}, {"mesh": "ring.obj"}],
+    "hierarchies": [{"bv": "aabb"}, {"bv": "obb"}],
+    "strategies": [{"type": "exact"}, {"type": "exact", "coherent": true}])";
+  const std::string slow_twist = R"({"object": "torus", "other": "ring", "deformation": "twist:amplitude=0.3",
+    "frames": 12, "poses": {"distances": [1.2, 1.4], "steps": 16}})";
+  const DeformOutput out = run_deform(parse(deform_scene(slow_twist, head)), RunOptions{});
+  std::map<std::string, std::uint64_t> tests;  // hierarchy, update, series: BV tests after the first frame
+  std::size_t colliding = 0;
+  for (const DeformRow& r : out.rows) {
+    EXPECT_EQ(r.missed + r.false_pairs, 0u) << r.hierarchy << " " << r.update << " " << r.series;
+    if (r.frame > 1) tests[r.hierarchy + " " + r.update + " " + r.series] += r.bv_tests;
+    colliding += r.colliding;
+  }
+  EXPECT_GT(colliding, 0u);
+  EXPECT_LT(colliding, out.rows.size() * out.poses) << "some poses apart";
+  for (const std::string bv : {"aabb", "obb"})
+    EXPECT_LT(tests[bv + " refit exact coherent"], tests[bv + " refit exact"]) << bv;
 }
 
 }  // namespace

@@ -144,6 +144,33 @@ TEST(CoherentQueryState, WarmUpQueriesRunOnACopyOfTheCallersState) {
   EXPECT_THROW(a.prepare(b, variant("exact", false))->time(poses, 0, with, plain), std::logic_error);
 }
 
+// time_per_pose (a deforming object asked at the same poses frame after frame): pose k continues states[k],
+// as a run with that state alone would; the warm-up queries run on copies.
+TEST(CoherentQueryState, EachPoseContinuesItsOwnState) {
+  const AnyTree a = torus_tree("aabb"), b = torus_tree("aabb");
+  const auto poses = protocol_poses(1.2, 40);
+  const auto query = a.prepare(b, variant("exact", true));
+  std::vector<CoherentState> states(poses.size()), alone(poses.size());
+  std::vector<QueryRecord> records;
+  for (int frame = 0; frame < 2; ++frame) {
+    query->time_per_pose(poses, 3, records, states);
+    ASSERT_EQ(records.size(), poses.size());
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      Result r;
+      query->run(
+          std::span(&poses[k], 1), [&](std::size_t, const Result& x) { r = x; }, alone[k]);
+      EXPECT_EQ(records[k].collides, r.collides) << k;
+      EXPECT_EQ(records[k].counters.bv_tests, r.counters.bv_tests) << "frame " << frame << ", pose " << k;
+    }
+  }
+  EXPECT_GT(states[0].witness_hits() + states[0].stored_pairs(), 0u);
+  std::vector<CoherentState> too_few(poses.size() - 1);
+  EXPECT_NE(error_of([&] { query->time_per_pose(poses, 0, records, too_few); }).find("one per pose"),
+            std::string::npos);
+  EXPECT_THROW(a.prepare(b, variant("exact", false))->time_per_pose(poses, 0, records, states),
+               std::logic_error);
+}
+
 TEST(CoherentQueryState, AStateOfOtherTreesIsRefused) {
   const AnyTree a = torus_tree("aabb"), b = torus_tree("aabb"), c = torus_tree("aabb", 30);
   const auto poses = turns();
