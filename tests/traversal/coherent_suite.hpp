@@ -109,8 +109,9 @@ TYPED_TEST_P(Coherent, WhereTheFrontDoesNotPayTheQueriesStartFromTheRoot) {
   }
   EXPECT_GT(walked, 1.2 * cold);  // the stale fronts cost more: the case the fallback is for
   // The probes of the front, and the walks from the root: about 1.16 of the cold work on RSS trees, whose
-  // tight volumes make the cold queries cheapest, below 1.15 on the others.
-  EXPECT_LT(falling_back, 1.2 * cold);
+  // tight volumes make the cold queries cheapest, 1.05 to 1.11 on the others.
+  const double bound = TypeParam::name() == "rss" ? 1.2 : 1.15;
+  EXPECT_LT(falling_back, bound * cold);
   EXPECT_GT(state.cold_queries(), 250u);
   EXPECT_EQ(always.cold_queries(), 0u);
   // Judged by time, the same answers (which run is faster depends on the machine: bench_coherence).
