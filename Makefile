@@ -8,8 +8,10 @@ BUILD_DIR := build/$(PRESET)
 deps:
 	@bash cmake/install-deps.sh
 
+# A build folder made by Unix Makefiles (before the presets named Ninja) is configured afresh.
 configure: deps
-	@cmake --preset $(PRESET) >/dev/null
+	@fresh=; grep -qs '^CMAKE_GENERATOR:INTERNAL=Unix Makefiles$$' $(BUILD_DIR)/CMakeCache.txt && fresh=--fresh; \
+	  cmake --preset $(PRESET) $$fresh >/dev/null
 
 build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)
@@ -20,7 +22,9 @@ demo: configure
 	cmake --build --preset $(PRESET) -j $(JOBS) --target bvhlab_demo
 	$(BUILD_DIR)/bench/bvhlab-demo demo --build-dir $(BUILD_DIR)
 
-test: build
+# What the tests run (target bvhlab_tests: all but the benchmark suites no test runs; `make build` adds them).
+test: configure
+	cmake --build --preset $(PRESET) -j $(JOBS) --target bvhlab_tests
 	ctest --preset $(PRESET) -j $(JOBS)
 
 # ASan + UBSan on the tests declared SANITIZED and the fuzz corpora: the build holds only what they need

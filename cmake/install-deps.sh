@@ -3,7 +3,7 @@
 # As root: `apt-get update` once, then `apt-get install -y` of exactly those.
 # Otherwise: prints the command to run and fails, so `make` stops.
 set -euo pipefail
-packages=(build-essential cmake libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libassimp-dev
+packages=(build-essential cmake ninja-build libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libassimp-dev
           libbenchmark-dev libgtest-dev libfcl-dev libcli11-dev nlohmann-json3-dev libfmt-dev
           python3 python3-matplotlib ca-certificates)
 # Used by the fetch of larger meshes (npm pack) and by the fuzzers (clang, its sanitizer runtimes).
