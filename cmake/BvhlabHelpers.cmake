@@ -60,3 +60,43 @@ function(bvhlab_add_test)
        "endif()\n")
   set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${script}")
 endfunction()
+
+# bvhlab_add_benchmark_test(NAME name BENCHMARK bench_x ARGS ...): a ctest entry that runs a benchmark suite;
+# `make test` builds the suites such tests run and leaves the others to `make build` (bvhlab_tests below).
+function(bvhlab_add_benchmark_test)
+  cmake_parse_arguments(T "" "NAME;BENCHMARK" "ARGS" ${ARGN})
+  add_test(NAME ${T_NAME} COMMAND ${T_BENCHMARK} ${T_ARGS})
+  set_property(GLOBAL APPEND PROPERTY BVHLAB_TESTED_BENCHMARKS ${T_BENCHMARK})
+endfunction()
+
+# Every target defined in `dir` and below it.
+function(bvhlab_targets_below dir out)
+  get_property(targets DIRECTORY ${dir} PROPERTY BUILDSYSTEM_TARGETS)
+  get_property(subdirs DIRECTORY ${dir} PROPERTY SUBDIRECTORIES)
+  foreach(sub ${subdirs})
+    bvhlab_targets_below(${sub} more)
+    list(APPEND targets ${more})
+  endforeach()
+  set(${out} ${targets} PARENT_SCOPE)
+endfunction()
+
+# The target `make test` builds: everything the default build makes but the benchmark suites no test runs,
+# which only compile there (`.ci/run` builds them in a stage of their own).
+function(bvhlab_add_tests_target)
+  bvhlab_targets_below(${PROJECT_SOURCE_DIR} targets)
+  get_property(benchmarks GLOBAL PROPERTY BVHLAB_BENCHMARKS)
+  get_property(tested GLOBAL PROPERTY BVHLAB_TESTED_BENCHMARKS)
+  set(untested ${benchmarks})
+  if(tested)
+    list(REMOVE_ITEM untested ${tested})
+  endif()
+  add_custom_target(bvhlab_tests)
+  foreach(target ${targets})
+    get_target_property(type ${target} TYPE)
+    get_target_property(excluded ${target} EXCLUDE_FROM_ALL)
+    if(type STREQUAL "UTILITY" OR type STREQUAL "INTERFACE_LIBRARY" OR excluded OR target IN_LIST untested)
+      continue()
+    endif()
+    add_dependencies(bvhlab_tests ${target})
+  endforeach()
+endfunction()
