@@ -161,9 +161,9 @@ class Bvh {
 
   [[nodiscard]] const std::vector<TreeNode>& nodes() const { return nodes_; }
   /// Names this tree's topology within the process: a new number for each build and each from_parts (a
-  /// load), kept by copies and by refit(), 0 for an empty tree. What a coherent query's state is bound to
-  /// (traversal/coherent_state.hpp): its stored node pairs mean something only in the topology they came
-  /// from, and a new tree may be given the address of one that is gone.
+  /// load), kept by copies and by refit(), 0 for a default-constructed one. What a coherent query's state is
+  /// bound to (traversal/coherent_state.hpp): its stored node pairs mean something only in the topology they
+  /// came from, and a new tree may be given the address of one that is gone.
   [[nodiscard]] std::uint64_t identity() const { return identity_; }
   [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
   [[nodiscard]] const TreeNode& node(std::uint32_t i) const { return nodes_[i]; }

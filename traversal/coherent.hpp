@@ -35,12 +35,14 @@ namespace coherent_detail {
 inline constexpr std::uint32_t kCold = ~std::uint32_t{0};
 using LeafPair = std::pair<std::uint32_t, std::uint32_t>;
 
-/// Binds a new state to its trees (and B's root box: what a pose jump is measured against, in B's frame);
-/// throws std::invalid_argument for a state bound to other trees.
+/// What a state is bound to of `tree`: its address, identity and node count.
 template <TreeVolume BV>
 CoherentState::TreeKey key_of(const Bvh<BV>& tree) {
   return {&tree, tree.identity(), tree.nodes().size()};
 }
+
+/// Binds a new state to its trees (and B's root box: what a pose jump is measured against, in B's frame);
+/// throws std::invalid_argument for a state bound to other trees.
 template <TreeVolume BV>
 void attach(CoherentState& state, const Bvh<BV>& a, const Bvh<BV>& b) {
   if (!state.bound() && !b.empty()) {
