@@ -9,7 +9,10 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
+#include <string>
+#include <vector>
 
 namespace bvhlab::python {
 
@@ -71,6 +74,30 @@ RigidTransform pose_from(const py::object& pose, const py::object& rotation, con
   return rigid_from_parts(rotation.is_none() ? identity : r.data(), t.data(), "pose");
 }
 
+/// Contacts' geometry as arrays of one row per contact: triangles (K, 2), segments (K, 2, 3: where the two
+/// triangles meet), points (K, 3: the segments' midpoints), normals (K, 3), coplanar (K).
+py::dict geometry_arrays(std::span<const ContactGeometry> contacts) {
+  const auto k = static_cast<py::ssize_t>(contacts.size());
+  py::array_t<std::int64_t> triangles({k, py::ssize_t{2}});
+  py::array_t<double> segments({k, py::ssize_t{2}, py::ssize_t{3}}), points({k, py::ssize_t{3}}),
+      normals({k, py::ssize_t{3}});
+  py::array_t<bool> coplanar(k);
+  for (py::ssize_t i = 0; i < k; ++i) {
+    const ContactGeometry& g = contacts[static_cast<std::size_t>(i)];
+    triangles.mutable_at(i, 0) = g.triangles.a;
+    triangles.mutable_at(i, 1) = g.triangles.b;
+    for (py::ssize_t c = 0; c < 3; ++c) {
+      segments.mutable_at(i, 0, c) = g.from[c];
+      segments.mutable_at(i, 1, c) = g.to[c];
+      points.mutable_at(i, c) = g.point[c];
+      normals.mutable_at(i, c) = g.normal[c];
+    }
+    coplanar.mutable_at(i) = g.coplanar;
+  }
+  return py::dict(py::arg("triangles") = triangles, py::arg("segments") = segments,
+                  py::arg("points") = points, py::arg("normals") = normals, py::arg("coplanar") = coplanar);
+}
+
 struct QueryResult {
   Result result;
   bool geometry_asked = false;
@@ -111,25 +138,7 @@ struct QueryResult {
   /// Per named contact: its triangles, segment, midpoint, normal and whether it is an area contact.
   py::object contact_geometry() const {
     if (!geometry_asked) return py::none();
-    const auto k = static_cast<py::ssize_t>(result.contact_geometry.size());
-    py::array_t<std::int64_t> triangles({k, py::ssize_t{2}});
-    py::array_t<double> segments({k, py::ssize_t{2}, py::ssize_t{3}}), points({k, py::ssize_t{3}}),
-        normals({k, py::ssize_t{3}});
-    py::array_t<bool> coplanar(k);
-    for (py::ssize_t i = 0; i < k; ++i) {
-      const ContactGeometry& g = result.contact_geometry[static_cast<std::size_t>(i)];
-      triangles.mutable_at(i, 0) = g.triangles.a;
-      triangles.mutable_at(i, 1) = g.triangles.b;
-      for (py::ssize_t c = 0; c < 3; ++c) {
-        segments.mutable_at(i, 0, c) = g.from[c];
-        segments.mutable_at(i, 1, c) = g.to[c];
-        points.mutable_at(i, c) = g.point[c];
-        normals.mutable_at(i, c) = g.normal[c];
-      }
-      coplanar.mutable_at(i) = g.coplanar;
-    }
-    return py::dict(py::arg("triangles") = triangles, py::arg("segments") = segments,
-                    py::arg("points") = points, py::arg("normals") = normals, py::arg("coplanar") = coplanar);
+    return geometry_arrays(result.contact_geometry);
   }
   py::dict counters() const {
     const Counters& c = result.counters;
@@ -180,6 +189,8 @@ struct BatchColumns {
       probability_evaluations;
   py::array_t<double> distance, lower_bound, points;  ///< NaN for the strategies that measure no distance
   py::array_t<std::int64_t> nearest_a, nearest_b;
+  /// With contact_geometry=True: each pose's contacts, kept until the batch ends (their number varies).
+  std::optional<std::vector<std::vector<ContactGeometry>>> geometry;
 
   /// Writes result `i` (called without the GIL: raw pointers into arrays this object keeps alive).
   ResultSink sink() {
@@ -188,7 +199,8 @@ struct BatchColumns {
             n = contacts.mutable_data(), bv = bv_tests.mutable_data(), tri = triangle_tests.mutable_data(),
             nodes = nodes_visited.mutable_data(), est = probability_evaluations.mutable_data(),
             d = distance.mutable_data(), lo = lower_bound.mutable_data(), pts = points.mutable_data(),
-            na = nearest_a.mutable_data(), nb = nearest_b.mutable_data()](std::size_t i, const Result& r) {
+            na = nearest_a.mutable_data(), nb = nearest_b.mutable_data(),
+            g = geometry ? &*geometry : nullptr](std::size_t i, const Result& r) {
       c[i] = r.collides;
       e[i] = r.exact;
       x[i] = r.budget_exhausted;
@@ -201,6 +213,7 @@ struct BatchColumns {
       nodes[i] = static_cast<std::int64_t>(r.counters.nodes_visited);
       est[i] = static_cast<std::int64_t>(r.counters.probability_evaluations);
       write_proximity(r, i, d, lo, pts, na, nb);
+      if (g) (*g)[i] = r.contact_geometry;
     };
   }
   static void write_proximity(const Result& r, std::size_t i, double* d, double* lo, double* pts,
@@ -218,14 +231,31 @@ struct BatchColumns {
     nb[i] = pair ? std::int64_t{p->triangles->b} : -1;
   }
   py::dict dict() const {
-    return py::dict(
-        py::arg("collides") = collides, py::arg("probability") = probability, py::arg("exact") = exact,
-        py::arg("budget_exhausted") = budget_exhausted, py::arg("witness_a") = witness_a,
-        py::arg("witness_b") = witness_b, py::arg("contact_count") = contacts, py::arg("bv_tests") = bv_tests,
-        py::arg("triangle_tests") = triangle_tests, py::arg("nodes_visited") = nodes_visited,
-        py::arg("probability_evaluations") = probability_evaluations, py::arg("distance") = distance,
-        py::arg("lower_bound") = lower_bound, py::arg("points") = points, py::arg("nearest_a") = nearest_a,
-        py::arg("nearest_b") = nearest_b);
+    py::dict out(py::arg("collides") = collides, py::arg("probability") = probability,
+                 py::arg("exact") = exact, py::arg("budget_exhausted") = budget_exhausted,
+                 py::arg("witness_a") = witness_a, py::arg("witness_b") = witness_b,
+                 py::arg("contact_count") = contacts, py::arg("bv_tests") = bv_tests,
+                 py::arg("triangle_tests") = triangle_tests, py::arg("nodes_visited") = nodes_visited,
+                 py::arg("probability_evaluations") = probability_evaluations, py::arg("distance") = distance,
+                 py::arg("lower_bound") = lower_bound, py::arg("points") = points,
+                 py::arg("nearest_a") = nearest_a, py::arg("nearest_b") = nearest_b);
+    if (geometry) add_geometry(out);
+    return out;
+  }
+  /// Every pose's contacts in one set of arrays (geometry_arrays), pose i's in rows offsets[i] to
+  /// offsets[i + 1]: contact_offsets (K + 1), contact_triangles, contact_segments, contact_points,
+  /// contact_normals, contact_coplanar.
+  void add_geometry(py::dict& out) const {
+    std::vector<ContactGeometry> all;
+    py::array_t<std::int64_t> offsets(static_cast<py::ssize_t>(geometry->size() + 1));
+    offsets.mutable_at(0) = 0;
+    for (std::size_t i = 0; i < geometry->size(); ++i) {
+      all.insert(all.end(), (*geometry)[i].begin(), (*geometry)[i].end());
+      offsets.mutable_at(static_cast<py::ssize_t>(i + 1)) = static_cast<std::int64_t>(all.size());
+    }
+    out["contact_offsets"] = offsets;
+    for (const auto& [key, value] : geometry_arrays(all))
+      out[("contact_" + key.cast<std::string>()).c_str()] = value;
   }
 };
 
@@ -255,15 +285,18 @@ void run_interruptibly(const PreparedQuery& prepared, std::span<const RigidTrans
 
 py::dict query_batch(const AnyTree& a, const AnyTree& b, const py::object& poses, const py::object& rotations,
                      const py::object& translations, const std::string& strategy, long long bv_tests,
-                     double deadline_us, bool coherent, CoherentState* state, const py::kwargs& parameters) {
+                     double deadline_us, bool coherent, CoherentState* state, bool contact_geometry,
+                     const py::kwargs& parameters) {
   StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
   if (state && !coherent) throw py::value_error("a state is kept by coherent queries: give coherent=True");
   variant.coherent = coherent;
+  variant.contact_geometry = contact_geometry;
   check_strategy_options(variant);
   const std::vector<RigidTransform> checked = poses_from(poses, rotations, translations);
   check_same_kind_of_units(a.info(), b.info());
   const std::unique_ptr<PreparedQuery> prepared = a.prepare(b, variant);
   BatchColumns columns(static_cast<py::ssize_t>(checked.size()));
+  if (contact_geometry) columns.geometry.emplace(checked.size());
   CoherentState own;
   run_interruptibly(*prepared, checked, columns.sink(), coherent ? (state ? state : &own) : nullptr);
   return columns.dict();
@@ -354,7 +387,7 @@ void bind_queries(py::module_& m) {
       "query_batch", &query_batch, py::arg("a"), py::arg("b"), py::arg("poses") = py::none(), py::kw_only(),
       py::arg("rotations") = py::none(), py::arg("translations") = py::none(), py::arg("strategy") = "exact",
       py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0, py::arg("coherent") = false,
-      py::arg("state") = static_cast<CoherentState*>(nullptr),
+      py::arg("state") = static_cast<CoherentState*>(nullptr), py::arg("contact_geometry") = false,
       (std::string(
            "Queries every pose of poses (K, 4, 4), or of rotations (K, 3, 3; default identities) and "
            "translations (K, 3), without holding the GIL; Ctrl-C interrupts it (KeyboardInterrupt) within a "
@@ -364,7 +397,10 @@ void bind_queries(py::module_& m) {
            "Returns a dict of arrays of length K: collides, probability, exact, budget_exhausted, "
            "witness_a and witness_b (-1: none), contact_count and the counters; for the distance "
            "strategies distance, lower_bound, points (K, 2, 3: on A, on B, in A's frame) and nearest_a, "
-           "nearest_b (NaN and -1 for the others).") +
+           "nearest_b (NaN and -1 for the others). contact_geometry=True adds every pose's contacts as "
+           "Result.contact_geometry has them, in arrays of one row per contact: pose i's are rows "
+           "contact_offsets[i] to contact_offsets[i + 1] of contact_triangles, contact_segments, "
+           "contact_points, contact_normals and contact_coplanar.") +
        strategy_help)
           .c_str());
   m.def(

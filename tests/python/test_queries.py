@@ -205,6 +205,30 @@ def test_contact_geometry_lies_where_the_cubes_meet(cube_trees):
         bvhlab.query(adb, adb, translation=shift, strategy="adb", contact_geometry=True)
 
 
+@pytest.mark.parametrize("strategy", ["exact", "all_contacts"])
+def test_batch_contact_geometry_is_the_single_queries(gear_trees, strategy):
+    """query_batch(..., contact_geometry=True): pose i's contacts are rows offsets[i]:offsets[i + 1], the
+    geometry query(..., contact_geometry=True) gives at that pose."""
+    tree = gear_trees["none"]
+    poses = np.concatenate([bvhlab.protocol_poses(d, 12) for d in (1.0, 2.0)])
+    batch = bvhlab.query_batch(tree, tree, poses, strategy=strategy, contact_geometry=True)
+    offsets = batch["contact_offsets"]
+    assert offsets.shape == (len(poses) + 1,) and offsets[0] == 0 and (np.diff(offsets) >= 0).all()
+    rows = offsets[-1]
+    assert rows > 0 and batch["contact_segments"].shape == (rows, 2, 3)
+    for i, pose in enumerate(poses):
+        single = bvhlab.query(tree, tree, pose, strategy=strategy, contact_geometry=True).contact_geometry
+        for key in ("triangles", "segments", "points", "normals", "coplanar"):
+            np.testing.assert_array_equal(batch["contact_" + key][offsets[i]:offsets[i + 1]], single[key])
+    counts = np.diff(offsets)
+    assert (counts[batch["collides"]] > 0).all() and (counts[~batch["collides"]] == 0).all()
+    assert batch["collides"].any() and not batch["collides"].all()
+    assert "contact_offsets" not in bvhlab.query_batch(tree, tree, poses, strategy=strategy)
+    with pytest.raises(ValueError, match="tests no triangles"):
+        adb = gear_trees["adb"]
+        bvhlab.query_batch(adb, adb, poses, strategy="adb", contact_geometry=True)
+
+
 def test_budget_is_kept(gear_trees):
     tree = gear_trees["adb"]
     poses = bvhlab.protocol_poses(1.6, 40)
