@@ -14,8 +14,8 @@
 // is its inverse), and BV and triangle tests per query. A replayed test that answers otherwise than the
 // recorded one ends the run with an error (disagreements).
 #include "bench/core/bench_flags.hpp"
+#include "bench/core/protocol_meshes.hpp"
 #include "bench/report_tables.hpp"
-#include "engine/mesh_catalog.hpp"
 #include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/exact.hpp"
@@ -169,16 +169,10 @@ int main(int argc, char** argv) {
   static std::vector<RigidTransform> poses;
   for (double d : distances)
     for (const RigidTransform& pose : protocol_poses(d, steps)) poses.push_back(pose);
-  for (const auto& file : meshes) {
-    if (!find_mesh(file)) {
-      std::fprintf(stderr, "bench_bv_test: skipping %s (not found; run meshes/fetch.sh)\n", file.c_str());
-      continue;
-    }
-    const auto mesh = std::make_shared<const Mesh>(load_protocol_mesh(file));
-    const std::string label = std::filesystem::path(file).stem().string();
+  for_each_protocol_mesh("bench_bv_test", meshes, [&](const std::string& label, const auto& mesh) {
     for (const auto& v : volumes)
       with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_volume<BV>(label, mesh, poses); });
-  }
+  });
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

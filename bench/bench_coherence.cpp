@@ -12,8 +12,8 @@
 // of queries that started from the root because the front had cost more (cold_share), and the
 // disagreements with the cold answers (the run fails unless 0).
 #include "bench/core/bench_flags.hpp"
+#include "bench/core/protocol_meshes.hpp"
 #include "bench/report_tables.hpp"
-#include "engine/mesh_catalog.hpp"
 #include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/coherent.hpp"
@@ -189,16 +189,10 @@ int main(int argc, char** argv) {
       judge_name == "time" ? CoherenceOptions::Judge::time : CoherenceOptions::Judge::work;
   coherence_options.max_cold_run = static_cast<std::uint32_t>(max_cold_run);
   static const std::vector<PoseSet> sets = make_pose_sets(distances, steps, strides);
-  for (const auto& file : meshes) {
-    if (!find_mesh(file)) {
-      std::fprintf(stderr, "bench_coherence: skipping %s (not found; run meshes/fetch.sh)\n", file.c_str());
-      continue;
-    }
-    const auto mesh = std::make_shared<const Mesh>(load_protocol_mesh(file));
-    const std::string label = std::filesystem::path(file).stem().string();
+  for_each_protocol_mesh("bench_coherence", meshes, [&](const std::string& label, const auto& mesh) {
     for (const auto& v : volumes)
       with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_volume<BV>(label, mesh, sets); });
-  }
+  });
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -12,7 +12,7 @@
 // and the same with three tenths of the tests (`anytime_3tenths`).
 // Each bvhlab series has a `/coherent` twin: the poses in order through query_distance_coherent.
 #include "bench/core/bench_flags.hpp"
-#include "engine/mesh_catalog.hpp"
+#include "bench/core/protocol_meshes.hpp"
 #include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/distance.hpp"
@@ -191,13 +191,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_distance: --steps must be at least 1\n");
     return 2;
   }
-  for (const auto& file : meshes) {
-    if (!find_mesh(file)) {
-      std::fprintf(stderr, "bench_distance: skipping %s (not found; run meshes/fetch.sh)\n", file.c_str());
-      continue;
-    }
-    const auto mesh = std::make_shared<const Mesh>(load_protocol_mesh(file));
-    const std::string label = std::filesystem::path(file).stem().string();
+  for_each_protocol_mesh("bench_distance", meshes, [&](const std::string& label, const auto& mesh) {
     // One pose list per mesh, kept to the end of main: the benchmarks hold references into it.
     static std::deque<std::vector<PoseSet>> per_mesh;
     auto& sets = per_mesh.emplace_back(make_pose_sets(steps));
@@ -219,7 +213,7 @@ int main(int argc, char** argv) {
     register_fcl<fcl::RSSd>(label, "fcl_rss", mesh, sets);
     register_fcl<fcl::OBBRSSd>(label, "fcl_obbrss", mesh, sets);
 #endif
-  }
+  });
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

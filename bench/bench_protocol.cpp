@@ -6,7 +6,7 @@
 // Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
 // protocol's mean time per query. Counters: BV tests and triangle tests per query, bytes per triangle.
 #include "bench/core/bench_flags.hpp"
-#include "engine/mesh_catalog.hpp"
+#include "bench/core/protocol_meshes.hpp"
 #include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/exact.hpp"
@@ -124,20 +124,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   static const std::vector<PoseSet> sets = make_pose_sets(steps);
-  for (const auto& file : meshes) {
-    if (!find_mesh(file)) {
-      std::fprintf(stderr, "bench_protocol: skipping %s (not found; run meshes/fetch.sh)\n", file.c_str());
-      continue;
-    }
-    const auto mesh = std::make_shared<const Mesh>(load_protocol_mesh(file));
-    const std::string label = std::filesystem::path(file).stem().string();
+  for_each_protocol_mesh("bench_protocol", meshes, [&](const std::string& label, const auto& mesh) {
     for (const auto& v : volumes)
       with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_bvhlab<BV>(label, mesh, sets); });
 #ifdef BVHLAB_HAVE_FCL
     register_fcl<fcl::OBBd>(label, "fcl_obb", mesh, sets);
     register_fcl<fcl::OBBRSSd>(label, "fcl_obbrss", mesh, sets);
 #endif
-  }
+  });
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;
