@@ -36,6 +36,7 @@ function(bvhlab_add_test)
   add_executable(${T_NAME} ${T_SOURCES})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main bvhlab_warnings)
   target_include_directories(${T_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+  target_precompile_headers(${T_NAME} REUSE_FROM bvhlab_test_pch)  # tests/CMakeLists.txt
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 600)
   endif()
