@@ -168,6 +168,10 @@ class Bvh {
   [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
   [[nodiscard]] const TreeNode& node(std::uint32_t i) const { return nodes_[i]; }
   [[nodiscard]] const BV& volume(std::uint32_t i) const { return volumes_[i]; }
+  /// Node i's volume in its unpacked form (UnpackedVolume: what the traversals test).
+  [[nodiscard]] const unpacked_volume_t<BV>& unpacked(std::uint32_t i) const requires UnpackedVolume<BV> {
+    return unpacked_[i];
+  }
   /// The root's full volume (hierarchical volumes store every other node relative to its parent).
   [[nodiscard]] const Fitted& root_volume() const { return root_; }
   /// Every node's bounding box in the tree's own frame, decoding hierarchical volumes top-down.
@@ -202,7 +206,8 @@ class Bvh {
     s.depth = depth_;
     s.triangles = triangle_ids_.size();
     s.points = point_ids_.size();
-    s.bytes_per_node = sizeof(TreeNode) + sizeof(BV);
+    s.bytes_per_node =
+        sizeof(TreeNode) + sizeof(BV) + (UnpackedVolume<BV> ? sizeof(unpacked_volume_t<BV>) : 0);
     s.bytes_per_triangle = s.triangles ? double(s.nodes * s.bytes_per_node) / double(s.triangles) : 0;
     s.build_seconds = build_seconds_;
     return s;
@@ -284,7 +289,12 @@ class Bvh {
     }
   }
 
+  // The volumes' derived data: each node's box volume (sizes_) and, for an UnpackedVolume, its unpacked form.
   void compute_sizes() {
+    if constexpr (UnpackedVolume<BV>) {
+      unpacked_.clear();
+      for (const BV& v : volumes_) unpacked_.push_back(BV::unpack(v));
+    }
     sizes_.resize(volumes_.size());
     if constexpr (hierarchical) {
       if (!nodes_.empty() && volumes_.size() == nodes_.size())
@@ -383,6 +393,7 @@ class Bvh {
 
   std::vector<TreeNode> nodes_;
   std::vector<BV> volumes_;
+  std::vector<unpacked_volume_t<BV>> unpacked_;  ///< an UnpackedVolume's, else empty
   Fitted root_{};
   std::vector<float> sizes_;
   std::vector<std::uint32_t> triangle_ids_;

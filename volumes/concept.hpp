@@ -49,6 +49,12 @@
 //                               pose's rotation is orthonormal to rounding. A volume that has it is a
 //                               `DistanceVolume` (proximity queries, issue #38). Hierarchical volumes
 //                               (below) have none.
+//   BV::Unpacked, BV::unpack(a) A form of the volume that is faster to test and larger to keep (an OBB's
+//                               axes as a matrix, not a quaternion). A volume that has it is an
+//                               `UnpackedVolume`: a tree keeps each node's unpacked form beside the stored
+//                               one (Bvh::unpacked; in memory only, saved trees hold the stored form), and
+//                               the traversals call BV::overlap on the unpacked forms (also the 4-argument
+//                               one of a FramePlacingVolume), which must answer exactly as on the stored.
 #pragma once
 
 #include "geometry.hpp"
@@ -79,6 +85,14 @@ concept BoundingVolume = std::is_trivially_copyable_v<BV> && std::is_standard_la
 template <class BV>
 concept FramedVolume = BoundingVolume<BV> && requires(const BV& a) {
   { a.oriented_box() } -> std::same_as<OrientedBox>;
+};
+
+/// A volume with a form that is faster to test (the optional `Unpacked` above).
+template <class BV>
+concept UnpackedVolume = BoundingVolume<BV> &&
+    requires(const BV& a, const typename BV::Unpacked& u, const typename BV::PairContext& context) {
+  { BV::unpack(a) } -> std::same_as<typename BV::Unpacked>;
+  { BV::overlap(u, u, context) } -> std::same_as<bool>;
 };
 
 /// A framed volume whose overlap test hands on the boxes' placement (the optional 4-argument overlap above).
@@ -143,6 +157,19 @@ struct fitted_volume<V> {
 };
 template <class V>
 using fitted_volume_t = typename fitted_volume<V>::type;
+
+/// What a tree keeps beside each stored volume: its Unpacked form, or nothing.
+struct NothingUnpacked {};
+template <class V>
+struct unpacked_volume {
+  using type = NothingUnpacked;
+};
+template <UnpackedVolume V>
+struct unpacked_volume<V> {
+  using type = typename V::Unpacked;
+};
+template <class V>
+using unpacked_volume_t = typename unpacked_volume<V>::type;
 
 namespace detail {
 inline const Vec3 kAxisDirections[3] = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};

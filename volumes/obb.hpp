@@ -101,12 +101,30 @@ struct Obb {
             pose.translation.cwiseAbs().maxCoeff()};
   }
 
+  /// The box with its axes as a matrix (UnpackedVolume): trees keep it beside the stored box, since turning
+  /// the quaternions into axes was about 40% of a test (bench/RESULTS.md, "Time per BV test").
+  struct Unpacked {
+    Mat3 axes;
+    Vec3 center, half;
+    double magnitude;
+  };
+  static Unpacked unpack(const Obb& v) {
+    return {axes_of(v.orientation), to_vec(v.center), to_vec(v.half), v.magnitude()};
+  }
+
   [[gnu::flatten]] static bool overlap(const Obb& a, const Obb& b, const PairContext& c) {
+    return test(unpack(a), unpack(b), c, nullptr);
+  }
+  [[gnu::flatten]] static bool overlap(const Unpacked& a, const Unpacked& b, const PairContext& c) {
     return test(a, b, c, nullptr);
   }
   /// The same test, also handing on the placement it computes (FramePlacingVolume): for the ADB estimate
   /// in the nodes' frames, which would otherwise compute it again.
   [[gnu::flatten]] static bool overlap(const Obb& a, const Obb& b, const PairContext& c,
+                                       PlacedBoxes& placed) {
+    return test(unpack(a), unpack(b), c, &placed);
+  }
+  [[gnu::flatten]] static bool overlap(const Unpacked& a, const Unpacked& b, const PairContext& c,
                                        PlacedBoxes& placed) {
     return test(a, b, c, &placed);
   }
@@ -121,6 +139,10 @@ struct Obb {
   /// separated clouds, a median of bound / distance 0.941 with all nine, 0.940 without those, 0.899 with
   /// none). 0 exactly where overlap() is true.
   [[gnu::flatten]] static double distance_lower_bound(const Obb& a, const Obb& b, const PairContext& c) {
+    return distance_lower_bound(unpack(a), unpack(b), c);
+  }
+  [[gnu::flatten]] static double distance_lower_bound(const Unpacked& a, const Unpacked& b,
+                                                      const PairContext& c) {
     const Placement p = place(a, b, c);
     // Each frame's three face gaps separate A's box from the box around B's along orthogonal axes: their
     // Euclidean length bounds the distance, and unlike the largest single gap it closes in on the distance
@@ -191,16 +213,14 @@ struct Obb {
     Vec3 ha, hb;
     double slack;  // rounding slack of every gap below
   };
-  [[gnu::always_inline]] static Placement place(const Obb& a, const Obb& b, const PairContext& c) {
-    const Mat3 ra = axes_of(a.orientation), rb = axes_of(b.orientation);
-    const Vec3 ca = to_vec(a.center), cb = to_vec(b.center);
+  [[gnu::always_inline]] static Placement place(const Unpacked& a, const Unpacked& b, const PairContext& c) {
     const auto rotation = c.rotation.map();
-    const Mat3 m = ra.transpose() * (rotation * rb);
-    const Vec3 t = ra.transpose() * (rotation * cb + to_vec(c.translation) - ca);
+    const Mat3 m = a.axes.transpose() * (rotation * b.axes);
+    const Vec3 t = a.axes.transpose() * (rotation * b.center + to_vec(c.translation) - a.center);
     const Mat3 abs_m = m.cwiseAbs().array() + Scalar(8) * std::numeric_limits<Scalar>::epsilon();
-    const double slack = 64 * std::numeric_limits<double>::epsilon() *
-                         (a.magnitude() + b.magnitude() + c.translation_magnitude);
-    return {m, t, abs_m, to_vec(a.half), to_vec(b.half), slack};
+    const double slack =
+        64 * std::numeric_limits<double>::epsilon() * (a.magnitude + b.magnitude + c.translation_magnitude);
+    return {m, t, abs_m, a.half, b.half, slack};
   }
   [[gnu::always_inline]] static double square(double x) { return x * x; }
   // |T . L| - radius_a - radius_b on A's face axis i, B's face axis j, and the edge axis a_i x b_j (not a
@@ -220,7 +240,7 @@ struct Obb {
   }
 
   // The 15-axis test; with `placed`, what it computed of the placement is written there.
-  [[gnu::always_inline]] static bool test(const Obb& a, const Obb& b, const PairContext& c,
+  [[gnu::always_inline]] static bool test(const Unpacked& a, const Unpacked& b, const PairContext& c,
                                           PlacedBoxes* placed) {
     const Placement p = place(a, b, c);
     if (placed) *placed = {p.ha, p.hb, {p.m, p.t}};

@@ -1,0 +1,75 @@
+// Unpacked volumes (volumes/concept.hpp, UnpackedVolume): what a tree keeps beside its stored volumes must be
+// their unpacked form after every change, and the tests on it must answer as on the stored volumes.
+#include "bvh/bvh.hpp"
+#include "support/generated_meshes.hpp"
+#include "support/random_draws.hpp"
+#include "volumes/obb.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+
+namespace bvhlab {
+namespace {
+
+using testing::draw_vec3;
+using testing::random_pose;
+
+bool same_bytes(const Obb::Unpacked& a, const Obb::Unpacked& b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+/// Every node's kept form is the unpacked stored volume, bit for bit.
+void expect_unpacked(const Bvh<Obb>& tree, const char* after) {
+  ASSERT_EQ(tree.nodes().size(), tree.volumes().size());
+  for (std::uint32_t i = 0; i < tree.nodes().size(); ++i)
+    ASSERT_TRUE(same_bytes(tree.unpacked(i), Obb::unpack(tree.volume(i))))
+        << "node " << i << " after " << after;
+}
+
+TEST(UnpackedObb, TheTreeKeepsTheUnpackedFormOfEveryVolume) {
+  const Mesh torus = testing::make_torus(1.0, 0.3, 24, 12);
+  Bvh<Obb> tree = Bvh<Obb>::build(torus);
+  expect_unpacked(tree, "the build");
+  Mesh moved = torus;
+  for (Vec3& v : moved.vertices) v = Vec3(1.5 * v.x(), v.y() + 0.2 * v.x() * v.x(), 0.7 * v.z());
+  tree.refit(moved, RefitMethod::Merge);
+  expect_unpacked(tree, "a refit by merging");
+  tree.refit(torus, RefitMethod::Fit);
+  expect_unpacked(tree, "a refit by fitting");
+  const Bvh<Obb> loaded = Bvh<Obb>::from_parts(tree.nodes(), tree.volumes(), tree.triangle_ids());
+  expect_unpacked(loaded, "from_parts");
+  EXPECT_EQ(tree.stats().bytes_per_node, sizeof(TreeNode) + sizeof(Obb) + sizeof(Obb::Unpacked));
+}
+
+TEST(UnpackedObb, AnswersPlacesAndBoundsAsTheStoredBoxes) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int overlapping = 0, apart = 0;
+  for (int k = 0; k < 20000; ++k) {
+    Vec3 pa[6], pb[6];
+    const Vec3 ca = draw_vec3(u, rng), cb = draw_vec3(u, rng);
+    for (int p = 0; p < 6; ++p) pa[p] = ca + 0.5 * draw_vec3(u, rng), pb[p] = cb + 0.5 * draw_vec3(u, rng);
+    const Obb a = Obb::fit(pa), b = Obb::fit(pb);
+    const RigidTransform pose = random_pose(rng, 0.5);
+    const auto context = Obb::make_context(pose);
+    const bool stored = Obb::overlap(a, b, context);
+    ASSERT_EQ(Obb::overlap(Obb::unpack(a), Obb::unpack(b), context), stored) << k;
+    PlacedBoxes from_stored, from_unpacked;
+    ASSERT_EQ(Obb::overlap(a, b, context, from_stored), stored);
+    ASSERT_EQ(Obb::overlap(Obb::unpack(a), Obb::unpack(b), context, from_unpacked), stored);
+    ASSERT_EQ(from_stored.half_a, from_unpacked.half_a);
+    ASSERT_EQ(from_stored.half_b, from_unpacked.half_b);
+    ASSERT_EQ(from_stored.b_in_a.rotation, from_unpacked.b_in_a.rotation);
+    ASSERT_EQ(from_stored.b_in_a.translation, from_unpacked.b_in_a.translation);
+    ASSERT_EQ(Obb::distance_lower_bound(Obb::unpack(a), Obb::unpack(b), context),
+              Obb::distance_lower_bound(a, b, context));
+    (stored ? overlapping : apart)++;
+  }
+  EXPECT_GT(overlapping, 1000);  // both answers were exercised
+  EXPECT_GT(apart, 1000);
+}
+
+}  // namespace
+}  // namespace bvhlab
