@@ -168,9 +168,13 @@ class Bvh {
   [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
   [[nodiscard]] const TreeNode& node(std::uint32_t i) const { return nodes_[i]; }
   [[nodiscard]] const BV& volume(std::uint32_t i) const { return volumes_[i]; }
-  /// Node i's volume in its unpacked form (UnpackedVolume: what the traversals test).
-  [[nodiscard]] const unpacked_volume_t<BV>& unpacked(std::uint32_t i) const requires UnpackedVolume<BV> {
-    return unpacked_[i];
+  /// Node i's volume in the form the traversals test: its unpacked form for an UnpackedVolume, else as
+  /// stored.
+  [[nodiscard]] const auto& tested_volume(std::uint32_t i) const {
+    if constexpr (UnpackedVolume<BV>)
+      return unpacked_[i];
+    else
+      return volumes_[i];
   }
   /// The root's full volume (hierarchical volumes store every other node relative to its parent).
   [[nodiscard]] const Fitted& root_volume() const { return root_; }

@@ -85,7 +85,7 @@ class DistanceHooks {
 
   [[gnu::always_inline]] double evaluate(const Pair& p) {
     ++trees_.counters.bv_tests;
-    return node_distance_bound(trees_.a, p.a, trees_.b, p.b, trees_.context);
+    return BV::distance_lower_bound(trees_.a.tested_volume(p.a), trees_.b.tested_volume(p.b), trees_.context);
   }
   [[gnu::always_inline]] Admission admit(Pair& p, double bound) {
     if (bound >= nearest_.distance) return Admission::Drop;
@@ -295,7 +295,8 @@ class ToleranceHooks {
 
   [[gnu::always_inline]] bool evaluate(const Pair& p) {
     ++trees_.counters.bv_tests;
-    return node_distance_bound(trees_.a, p.a, trees_.b, p.b, trees_.context) <= tolerance_;
+    return BV::distance_lower_bound(trees_.a.tested_volume(p.a), trees_.b.tested_volume(p.b),
+                                    trees_.context) <= tolerance_;
   }
   static Admission admit(Pair&, bool near) { return near ? Admission::Queue : Admission::Drop; }
   [[gnu::always_inline]] Step leaf_pair(const Pair& p) { return within(p.a, p.b); }

@@ -24,16 +24,6 @@ const auto& bvh_of(const Tree& tree) {
 template <TreeVolume BV>
 struct VolumeWalker;
 
-/// BV::distance_lower_bound on nodes i of a and j of b, on their unpacked forms where the volume has them.
-template <DistanceVolume BV>
-[[gnu::always_inline]] inline double node_distance_bound(const Bvh<BV>& a, std::uint32_t i, const Bvh<BV>& b,
-                                                         std::uint32_t j, const typename BV::PairContext& c) {
-  if constexpr (UnpackedVolume<BV>)
-    return BV::distance_lower_bound(a.unpacked(i), b.unpacked(j), c);
-  else
-    return BV::distance_lower_bound(a.volume(i), b.volume(j), c);
-}
-
 template <BoundingVolume BV>
 struct VolumeWalker<BV> {
   struct Working {};
@@ -49,10 +39,7 @@ struct VolumeWalker<BV> {
   [[gnu::always_inline]] static bool overlap(const Bvh<BV>& a, std::uint32_t i, const Working&,
                                              const Bvh<BV>& b, std::uint32_t j, const Working&,
                                              const Context& c) {
-    if constexpr (UnpackedVolume<BV>)
-      return BV::overlap(a.unpacked(i), b.unpacked(j), c);
-    else
-      return BV::overlap(a.volume(i), b.volume(j), c);
+    return BV::overlap(a.tested_volume(i), b.tested_volume(j), c);
   }
   static Box box(const Bvh<BV>& tree, std::uint32_t i, const Working&) {
     return tree.volume(i).bounding_box();

@@ -132,11 +132,7 @@ class TreePair {
   [[gnu::always_inline]] bool overlap(const Pair& p,
                                       PlacedBoxes& placed) const requires FramePlacingVolume<BV> {
     ++counters.bv_tests;
-    bool volumes;
-    if constexpr (UnpackedVolume<BV>)
-      volumes = BV::overlap(a.unpacked(p.a), b.unpacked(p.b), context, placed);
-    else
-      volumes = BV::overlap(a.volume(p.a), b.volume(p.b), context, placed);
+    const bool volumes = BV::overlap(a.tested_volume(p.a), b.tested_volume(p.b), context, placed);
     if constexpr (Leaves::kTriangles)
       return volumes;
     else

@@ -52,9 +52,10 @@
 //   BV::Unpacked, BV::unpack(a) A form of the volume that is faster to test and larger to keep (an OBB's
 //                               axes as a matrix, not a quaternion). A volume that has it is an
 //                               `UnpackedVolume`: a tree keeps each node's unpacked form beside the stored
-//                               one (Bvh::unpacked; in memory only, saved trees hold the stored form), and
-//                               the traversals call BV::overlap on the unpacked forms (also the 4-argument
-//                               one of a FramePlacingVolume), which must answer exactly as on the stored.
+//                               one (Bvh::tested_volume; in memory only, saved trees hold the stored form),
+//                               and the traversals call BV::overlap on the unpacked forms (also the
+//                               4-argument one of a FramePlacingVolume, and a DistanceVolume's
+//                               distance_lower_bound), which must answer exactly as on the stored.
 #pragma once
 
 #include "geometry.hpp"
