@@ -383,8 +383,14 @@ struct KDop {
     return c;
   }
 
+  // Stops at the first separating axis, and works out the slack only for an axis whose intervals are
+  // apart: pairs that overlap, which test every axis, never need it.
   static bool overlap(const KDop& a, const KDop& b, const PairContext& c) {
-    return smallest_overlap(a, b, c) >= -slack(a, b, c);
+    for (std::size_t m = 0; m < kAxes; ++m) {
+      const double o = axis_overlap(a, b, c, m);
+      if (o < 0 && o < -slack(a, b, c)) return false;
+    }
+    return true;
   }
 
   /// DistanceVolume: the widest gap between A's interval and B's (conservative) interval on A's unit axes,
@@ -441,13 +447,6 @@ struct KDop {
   }
 
  private:
-  // Smallest signed overlap of the projection intervals over A's axes; negative means separated (by the
-  // largest gap, -smallest_overlap). Shared by overlap() and distance_lower_bound().
-  [[gnu::always_inline]] static double smallest_overlap(const KDop& a, const KDop& b, const PairContext& c) {
-    double worst = std::numeric_limits<double>::infinity();
-    for (std::size_t m = 0; m < kAxes; ++m) worst = std::min(worst, axis_overlap(a, b, c, m));
-    return worst;
-  }
   // The signed overlap on A's axis m (axes 0 to 2 are the coordinate axes).
   [[gnu::always_inline]] static double axis_overlap(const KDop& a, const KDop& b, const PairContext& c,
                                                     std::size_t m) {
@@ -455,14 +454,15 @@ struct KDop {
     const double b_upper = c.coefficients[m][0] * double(b.offsets[c.planes[m][0]]) +
                            c.coefficients[m][1] * double(b.offsets[c.planes[m][1]]) +
                            c.coefficients[m][2] * double(b.offsets[c.planes[m][2]]) + c.axis_shift[m];
-    const double b_neg_lower = c.coefficients[opposite][0] * double(b.offsets[c.planes[opposite][0]]) +
-                               c.coefficients[opposite][1] * double(b.offsets[c.planes[opposite][1]]) +
-                               c.coefficients[opposite][2] * double(b.offsets[c.planes[opposite][2]]) -
+    // The opposite plane's coefficients are m's (make_context): loaded once for both ends.
+    const double b_neg_lower = c.coefficients[m][0] * double(b.offsets[c.planes[opposite][0]]) +
+                               c.coefficients[m][1] * double(b.offsets[c.planes[opposite][1]]) +
+                               c.coefficients[m][2] * double(b.offsets[c.planes[opposite][2]]) -
                                c.axis_shift[m];
     // B's interval [-b_neg_lower, b_upper] against A's [-a.offsets[opposite], a.offsets[m]].
     return std::min(b_upper + double(a.offsets[opposite]), b_neg_lower + double(a.offsets[m]));
   }
-  // The rounding slack of smallest_overlap (make_context).
+  // The rounding slack of the axes' overlaps (make_context).
   [[gnu::always_inline]] static double slack(const KDop& a, const KDop& b, const PairContext& c) {
     return c.slack_per_a_scale * a.coordinate_scale() + c.slack_per_b_scale * b.coordinate_scale() +
            c.slack_translation;
