@@ -103,7 +103,7 @@ class Bvh {
     out.triangle_ids_ = std::move(ids);
     out.triangles_ = std::move(triangles);
     out.recount();
-    out.compute_sizes();
+    out.derive_from_volumes();
     out.built_spread_ = out.spread();
     return out;
   }
@@ -275,7 +275,7 @@ class Bvh {
     } else {
       volumes_ = std::move(fitted);
     }
-    compute_sizes();
+    derive_from_volumes();
   }
 
   // Calls f(index, decoded volume) for every node, parents before children.
@@ -294,9 +294,10 @@ class Bvh {
   }
 
   // The volumes' derived data: each node's box volume (sizes_) and, for an UnpackedVolume, its unpacked form.
-  void compute_sizes() {
+  void derive_from_volumes() {
     if constexpr (UnpackedVolume<BV>) {
       unpacked_.clear();
+      unpacked_.reserve(volumes_.size());
       for (const BV& v : volumes_) unpacked_.push_back(BV::unpack(v));
     }
     sizes_.resize(volumes_.size());

@@ -303,11 +303,12 @@ struct KDop {
   std::array<float, kPlanes> offsets = filled(-1.0f);
 
   struct PairContext {
-    // Per plane m of A (direction n_m): B's support in n_m is at most
-    //   sum_k coefficients[m][k] * b.offsets[planes[m][k]] + shift(m),
-    // with shift(m) = +axis_shift[a] for m = a < k/2 and -axis_shift[a] for m = a + k/2.
+    // Per plane m of A (direction n_m, on axis a = m mod k/2): B's support in n_m is at most
+    //   sum_k coefficients[a][k] * b.offsets[planes[m][k]] + shift(m),
+    // with shift(m) = +axis_shift[a] for m = a < k/2 and -axis_shift[a] for m = a + k/2. A plane and its
+    // opposite share their coefficients (Tables::opposite), so they are kept once per axis.
     std::array<std::array<std::uint8_t, 3>, kPlanes> planes;
-    std::array<std::array<double, 3>, kPlanes> coefficients;
+    std::array<std::array<double, 3>, kAxes> coefficients;
     std::array<double, kAxes> axis_shift;  // n_a . t
     double slack_per_a_scale;              // rounding slack per unit of A's coordinate magnitude
     double slack_per_b_scale;
@@ -367,7 +368,6 @@ struct KDop {
       t.realign(v, c.planes[m], c.coefficients[m]);
       for (int k = 0; k < 3; ++k)
         c.planes[m + kAxes][k] = static_cast<std::uint8_t>(t.opposite(c.planes[m][k]));
-      c.coefficients[m + kAxes] = c.coefficients[m];
       max_coefficient_sum =
           std::max(max_coefficient_sum, std::abs(c.coefficients[m][0]) + std::abs(c.coefficients[m][1]) +
                                             std::abs(c.coefficients[m][2]));
@@ -454,7 +454,6 @@ struct KDop {
     const double b_upper = c.coefficients[m][0] * double(b.offsets[c.planes[m][0]]) +
                            c.coefficients[m][1] * double(b.offsets[c.planes[m][1]]) +
                            c.coefficients[m][2] * double(b.offsets[c.planes[m][2]]) + c.axis_shift[m];
-    // The opposite plane's coefficients are m's (make_context): loaded once for both ends.
     const double b_neg_lower = c.coefficients[m][0] * double(b.offsets[c.planes[opposite][0]]) +
                                c.coefficients[m][1] * double(b.offsets[c.planes[opposite][1]]) +
                                c.coefficients[m][2] * double(b.offsets[c.planes[opposite][2]]) -

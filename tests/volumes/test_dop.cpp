@@ -105,9 +105,10 @@ TYPED_TEST(DopTest, RealignedSupportBoundsTheExactSupport) {
         for (const Vec3& x : vertices) exact = std::max(exact, normals[m].dot(pose.apply(x)));
         const double shift = m < BV::kAxes ? c.axis_shift[m] : -c.axis_shift[m - BV::kAxes];
         double bound = shift;
+        const auto& coefficients = c.coefficients[m % BV::kAxes];  // shared by a plane and its opposite
         for (int j = 0; j < 3; ++j) {
-          ASSERT_GE(c.coefficients[m][j], -1e-12) << "coefficient outside the normal cone";
-          bound += c.coefficients[m][j] * d[c.planes[m][j]];
+          ASSERT_GE(coefficients[j], -1e-12) << "coefficient outside the normal cone";
+          bound += coefficients[j] * d[c.planes[m][j]];
         }
         ASSERT_GE(bound, exact - 1e-9 * scale) << set.label << ", pose " << k << ", plane " << m;
         if (k == 0) {
