@@ -87,17 +87,7 @@ struct RigidTransform {
   /// Throws std::invalid_argument naming the defect unless the entries are finite, R^T R = I within
   /// `tolerance` and det R = +1. Queries call it once each: a NaN or scaled matrix would otherwise make
   /// every overlap test false and return a silent, "exact" no.
-  void validate(Scalar tolerance = 1e-9) const {
-    if (!rotation.allFinite()) throw std::invalid_argument("transform: rotation has a NaN or infinite entry");
-    if (!translation.allFinite())
-      throw std::invalid_argument("transform: translation has a NaN or infinite entry");
-    const Scalar orthogonality = (rotation.transpose() * rotation - Mat3::Identity()).cwiseAbs().maxCoeff();
-    if (!(orthogonality <= tolerance))
-      throw std::invalid_argument(
-          "transform: rotation is not orthonormal (max |R^T R - I| = " + std::to_string(orthogonality) + ")");
-    if (rotation.determinant() < 0)
-      throw std::invalid_argument("transform: rotation is a reflection (det R = -1), not a rigid motion");
-  }
+  void validate(Scalar tolerance = 1e-9) const;
 
   /// Validated construction from caller input (see validate); never returns a non-rigid transform.
   static RigidTransform checked(const Mat3& rotation, const Vec3& translation, Scalar tolerance = 1e-9) {

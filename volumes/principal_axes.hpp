@@ -4,31 +4,15 @@
 
 #include "geometry.hpp"
 
-#include <Eigen/Eigenvalues>
-
 #include <span>
 
 namespace bvhlab {
 
 /// The mean of `points` (not empty).
-inline Vec3 mean_point(std::span<const Vec3> points) {
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& p : points) mean += p;
-  return mean / double(points.size());
-}
+Vec3 mean_point(std::span<const Vec3> points);
 
 /// The eigenvectors of the covariance of `points` about `mean`, as the columns of a rotation (right-handed);
 /// the identity when the covariance is not finite or the solver fails.
-inline Mat3 principal_axes(std::span<const Vec3> points, const Vec3& mean) {
-  Mat3 covariance = Mat3::Zero();
-  for (const Vec3& p : points) covariance += (p - mean) * (p - mean).transpose();
-  Mat3 axes = Mat3::Identity();
-  if (!covariance.allFinite()) return axes;
-  const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
-  if (solver.info() != Eigen::Success) return axes;
-  axes = solver.eigenvectors();
-  axes.col(2) = axes.col(0).cross(axes.col(1));  // right-handed, so it is a rotation
-  return axes;
-}
+Mat3 principal_axes(std::span<const Vec3> points, const Vec3& mean);
 
 }  // namespace bvhlab

@@ -37,7 +37,6 @@
 
 #include "concept.hpp"
 #include "obb.hpp"
-#include "principal_axes.hpp"
 #include "storage.hpp"
 
 #include <algorithm>
@@ -190,23 +189,9 @@ struct Rss {
 
   static constexpr std::string_view name() { return "rss"; }
 
-  static Rss fit(std::span<const Vec3> points) {
-    if (std::any_of(points.begin(), points.end(), [](const Vec3& p) { return !p.allFinite(); }))
-      throw std::invalid_argument("rss::fit: a point has a NaN or infinite coordinate");
-    return fit_balls(points, {});
-  }
+  static Rss fit(std::span<const Vec3> points);
 
-  static Rss merge(const Rss& a, const Rss& b) {
-    if (a.empty()) return b;
-    if (b.empty()) return a;
-    std::array<Vec3, 8> corners;
-    a.write_corners(corners.data());
-    b.write_corners(corners.data() + 4);
-    std::array<double, 8> radii;
-    std::fill(radii.begin(), radii.begin() + 4, a.corner_radius());
-    std::fill(radii.begin() + 4, radii.end(), b.corner_radius());
-    return fit_balls(corners, radii);
-  }
+  static Rss merge(const Rss& a, const Rss& b);
 
   static PairContext make_context(const RigidTransform& pose) {
     return {PlainMat3::from(pose.rotation), to_double3(pose.translation),
@@ -234,18 +219,7 @@ struct Rss {
 
   /// For loaders of raw node bytes: finite, non-negative half-lengths and radius, and a quaternion that is
   /// close to unit length (fit stores unit ones; axes_of divides by the squared norm).
-  [[nodiscard]] bool valid() const {
-    double norm2 = 0;
-    for (float q : orientation) {
-      if (!std::isfinite(q)) return false;
-      norm2 += double(q) * q;
-    }
-    for (float c : center)
-      if (!std::isfinite(c)) return false;
-    for (float h : half)
-      if (!(std::isfinite(h) && h >= 0)) return false;
-    return std::isfinite(radius) && radius >= 0 && norm2 > 0.5 && norm2 < 2;
-  }
+  [[nodiscard]] bool valid() const;
 
   /// Steiner's formula for a flat convex set swept by a ball: 2 r area + (pi r^2 / 2) perimeter + 4/3 pi r^3.
   [[nodiscard]] Scalar volume() const {
@@ -262,10 +236,7 @@ struct Rss {
     return {to_vec(center) - reach, to_vec(center) + reach};
   }
 
-  [[nodiscard]] bool contains(const Vec3& p) const {
-    if (empty()) return false;
-    return distance_to_rectangle(Obb::axes_of(orientation), to_vec(center), half[0], half[1], p) <= radius;
-  }
+  [[nodiscard]] bool contains(const Vec3& p) const;
 
   /// The rectangle (the frame's first two axes, centre, half-lengths): what the volume sweeps.
   [[nodiscard]] rss::Rectangle rectangle() const {
@@ -314,127 +285,23 @@ struct Rss {
     return to_vec(center).cwiseAbs().maxCoeff() + double(half[0]) + double(half[1]) + double(radius);
   }
 
-  void write_corners(Vec3* out) const {
-    const Mat3 axes = Obb::axes_of(orientation);
-    const Vec3 c = to_vec(center), u = double(half[0]) * axes.col(0), v = double(half[1]) * axes.col(1);
-    out[0] = c - u - v;
-    out[1] = c + u - v;
-    out[2] = c + u + v;
-    out[3] = c - u + v;
-  }
+  void write_corners(Vec3* out) const;
   // The radius a corner carries into a merge: the volume's own, widened by the float rounding of its frame
   // and centre (which the GCC 12 folding, see rounded(), may undo when the volume was just stored) and by the
   // corners' own rounding.
-  [[nodiscard]] double corner_radius() const {
-    const Vec3 c = to_vec(center);
-    return double(radius) + kFrameRounding * std::hypot(double(half[0]), double(half[1])) +
-           0x1p-24 * c.norm() + 16 * kEps * magnitude();
-  }
+  [[nodiscard]] double corner_radius() const;
 
   // One expression for fit and contains, so a fitted point always tests as contained.
   static double distance_to_rectangle(const Mat3& axes, const Vec3& center, double h0, double h1,
-                                      const Vec3& p) {
-    const Vec3 local = axes.transpose() * (p - center);
-    return std::sqrt(rss::detail::outside_squared(local.x(), h0) +
-                     rss::detail::outside_squared(local.y(), h1) + local.z() * local.z());
-  }
+                                      const Vec3& p);
 
   // The RSS holding every ball (points[i], radii[i]; no radii: points), in the better of two frames.
-  static Rss fit_balls(std::span<const Vec3> points, std::span<const double> radii) {
-    if (points.empty()) return {};
-    const Vec3 mean = mean_point(points);
-    const Rss by_pca = fit_in_frame(points, radii, mean, principal_axes(points, mean));
-    const Rss by_axes = fit_in_frame(points, radii, mean, Mat3::Identity());
-    return smaller(by_pca, by_axes) ? by_pca : by_axes;
-  }
+  static Rss fit_balls(std::span<const Vec3> points, std::span<const double> radii);
 
   // The RSS in the frame's axes (orthonormal columns), one of which becomes its normal. Coordinates are
   // taken relative to `origin` (the points' mean), which keeps the digits of a small set far from the origin.
   static Rss fit_in_frame(std::span<const Vec3> points, std::span<const double> radii, const Vec3& origin,
-                          const Mat3& frame) {
-    const auto radius_of = [&](std::size_t i) { return radii.empty() ? 0.0 : radii[i]; };
-    // The normal: the axis along which the balls are thinnest.
-    Vec3 lo = Vec3::Constant(rss::detail::kInfinity), hi = -lo;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const Vec3 s = frame.transpose() * (points[i] - origin);
-      lo = lo.cwiseMin(s - Vec3::Constant(radius_of(i)));
-      hi = hi.cwiseMax(s + Vec3::Constant(radius_of(i)));
-    }
-    int normal = 0;
-    (hi - lo).minCoeff(&normal);
-    Mat3 axes;
-    axes.col(0) = frame.col((normal + 1) % 3);
-    axes.col(1) = frame.col((normal + 2) % 3);
-    axes.col(2) = axes.col(0).cross(axes.col(1));  // right-handed, so it is a rotation
-    const Mat3 to_local = axes.transpose();
-
-    // The slab: the radius spans the balls along the normal.
-    double z_lo = rss::detail::kInfinity, z_hi = -z_lo;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const double z = axes.col(2).dot(points[i] - origin);
-      z_lo = std::min(z_lo, z - radius_of(i));
-      z_hi = std::max(z_hi, z + radius_of(i));
-    }
-    const double z_mid = (z_lo + z_hi) / 2, slab = (z_hi - z_lo) / 2;
-    // How far a ball's centre may lie beyond the rectangle, in its plane, for the ball to stay in the volume.
-    const auto allowance = [&](double z, double r) {
-      return std::sqrt(std::max(0.0, rss::detail::square(slab - r) - rss::detail::square(z - z_mid)));
-    };
-
-    // The rectangle: on each axis the smallest interval no centre exceeds by more than its allowance.
-    double side_lo[2], side_hi[2];
-    {
-      double lowest_high[2] = {rss::detail::kInfinity, rss::detail::kInfinity};    // min of x + allowance
-      double highest_low[2] = {-rss::detail::kInfinity, -rss::detail::kInfinity};  // max of x - allowance
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        const Vec3 s = to_local * (points[i] - origin);
-        const double a = allowance(s.z(), radius_of(i));
-        for (int k = 0; k < 2; ++k) {
-          lowest_high[k] = std::min(lowest_high[k], s[k] + a);
-          highest_low[k] = std::max(highest_low[k], s[k] - a);
-        }
-      }
-      for (int k = 0; k < 2; ++k) {
-        if (lowest_high[k] <= highest_low[k]) {
-          side_lo[k] = lowest_high[k];
-          side_hi[k] = highest_low[k];
-        } else {  // any point between will do: no extent
-          side_lo[k] = side_hi[k] = (lowest_high[k] + highest_low[k]) / 2;
-        }
-      }
-    }
-    // A centre beyond a corner needs its distance to the corner, not only each axis's, within its allowance:
-    // push out the side whose move adds less volume.
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const Vec3 s = to_local * (points[i] - origin);
-      const double a = allowance(s.z(), radius_of(i));
-      const double dx = std::max({0.0, side_lo[0] - s.x(), s.x() - side_hi[0]});
-      const double dy = std::max({0.0, side_lo[1] - s.y(), s.y() - side_hi[1]});
-      if (dx == 0 || dy == 0 || dx * dx + dy * dy <= a * a) continue;
-      const double keep_x = std::sqrt(std::max(0.0, a * a - dy * dy));  // what x may exceed by, y unchanged
-      const double keep_y = std::sqrt(std::max(0.0, a * a - dx * dx));
-      // Volume added per unit of a side's move: slab height times the other side, and the rounded edge.
-      const double cost_x =
-          (dx - keep_x) * (4 * slab * (side_hi[1] - side_lo[1]) + std::numbers::pi * slab * slab);
-      const double cost_y =
-          (dy - keep_y) * (4 * slab * (side_hi[0] - side_lo[0]) + std::numbers::pi * slab * slab);
-      const int k = cost_x <= cost_y ? 0 : 1;
-      const double keep = k == 0 ? keep_x : keep_y;
-      if (s[k] < side_lo[k])
-        side_lo[k] = s[k] + keep;
-      else
-        side_hi[k] = s[k] - keep;
-    }
-
-    // The radius, measured as contains() measures it.
-    const Vec3 center =
-        origin + axes * Vec3((side_lo[0] + side_hi[0]) / 2, (side_lo[1] + side_hi[1]) / 2, z_mid);
-    const double h0 = (side_hi[0] - side_lo[0]) / 2, h1 = (side_hi[1] - side_lo[1]) / 2;
-    double reach = 0;
-    for (std::size_t i = 0; i < points.size(); ++i)
-      reach = std::max(reach, distance_to_rectangle(axes, center, h0, h1, points[i]) + radius_of(i));
-    return rounded(axes, center, h0, h1, reach);
-  }
+                          const Mat3& frame);
 
   // The stored volume for the exact one (frame `axes`, a rotation; every point within `reach` of the
   // rectangle). A point's nearest point on the rectangle, c + axes (x, y, 0), has its twin c' + axes' (x, y,
@@ -442,27 +309,10 @@ struct Rss {
   // the radius grows by that and by a few ulps for contains()'s arithmetic. Bounding the rounding instead of
   // re-measuring against the stored floats also keeps this correct under GCC 12's -O2 SLP vectoriser, which
   // folds double(float(x)) back to x.
-  static Rss rounded(const Mat3& axes, const Vec3& center, double h0, double h1, double reach) {
-    Rss out;
-    Eigen::Quaterniond q(axes);
-    q.normalize();
-    out.orientation = {float(q.x()), float(q.y()), float(q.z()), float(q.w())};
-    out.center = {float(center.x()), float(center.y()), float(center.z())};
-    out.half = {float_up(h0), float_up(h1)};
-    const double moved = kFrameRounding * std::hypot(double(out.half[0]), double(out.half[1])) +
-                         0x1p-24 * center.norm() + 32 * kEps * (h0 + h1 + reach) + 1e-44;
-    out.radius = float_up((reach + moved) * (1 + 8 * kEps));
-    return out;
-  }
+  static Rss rounded(const Mat3& axes, const Vec3& center, double h0, double h1, double reach);
 
   // Smaller volume wins; for (nearly) flat volumes, the smaller rectangle, then the smaller sizes.
-  static bool smaller(const Rss& a, const Rss& b) {
-    const double va = a.volume(), vb = b.volume();
-    if (std::abs(va - vb) > 1e-9 * std::max(va, vb)) return va < vb;
-    const double aa = double(a.half[0]) * a.half[1], ab = double(b.half[0]) * b.half[1];
-    if (std::abs(aa - ab) > 1e-9 * std::max(aa, ab)) return aa < ab;
-    return double(a.half[0]) + a.half[1] + a.radius <= double(b.half[0]) + b.half[1] + b.radius;
-  }
+  static bool smaller(const Rss& a, const Rss& b);
 };
 
 static_assert(BoundingVolume<Rss> && DistanceVolume<Rss>);
