@@ -26,13 +26,17 @@ function(bvhlab_folder_includes target scope)
     $<INSTALL_INTERFACE:include>)
 endfunction()
 
-# bvhlab_add_test(NAME name SOURCES a.cpp ... [LIBS ...] [LABELS ...] [TIMEOUT s] [NEEDS_MESHES] [SANITIZED])
+# bvhlab_add_test(NAME name SOURCES a.cpp ... [LIBS ...] [LABELS ...] [TIMEOUT s] [NEEDS_MESHES] [SANITIZED]
+#                 [ONE_PROCESS])
 # One GoogleTest executable; each TEST is a separate ctest entry so ctest -j spreads them.
+# ONE_PROCESS: the tests share a setup that costs more than they do (a static fixture built once per process,
+# such as annotated trees): ctest runs the executable once, as one entry named after it. The asan preset's
+# GTEST_FILTER leaves out there what its name filter leaves out of the other executables.
 # NEEDS_MESHES: the tests read fetched meshes, so they require the ctest fixture `meshes` (cmake/Meshes.cmake).
 # SANITIZED: the ASan stage builds and runs it too (label `sanitized`, target bvhlab_sanitized_tests; which
 # tests and why: tests/README.md, "Sanitizers and fuzzing"). Every test runs in the Release stage.
 function(bvhlab_add_test)
-  cmake_parse_arguments(T "NEEDS_MESHES;SANITIZED" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(T "NEEDS_MESHES;SANITIZED;ONE_PROCESS" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main bvhlab_warnings)
   target_include_directories(${T_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
@@ -40,7 +44,11 @@ function(bvhlab_add_test)
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 600)
   endif()
-  gtest_discover_tests(${T_NAME} DISCOVERY_TIMEOUT 60)
+  if(T_ONE_PROCESS)
+    add_test(NAME ${T_NAME} COMMAND ${T_NAME})
+  else()
+    gtest_discover_tests(${T_NAME} DISCOVERY_TIMEOUT 60)
+  endif()
   # The properties go into a script ctest includes after the discovered tests, not into
   # gtest_discover_tests(PROPERTIES): that flattens list values ("unit;bvh", two ENVIRONMENT entries) into the
   # name/value pairs, so labels, timeout and environment were silently lost.
@@ -53,6 +61,10 @@ function(bvhlab_add_test)
   string(APPEND properties "${PROJECT_SOURCE_DIR};BVHLAB_MESH_CACHE=${BVHLAB_MESH_CACHE}]==]")
   if(T_NEEDS_MESHES)
     string(APPEND properties " FIXTURES_REQUIRED meshes")
+  endif()
+  if(T_ONE_PROCESS)
+    cmake_language(EVAL CODE "set_tests_properties(${T_NAME} PROPERTIES ${properties})")
+    return()
   endif()
   set(script "${CMAKE_CURRENT_BINARY_DIR}/${T_NAME}_properties.cmake")
   file(WRITE "${script}"
