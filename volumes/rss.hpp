@@ -198,9 +198,24 @@ struct Rss {
             pose.translation.cwiseAbs().maxCoeff()};
   }
 
+  /// The volume with its frame as a matrix (UnpackedVolume): trees keep it beside the stored one, since
+  /// turning the two quaternions into frames is part of every test, as for the OBB.
+  struct Unpacked {
+    Mat3 axes;
+    Vec3 center;
+    double half0, half1, radius;  // radius < 0: empty
+    double magnitude;
+  };
+  static Unpacked unpack(const Rss& v) {
+    return {Obb::axes_of(v.orientation), to_vec(v.center), v.half[0], v.half[1], v.radius, v.magnitude()};
+  }
+
   /// True when the rectangles are at most ra + rb (and the rounding slack) apart.
   [[gnu::flatten]] static bool overlap(const Rss& a, const Rss& b, const PairContext& c) {
-    if (a.empty() || b.empty()) return false;
+    return overlap(unpack(a), unpack(b), c);
+  }
+  [[gnu::flatten]] static bool overlap(const Unpacked& a, const Unpacked& b, const PairContext& c) {
+    if (a.radius < 0 || b.radius < 0) return false;
     return overlapping(a, b, place(a, b, c));
   }
 
@@ -208,7 +223,11 @@ struct Rss {
   /// tested first, so the bound is 0 wherever it is true: most pairs a proximity query tests near contact
   /// overlap, and that test skips every edge whose gaps alone rule out a contact.
   [[gnu::flatten]] static double distance_lower_bound(const Rss& a, const Rss& b, const PairContext& c) {
-    if (a.empty() || b.empty()) return 0;
+    return distance_lower_bound(unpack(a), unpack(b), c);
+  }
+  [[gnu::flatten]] static double distance_lower_bound(const Unpacked& a, const Unpacked& b,
+                                                      const PairContext& c) {
+    if (a.radius < 0 || b.radius < 0) return 0;
     const Placement p = place(a, b, c);
     if (overlapping(a, b, p)) return 0;
     const double squared = squared_gap(a, b, p, rss::detail::kInfinity, 0);
@@ -259,23 +278,22 @@ struct Rss {
   // The slack covers the rounding of the placement (absolute, so it grows with the centres' and the
   // translation's magnitudes, not only with the rectangles') and of the rectangle distance (a few ulps of the
   // coordinates in A's frame, which those magnitudes bound).
-  [[gnu::always_inline]] static Placement place(const Rss& a, const Rss& b, const PairContext& c) {
-    const Mat3 ra = Obb::axes_of(a.orientation), rb = Obb::axes_of(b.orientation);
+  [[gnu::always_inline]] static Placement place(const Unpacked& a, const Unpacked& b, const PairContext& c) {
     const Mat3 rotation = c.rotation.map();  // as in Obb::place: products with the row-major map are slower
-    const Mat3 m = ra.transpose() * (rotation * rb);
-    const Vec3 t = ra.transpose() * (rotation * to_vec(b.center) + to_vec(c.translation) - to_vec(a.center));
-    const double slack = 128 * kEps * (a.magnitude() + b.magnitude() + c.translation_magnitude);
-    return {m, t, double(a.radius) + double(b.radius) + slack};
+    const Mat3 m = a.axes.transpose() * (rotation * b.axes);
+    const Vec3 t = a.axes.transpose() * (rotation * b.center + to_vec(c.translation) - a.center);
+    const double slack = 128 * kEps * (a.magnitude + b.magnitude + c.translation_magnitude);
+    return {m, t, a.radius + b.radius + slack};
   }
   // Whether the rectangles are at most `reach` apart. Starting just above the limit lets every edge whose
   // gaps exceed it be skipped.
-  [[gnu::always_inline]] static bool overlapping(const Rss& a, const Rss& b, const Placement& p) {
+  [[gnu::always_inline]] static bool overlapping(const Unpacked& a, const Unpacked& b, const Placement& p) {
     const double limit = p.reach * p.reach;
     return squared_gap(a, b, p, next_above(limit), limit) <= limit;
   }
-  [[gnu::always_inline]] static double squared_gap(const Rss& a, const Rss& b, const Placement& p,
+  [[gnu::always_inline]] static double squared_gap(const Unpacked& a, const Unpacked& b, const Placement& p,
                                                    double best, double enough) {
-    return rss::detail::squared_distance(p.t, p.m, a.half[0], a.half[1], b.half[0], b.half[1], best, enough);
+    return rss::detail::squared_distance(p.t, p.m, a.half0, a.half1, b.half0, b.half1, best, enough);
   }
 
   // The next double above x (finite, >= 0): std::nextafter without the library call.
@@ -315,6 +333,6 @@ struct Rss {
   static bool smaller(const Rss& a, const Rss& b);
 };
 
-static_assert(BoundingVolume<Rss> && DistanceVolume<Rss>);
+static_assert(BoundingVolume<Rss> && DistanceVolume<Rss> && UnpackedVolume<Rss>);
 
 }  // namespace bvhlab

@@ -4,6 +4,7 @@
 #include "support/generated_meshes.hpp"
 #include "support/random_draws.hpp"
 #include "volumes/obb.hpp"
+#include "volumes/rss.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,21 +17,24 @@ namespace {
 using testing::draw_vec3;
 using testing::random_pose;
 
-bool same_bytes(const Obb::Unpacked& a, const Obb::Unpacked& b) {
+template <class U>
+bool same_bytes(const U& a, const U& b) {
   return std::memcmp(&a, &b, sizeof a) == 0;
 }
 
 /// Every node's kept form is the unpacked stored volume, bit for bit.
-void expect_unpacked(const Bvh<Obb>& tree, const char* after) {
+template <class BV>
+void expect_unpacked(const Bvh<BV>& tree, const char* after) {
   ASSERT_EQ(tree.nodes().size(), tree.volumes().size());
   for (std::uint32_t i = 0; i < tree.nodes().size(); ++i)
-    ASSERT_TRUE(same_bytes(tree.tested_volume(i), Obb::unpack(tree.volume(i))))
+    ASSERT_TRUE(same_bytes(tree.tested_volume(i), BV::unpack(tree.volume(i))))
         << "node " << i << " after " << after;
 }
 
-TEST(UnpackedObb, TheTreeKeepsTheUnpackedFormOfEveryVolume) {
+template <class BV>
+void expect_kept_through_changes() {
   const Mesh torus = testing::make_torus(1.0, 0.3, 24, 12);
-  Bvh<Obb> tree = Bvh<Obb>::build(torus);
+  Bvh<BV> tree = Bvh<BV>::build(torus);
   expect_unpacked(tree, "the build");
   Mesh moved = torus;
   for (Vec3& v : moved.vertices) v = Vec3(1.5 * v.x(), v.y() + 0.2 * v.x() * v.x(), 0.7 * v.z());
@@ -38,9 +42,17 @@ TEST(UnpackedObb, TheTreeKeepsTheUnpackedFormOfEveryVolume) {
   expect_unpacked(tree, "a refit by merging");
   tree.refit(torus, RefitMethod::Fit);
   expect_unpacked(tree, "a refit by fitting");
-  const Bvh<Obb> loaded = Bvh<Obb>::from_parts(tree.nodes(), tree.volumes(), tree.triangle_ids());
+  const Bvh<BV> loaded = Bvh<BV>::from_parts(tree.nodes(), tree.volumes(), tree.triangle_ids());
   expect_unpacked(loaded, "from_parts");
-  EXPECT_EQ(tree.stats().bytes_per_node, sizeof(TreeNode) + sizeof(Obb) + sizeof(Obb::Unpacked));
+  EXPECT_EQ(tree.stats().bytes_per_node, sizeof(TreeNode) + sizeof(BV) + sizeof(typename BV::Unpacked));
+}
+
+TEST(UnpackedObb, TheTreeKeepsTheUnpackedFormOfEveryVolume) {
+  expect_kept_through_changes<Obb>();
+}
+
+TEST(UnpackedRss, TheTreeKeepsTheUnpackedFormOfEveryVolume) {
+  expect_kept_through_changes<Rss>();
 }
 
 TEST(UnpackedObb, AnswersPlacesAndBoundsAsTheStoredBoxes) {
@@ -69,6 +81,34 @@ TEST(UnpackedObb, AnswersPlacesAndBoundsAsTheStoredBoxes) {
   }
   EXPECT_GT(overlapping, 1000);  // both answers were exercised
   EXPECT_GT(apart, 1000);
+}
+
+TEST(UnpackedRss, AnswersAndBoundsAsTheStoredVolumes) {
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int overlapping = 0, apart = 0;
+  for (int k = 0; k < 20000; ++k) {
+    Vec3 pa[6], pb[6];
+    const Vec3 ca = draw_vec3(u, rng), cb = draw_vec3(u, rng);
+    for (int p = 0; p < 6; ++p) pa[p] = ca + 0.5 * draw_vec3(u, rng), pb[p] = cb + 0.5 * draw_vec3(u, rng);
+    const Rss a = Rss::fit(pa), b = Rss::fit(pb);
+    const RigidTransform pose = random_pose(rng, 0.5);
+    const auto context = Rss::make_context(pose);
+    const bool stored = Rss::overlap(a, b, context);
+    ASSERT_EQ(Rss::overlap(Rss::unpack(a), Rss::unpack(b), context), stored) << k;
+    ASSERT_EQ(Rss::distance_lower_bound(Rss::unpack(a), Rss::unpack(b), context),
+              Rss::distance_lower_bound(a, b, context))
+        << k;
+    (stored ? overlapping : apart)++;
+  }
+  EXPECT_GT(overlapping, 1000);  // both answers were exercised
+  EXPECT_GT(apart, 1000);
+  // An empty volume overlaps nothing and bounds nothing, unpacked or not.
+  const Rss empty, some = Rss::fit(std::array<Vec3, 1>{Vec3::Zero()});
+  const auto context = Rss::make_context(RigidTransform{});
+  EXPECT_FALSE(Rss::overlap(Rss::unpack(empty), Rss::unpack(some), context));
+  EXPECT_EQ(Rss::distance_lower_bound(Rss::unpack(some), Rss::unpack(empty), context),
+            Rss::distance_lower_bound(some, empty, context));
 }
 
 }  // namespace
