@@ -15,6 +15,7 @@
 #include "traversal/strategies.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -73,26 +74,48 @@ Tree<BV, D> attach_polygons(const Tree<BV, D>& saved, const Mesh& mesh) {
   return Tree<BV, D>{std::move(with_polygons), saved.density};
 }
 
-template <class BV, class D>
-struct TypedBase;
-
 /// The densities a tree over points can carry (with_cloud_density): only these compile the surface test.
 template <class D>
 inline constexpr bool kCloudDensity = std::is_same_v<D, NoDensity> || std::is_same_v<D, AdbDensity>;
 
-/// Strategy S on two trees of one type, configured once; with kSurfaces, with the clouds' surface test at
+/// What a density-free strategy (kDensityFree) reads of a tree: its hierarchy alone, so that one compiled
+/// query serves the trees of every density.
+template <class BV>
+struct HierarchyOnly {
+  const Bvh<BV>& bvh;
+};
+
+/// A tree as strategy S reads it: `Held` is std::reference_wrapper<const Tree<BV, D>> or HierarchyOnly<BV>.
+template <class T>
+const T& tree_of(const std::reference_wrapper<const T>& held) {
+  return held.get();
+}
+template <class BV>
+const HierarchyOnly<BV>& tree_of(const HierarchyOnly<BV>& held) {
+  return held;
+}
+
+/// The two trees of a prepared query as its strategy reads them, their sides of a point query, and their
+/// models, kept alive while the query lives.
+template <class Held>
+struct QueryTrees {
+  ModelPtr owner_a, owner_b;
+  Held a, b;
+  SurfaceSide side_a, side_b;
+};
+
+/// Strategy S on two trees of volume BV, configured once; with kSurfaces, with the clouds' surface test at
 /// the leaves (traversal/point_leaves.hpp), made per pose as query_exact_points and query_adb_points make it.
-template <class S, class BV, class D, bool kSurfaces>
+template <class S, class BV, class Held, bool kSurfaces>
 class TypedQuery final : public PreparedQuery {
  public:
-  TypedQuery(std::shared_ptr<const TypedBase<BV, D>> a, std::shared_ptr<const TypedBase<BV, D>> b,
-             typename S::Options options, bool coherent, bool contact_geometry = false)
-      : a_(std::move(a)), b_(std::move(b)), options_(std::move(options)), coherent_(coherent) {
+  TypedQuery(QueryTrees<Held> trees, typename S::Options options, bool coherent,
+             bool contact_geometry = false)
+      : trees_(std::move(trees)), options_(std::move(options)), coherent_(coherent) {
     if (contact_geometry)
-      geometry_.emplace(a_->tree.bvh.triangles(), a_->tree.bvh.triangle_ids(), b_->tree.bvh.triangles(),
-                        b_->tree.bvh.triangle_ids());
+      geometry_.emplace(a().bvh.triangles(), a().bvh.triangle_ids(), b().bvh.triangles(),
+                        b().bvh.triangle_ids());
   }
-
   void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
     if (coherent_) {
       CoherentState state;
@@ -142,10 +165,10 @@ class TypedQuery final : public PreparedQuery {
   /// which halves what each combination costs to compile.
   [[gnu::noinline]] Result query(const RigidTransform& pose) const {
     if constexpr (kSurfaces) {
-      const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), pose);
-      return S::query(a_->tree, b_->tree, pose, options_, leaves);
+      const SurfaceLeaves<BV> leaves(a().bvh, trees_.side_a, b().bvh, trees_.side_b, pose);
+      return S::query(a(), b(), pose, options_, leaves);
     } else {
-      return with_geometry(pose, S::query(a_->tree, b_->tree, pose, options_));
+      return with_geometry(pose, S::query(a(), b(), pose, options_));
     }
   }
   Result with_geometry(const RigidTransform& pose, Result r) const {
@@ -157,17 +180,64 @@ class TypedQuery final : public PreparedQuery {
     if constexpr (!kRunsCoherent<S>) {
       throw std::logic_error("strategy " + std::string(S::name()) + " prepared coherent");
     } else if constexpr (kSurfaces) {
-      const SurfaceLeaves<BV> leaves(a_->tree.bvh, a_->side(), b_->tree.bvh, b_->side(), pose);
-      return S::query_coherent(a_->tree, b_->tree, pose, options_, state, leaves);
+      const SurfaceLeaves<BV> leaves(a().bvh, trees_.side_a, b().bvh, trees_.side_b, pose);
+      return S::query_coherent(a(), b(), pose, options_, state, leaves);
     } else {
-      return with_geometry(pose, S::query_coherent(a_->tree, b_->tree, pose, options_, state));
+      return with_geometry(pose, S::query_coherent(a(), b(), pose, options_, state));
     }
   }
-  std::shared_ptr<const TypedBase<BV, D>> a_, b_;
+  const auto& a() const { return tree_of(trees_.a); }
+  const auto& b() const { return tree_of(trees_.b); }
+
+  QueryTrees<Held> trees_;
   typename S::Options options_;
   bool coherent_ = false;
   std::optional<ContactGeometryMaker> geometry_;  ///< when the variant asks for the contacts' geometry
 };
+
+/// The prepared query of strategy S (configured as `options`) on `trees`, with the surface test when a side
+/// is a cloud (compiled only with kClouds: trees whose density a cloud's tree can carry). The caller checked
+/// the variant against the trees.
+template <class S, class BV, bool kClouds, class Held>
+std::unique_ptr<PreparedQuery> make_query(QueryTrees<Held> trees, typename S::Options options,
+                                          const StrategyVariant& variant) {
+  if (!trees.side_a.is_cloud() && !trees.side_b.is_cloud())
+    return std::make_unique<TypedQuery<S, BV, Held, false>>(std::move(trees), std::move(options),
+                                                            variant.coherent, variant.contact_geometry);
+  if constexpr (kClouds && requires(const SurfaceLeaves<BV>& leaves) {
+                  S::query(tree_of(trees.a), tree_of(trees.b), RigidTransform{}, options, leaves);
+                })
+    return std::make_unique<TypedQuery<S, BV, Held, true>>(std::move(trees), std::move(options),
+                                                           variant.coherent);
+  else
+    throw std::logic_error("cloud_query_refusal let strategy " + variant.strategy +
+                           " through without a leaf test");
+}
+
+/// The queries of the density-free strategies on volume slot V, for trees of any density: compiled in the
+/// volume's first slot file only (engine/volume_slot.cpp.in), which every engine with the volume has.
+template <std::size_t V, bool = (V < type_list_size(RegisteredVolumes{}))>
+struct DensityFreeQueries {
+  using BV = TypeAt<V, RegisteredVolumes>;
+  /// Throws std::logic_error for a strategy that is not density-free (the caller dispatches those itself).
+  static std::unique_ptr<PreparedQuery> prepare(QueryTrees<HierarchyOnly<BV>> trees,
+                                                const StrategyVariant& variant);
+};
+template <std::size_t V>
+struct DensityFreeQueries<V, false> {};  ///< a slot beyond the registered volumes
+
+template <std::size_t V, bool kRegistered>
+std::unique_ptr<PreparedQuery> DensityFreeQueries<V, kRegistered>::prepare(
+    QueryTrees<HierarchyOnly<BV>> trees, const StrategyVariant& variant) {
+  return with_strategy(
+      variant.strategy, [&]<class S>(std::type_identity<S>) -> std::unique_ptr<PreparedQuery> {
+        if constexpr (kDensityFree<S> && kAcceptsVolume<S, BV>)
+          return make_query<S, BV, true>(std::move(trees),
+                                         strategy_options<S>(variant.values, variant.budget), variant);
+        else
+          throw std::logic_error("strategy " + variant.strategy + " reached the density-free queries");
+      });
+}
 
 /// A typed tree, of a mesh or of a point cloud (then with its surface): what a query needs of either.
 template <class BV, class D>
@@ -263,35 +333,38 @@ struct TypedBase : TreeModel {
       if (variant.contact_geometry)
         throw std::invalid_argument("contact geometry needs triangles; a point cloud's tree has none");
       if constexpr (kCloudDensity<D>)
-        return prepare_points<S>(std::move(a), std::move(b), std::move(options), variant);
+        check_points<S>(*a, *b, options, variant);
       else
         throw std::logic_error("a tree over points with density " + info.density);
-    }
-    if (S::needs_polygons && !(info.polygons && b->info.polygons))
+    } else if (S::needs_polygons && !(info.polygons && b->info.polygons)) {
       throw std::invalid_argument(
           "strategy " + variant.strategy +
           " tests triangles, and a tree was loaded without polygons (load it with its "
           "mesh)");
-    return std::make_unique<TypedQuery<S, BV, D, false>>(std::move(a), std::move(b), std::move(options),
-                                                         variant.coherent, variant.contact_geometry);
+    }
+    const SurfaceSide side_a = a->side(), side_b = b->side();
+    const Bvh<BV>& bvh_a = a->tree.bvh;
+    const Bvh<BV>& bvh_b = b->tree.bvh;
+    if constexpr (kDensityFree<S>) {
+      QueryTrees<HierarchyOnly<BV>> trees{std::move(a), std::move(b), {bvh_a}, {bvh_b}, side_a, side_b};
+      return DensityFreeQueries<type_index<BV>(RegisteredVolumes{})>::prepare(std::move(trees), variant);
+    } else {
+      const Tree<BV, D>& tree_a = a->tree;
+      const Tree<BV, D>& tree_b = b->tree;
+      QueryTrees<std::reference_wrapper<const Tree<BV, D>>> trees{
+          std::move(a), std::move(b), std::cref(tree_a), std::cref(tree_b), side_a, side_b};
+      return make_query<S, BV, kCloudDensity<D>>(std::move(trees), std::move(options), variant);
+    }
   }
 
-  /// S with the surface test, after SurfaceLeaves' checks of the two sides (so running cannot fail).
+  /// SurfaceLeaves' checks of the two sides and the strategy's (so running cannot fail).
   template <class S>
-  static std::unique_ptr<PreparedQuery> prepare_points(std::shared_ptr<const TypedBase> a,
-                                                       std::shared_ptr<const TypedBase> b,
-                                                       typename S::Options options,
-                                                       const StrategyVariant& variant) {
-    (void)SurfaceLeaves<BV>(a->tree.bvh, a->side(), b->tree.bvh, b->side(), RigidTransform{});
+  static void check_points(const TypedBase& a, const TypedBase& b, const typename S::Options& options,
+                           const StrategyVariant& variant) {
+    (void)SurfaceLeaves<BV>(a.tree.bvh, a.side(), b.tree.bvh, b.side(), RigidTransform{});
     if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, variant.strategy);
         !refusal.empty())
       throw std::invalid_argument(refusal);
-    if constexpr (takes_leaf_test<S, BV, D>)
-      return std::make_unique<TypedQuery<S, BV, D, true>>(std::move(a), std::move(b), std::move(options),
-                                                          variant.coherent);
-    else
-      throw std::logic_error("cloud_query_refusal let strategy " + variant.strategy +
-                             " through without a leaf test");
   }
 };
 

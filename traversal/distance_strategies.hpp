@@ -48,6 +48,7 @@ struct ProximityTraits {
   static constexpr bool needs_polygons = true;
   template <class D>
   static constexpr bool accepts = true;
+  static constexpr bool density_free = true;
   template <class BV>
   static constexpr bool accepts_volume = DistanceVolume<BV>;
   static constexpr bool coherent = true;

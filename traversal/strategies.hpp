@@ -63,6 +63,7 @@ struct ExactStrategy {
   static constexpr bool needs_polygons = true;
   template <class D>
   static constexpr bool accepts = true;
+  static constexpr bool density_free = true;
   static std::span<const ParamSpec> parameters() { return {}; }
   static Options configure(const ParamValues&, const Budget&) { return ContactMode::First; }
   template <class TreeA, class TreeB, class Leaves = TriangleLeaves>

@@ -27,6 +27,10 @@
 //   S::query(..., options, leaves)  The same with another leaf test (traversal/driver.hpp): the shipped
 //                                   strategies take SurfaceLeaves for point clouds
 //                                   (traversal/point_leaves.hpp); optional for a new strategy.
+//   S::density_free        Optional constexpr bool true: the queries read only the trees' `bvh`, never
+//                          their density (exact, all contacts, the proximity strategies). S::query may then
+//                          be given any two objects with a member `bvh`, and the run-time layer compiles
+//                          the strategy once per volume instead of once per volume and density.
 // Optional: running coherent over a sequence of poses (traversal/coherent.hpp)
 //   S::coherent            constexpr bool true: the strategy offers
 //   S::query_coherent(a, b, b_to_a, options, state[, leaves])
@@ -65,6 +69,12 @@ concept Strategy = requires(const ParamValues& values, const Budget& budget) {
 template <class S>
 inline constexpr bool kRunsCoherent = requires {
   requires S::coherent;
+};
+
+/// Whether S reads only the trees' hierarchies (S::density_free, above).
+template <class S>
+inline constexpr bool kDensityFree = requires {
+  requires S::density_free;
 };
 
 /// Whether S runs on trees of volume BV (S::accepts_volume, above).

@@ -140,6 +140,75 @@ TEST(AnyTree, TheDistanceStrategiesRunThroughTheRegistry) {
   EXPECT_GT(apart, 5);
 }
 
+/// What two runs of one strategy must share: the answer, its witnesses and distance, and the work.
+void expect_same_results(const std::vector<Result>& got, const std::vector<Result>& want,
+                         const std::string& label) {
+  ASSERT_EQ(got.size(), want.size()) << label;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i].collides, want[i].collides) << label << ", pose " << i;
+    EXPECT_EQ(got[i].witness, want[i].witness) << label << ", pose " << i;
+    EXPECT_EQ(got[i].contacts, want[i].contacts) << label << ", pose " << i;
+    EXPECT_EQ(got[i].counters.bv_tests, want[i].counters.bv_tests) << label << ", pose " << i;
+    ASSERT_EQ(got[i].proximity.has_value(), want[i].proximity.has_value()) << label << ", pose " << i;
+    if (got[i].proximity) {
+      EXPECT_EQ(got[i].proximity->distance, want[i].proximity->distance) << label;
+    }
+  }
+}
+
+// The strategies that run on every density read only the trees' hierarchies: the engine compiles their
+// queries once per volume (engine/volume_slot.cpp.in), in the file of the first two densities, and the trees
+// of every other density use that code. On each volume and density, cold and coherent, they answer as on
+// the plain trees, and exact answers as guided exact (which reads the density: the other code path) does.
+TEST(AnyTree, AStrategyOfEveryDensityAnswersOnEachAsOnThePlainTree) {
+  // Tilted about x as they move apart: the trees' roles do not commute (B turned about A is not A about B).
+  std::vector<RigidTransform> poses;
+  for (int i = 0; i < 40; ++i)
+    poses.push_back(RigidTransform{Eigen::AngleAxisd(0.9, Vec3::UnitX()).toRotationMatrix(),
+                                   Vec3(0.04 * i, 0.2, 0.01 * i)});
+  const Mesh torus_a = testing::make_torus(0.7, 0.25, 16, 8), torus_b = testing::make_torus(0.5, 0.2, 12, 8);
+  std::size_t compared = 0, colliding = 0;
+  for (const std::string& bv : strategy_info("exact").volumes) {
+    const DensitySpec none = density_spec("none", {});
+    const AnyTree a = AnyTree::build(torus_a, MeshUnits{}, bv, none, BuildOptions{});
+    const AnyTree b = AnyTree::build(torus_b, MeshUnits{}, bv, none, BuildOptions{});
+    for (const DensityInfo& density : density_table()) {
+      if (density.name == "none") continue;
+      const DensitySpec spec = density_spec(density.name, {});
+      const AnyTree a_dense = a.annotated(spec, AnnotationContext{});
+      const AnyTree b_dense = b.annotated(spec, AnnotationContext{});
+      for (const StrategyInfo& s : strategy_table()) {
+        if (s.densities.size() != density_table().size() || !s.volume_refusal(bv).empty()) continue;
+        const ParamValues values =
+            s.parameter("tolerance") ? ParamValues{{"tolerance", 0.05}} : ParamValues{};
+        StrategyVariant variant =
+            strategy_variant(s.name, values, s.budget == BudgetUse::Required ? Budget{30, 0} : Budget{});
+        for (const bool coherent : {false, true}) {
+          if (coherent && !s.coherent) continue;
+          variant.coherent = coherent;
+          const std::string label =
+              s.name + (coherent ? " coherent" : "") + " on " + bv + ", " + density.name;
+          expect_same_results(results_of(a_dense, b_dense, variant, poses), results_of(a, b, variant, poses),
+                              label);
+          ++compared;
+        }
+      }
+      const auto exact = results_of(a_dense, b_dense, StrategyVariant{}, poses);
+      const auto guided = results_of(a_dense, b_dense, strategy_variant("guided_exact", {}, Budget{}), poses);
+      for (std::size_t i = 0; i < poses.size(); ++i) {
+        EXPECT_EQ(exact[i].collides, guided[i].collides) << bv << ", " << density.name << ", pose " << i;
+        colliding += exact[i].collides;
+      }
+    }
+  }
+  // At least exact and all contacts, cold and coherent, on every volume and density: fewer would mean that
+  // one was left out. And the poses cover both answers.
+  const std::size_t series = strategy_info("exact").volumes.size() * (density_table().size() - 1);
+  EXPECT_GE(compared, series * 4);
+  EXPECT_GT(colliding, 0u);
+  EXPECT_LT(colliding, series * poses.size());
+}
+
 TEST(AnyTree, TheDistanceStrategiesRefuseAVolumeWithoutADistanceBound) {
   const AnyTree rbox = torus_tree("rbox", "none");
   for (const char* name : {"distance", "tolerance"}) {
