@@ -148,20 +148,21 @@ Result run(Strategy s, const Annotated<BV>& a, const Annotated<BV>& b, const Rig
 
 // Compiled once, in robust_support.cpp, for every shipped volume: each test file of the suite only calls
 // them (instantiating the five strategies and the annotation per volume in every file cost minutes of CI).
+// The sanitizer builds (BVHLAB_LEAN_VOLUMES) compile only the lean registry's volumes there, the ones their
+// tests of this suite use (the file compiled under ASan in 20 s instead of 30 s, side by side); a file that
+// uses another volume in such a build instantiates it itself.
 #define BVHLAB_ROBUST_INSTANTIATIONS(PREFIX, BV)                                       \
   PREFIX template Result run<BV>(Strategy, const Annotated<BV>&, const Annotated<BV>&, \
                                  const RigidTransform&, double, std::uint64_t);        \
   PREFIX template Annotated<BV> annotated<BV>(const Mesh&, const BuildOptions&);
+#ifdef BVHLAB_LEAN_VOLUMES
+#define BVHLAB_ROBUST_FOR_EACH_VOLUME(X) X(Aabb) X(Dop24) X(Obb) X(Sphere) X(RestrictedBox)
+#else
+#define BVHLAB_ROBUST_FOR_EACH_VOLUME(X) \
+  X(Aabb) X(Dop<6>) X(Dop<14>) X(Dop<18>) X(Dop24) X(Dop<26>) X(Obb) X(Sphere) X(RestrictedBox)
+#endif
 #define BVHLAB_ROBUST_EXTERN(BV) BVHLAB_ROBUST_INSTANTIATIONS(extern, BV)
-BVHLAB_ROBUST_EXTERN(Aabb)
-BVHLAB_ROBUST_EXTERN(Dop<6>)
-BVHLAB_ROBUST_EXTERN(Dop<14>)
-BVHLAB_ROBUST_EXTERN(Dop<18>)
-BVHLAB_ROBUST_EXTERN(Dop24)
-BVHLAB_ROBUST_EXTERN(Dop<26>)
-BVHLAB_ROBUST_EXTERN(Obb)
-BVHLAB_ROBUST_EXTERN(Sphere)
-BVHLAB_ROBUST_EXTERN(RestrictedBox)
+BVHLAB_ROBUST_FOR_EACH_VOLUME(BVHLAB_ROBUST_EXTERN)
 #undef BVHLAB_ROBUST_EXTERN
 
 /// The one promise every strategy keeps: an answer marked exact is right, probabilities are probabilities.
