@@ -1,12 +1,14 @@
 """The demo's CLI (bvhlab-demo, `make demo`) against the full one: on every volume it compiles, the same
-answers and work on colliding and separate poses, with and without ADB; any other volume, and any other
-density, refused by name.
+answers and work on colliding and separate poses, with and without ADB; any other volume, any other
+density, and any scene but a pairs scene, refused by name.
 
 Usage: demo_cli_agrees.py FULL_CLI DEMO_CLI
 """
 import json
+import os
 import subprocess
 import sys
+import tempfile
 
 DEMO_VOLUMES = ["aabb", "dop24", "obb", "rbox"]
 LEFT_OUT = ["dop6", "dop14", "dop18", "dop26", "sphere"]
@@ -53,6 +55,15 @@ def main(full, demo):
         status, _, err = query(full, "aabb", POSES[0], strategy)
         if status != 0:
             failures.append(f"full CLI on {density}: status {status}: {err.strip()}")
+    scenes = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench", "scenes")
+    with tempfile.TemporaryDirectory() as out:
+        for kind in ("world", "deform", "points"):
+            command = [demo, "report", os.path.join(scenes, kind + ".json"), "-o", out, "--no-cache", "--quiet"]
+            done = subprocess.run(command, capture_output=True, text=True, check=False)
+            expected = f"/{kind}: a {kind} scene is not run by this program (the demo's"
+            if done.returncode != 1 or expected not in done.stderr:
+                failures.append(f"demo CLI on {kind}.json: status {done.returncode}, stderr "
+                                f"{done.stderr.strip()!r}; expected {expected!r}")
     for failure in failures:
         print(failure)
     print(f"{len(failures)} failures")
