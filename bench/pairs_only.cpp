@@ -1,6 +1,6 @@
 // What the demo's CLI (bench/bvhlab-demo) has instead of the world, deform and points runners: it runs pairs
 // scenes such as bench/scenes/demo.json, and refuses any other kind of scene by name while parsing it.
-// Leaving the other kinds out saves the demo about 84 s of compiling (tests/README.md, "Build and CI times").
+// Leaving the other kinds out saves the demo about 80 s of compiling (tests/README.md, "Build and CI times").
 #include "bench/core/scene_json.hpp"
 #include "bench/deform/deform.hpp"
 #include "bench/points/points.hpp"

@@ -34,14 +34,17 @@ Tree<BV, D> cloud_tree(const PointCloud& cloud, const ParamValues& density, cons
   }
 }
 
-/// Strategy S runs on point clouds of BV and D: it takes the leaf test as a last argument
-/// (S::query(a, b, pose, options, leaves)).
-template <class S, class BV, class D>
-inline constexpr bool takes_leaf_test = requires(const Tree<BV, D>& tree, const RigidTransform& pose,
-                                                 const typename S::Options& options,
-                                                 const SurfaceLeaves<BV>& leaves) {
+/// Strategy S, given two trees of type TreeT (a Tree<BV, D>, or what else it reads a tree as), runs on point
+/// clouds: it takes the leaf test as a last argument (S::query(a, b, pose, options, leaves)).
+template <class S, class BV, class TreeT>
+inline constexpr bool takes_leaf_test_on = requires(const TreeT& tree, const RigidTransform& pose,
+                                                    const typename S::Options& options,
+                                                    const SurfaceLeaves<BV>& leaves) {
   S::query(tree, tree, pose, options, leaves);
 };
+/// Strategy S runs on point clouds of BV and D.
+template <class S, class BV, class D>
+inline constexpr bool takes_leaf_test = takes_leaf_test_on<S, BV, Tree<BV, D>>;
 
 /// Why strategy S, configured with `options`, cannot query point clouds on trees of BV and D; empty when it
 /// can: it takes a leaf test (takes_leaf_test) and answers something other than triangle pairs

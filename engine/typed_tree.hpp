@@ -94,6 +94,8 @@ template <class BV>
 const HierarchyOnly<BV>& tree_of(const HierarchyOnly<BV>& held) {
   return held;
 }
+template <class Held>
+using HeldTree = std::remove_cvref_t<decltype(tree_of(std::declval<const Held&>()))>;
 
 /// The two trees of a prepared query as its strategy reads them, their sides of a point query, and their
 /// models, kept alive while the query lives.
@@ -204,9 +206,7 @@ std::unique_ptr<PreparedQuery> make_query(QueryTrees<Held> trees, typename S::Op
   if (!trees.side_a.is_cloud() && !trees.side_b.is_cloud())
     return std::make_unique<TypedQuery<S, BV, Held, false>>(std::move(trees), std::move(options),
                                                             variant.coherent, variant.contact_geometry);
-  if constexpr (kClouds && requires(const SurfaceLeaves<BV>& leaves) {
-                  S::query(tree_of(trees.a), tree_of(trees.b), RigidTransform{}, options, leaves);
-                })
+  if constexpr (kClouds && takes_leaf_test_on<S, BV, HeldTree<Held>>)
     return std::make_unique<TypedQuery<S, BV, Held, true>>(std::move(trees), std::move(options),
                                                            variant.coherent);
   else
@@ -229,6 +229,8 @@ struct DensityFreeQueries<V, false> {};  ///< a slot beyond the registered volum
 template <std::size_t V, bool kRegistered>
 std::unique_ptr<PreparedQuery> DensityFreeQueries<V, kRegistered>::prepare(
     QueryTrees<HierarchyOnly<BV>> trees, const StrategyVariant& variant) {
+  // The strategy is looked up by name again and its options made again (the caller checked them): a member
+  // template per strategy would not be covered by the class's extern declaration.
   return with_strategy(
       variant.strategy, [&]<class S>(std::type_identity<S>) -> std::unique_ptr<PreparedQuery> {
         if constexpr (kDensityFree<S> && kAcceptsVolume<S, BV>)
