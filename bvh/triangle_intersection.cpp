@@ -77,4 +77,8 @@ bool triangles_intersect(const TrianglePoints& p, const TrianglePoints& q) {
   return triangles_intersect_fast(p, q);
 }
 
+bool exactly_collinear(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return CGAL::collinear(to_cgal(a), to_cgal(b), to_cgal(c));
+}
+
 }  // namespace bvhlab

@@ -14,4 +14,8 @@ bool triangles_intersect(const TrianglePoints& p, const TrianglePoints& q);
 /// Throws std::invalid_argument for NaN or infinite coordinates.
 bool triangles_intersect_exact(const TrianglePoints& p, const TrianglePoints& q);
 
+/// Whether the three points lie exactly on one line (repeated points included): CGAL's exact predicate.
+/// Here so that callers such as the mesh loader need not parse CGAL themselves (8 s of each file's build).
+bool exactly_collinear(const Vec3& a, const Vec3& b, const Vec3& c);
+
 }  // namespace bvhlab

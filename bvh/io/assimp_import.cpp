@@ -2,8 +2,8 @@
 // kept to the one format the input was checked as, the scene checked before it is triangulated, then merged
 // into one welded Mesh.
 #include "bvh/io/mesh_load_internal.hpp"
+#include "bvh/triangle_intersection.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <assimp/BaseImporter.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -27,7 +27,6 @@
 namespace bvhlab::io {
 namespace {
 
-using Epick = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Mat4 = Eigen::Matrix<double, 4, 4>;
 
 // ---------------------------------------------------------------------------------------------------------
@@ -222,11 +221,7 @@ class SceneMerger {
         ++report_.degenerate_triangles;
         continue;
       }
-      const auto& a = mesh_.vertices[t[0]];
-      const auto& b = mesh_.vertices[t[1]];
-      const auto& c = mesh_.vertices[t[2]];
-      if (CGAL::collinear(Epick::Point_3(a.x(), a.y(), a.z()), Epick::Point_3(b.x(), b.y(), b.z()),
-                          Epick::Point_3(c.x(), c.y(), c.z())))
+      if (exactly_collinear(mesh_.vertices[t[0]], mesh_.vertices[t[1]], mesh_.vertices[t[2]]))
         ++report_.degenerate_triangles;
     }
 
