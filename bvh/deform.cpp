@@ -34,7 +34,7 @@ double parse_number(std::string_view spec, std::string_view key, std::string_vie
 
 // The deformations work in the rest mesh's bounds: its centre, its longest axis and, of the two others,
 // the shortest (a flat sheet's normal).
-struct Frame {
+struct RestFrame {
   Vec3 center;
   Vec3 lo;
   int longest = 0;
@@ -42,10 +42,10 @@ struct Frame {
   double length = 0;
 };
 
-Frame frame_of(const Mesh& rest) {
+RestFrame frame_of(const Mesh& rest) {
   const Box b = rest.bounds();
   const Vec3 e = b.extent();
-  Frame f;
+  RestFrame f;
   f.center = b.center();
   f.lo = b.min;
   for (int k = 1; k < 3; ++k)
@@ -58,11 +58,11 @@ Frame frame_of(const Mesh& rest) {
 }
 
 // The third axis, so (longest, other, shortest) names all three.
-int other_axis(const Frame& f) {
+int other_axis(const RestFrame& f) {
   return 3 - f.longest - f.shortest;
 }
 
-Vec3 twist(const Vec3& p, const Frame& f, double strength) {
+Vec3 twist(const Vec3& p, const RestFrame& f, double strength) {
   const double h = f.length > 0 ? (p[f.longest] - f.center[f.longest]) / f.length : 0;
   const double angle = strength * h, c = std::cos(angle), s = std::sin(angle);
   const int u = other_axis(f), v = f.shortest;
@@ -75,7 +75,7 @@ Vec3 twist(const Vec3& p, const Frame& f, double strength) {
 
 // The longest axis onto an arc of curvature k = strength / length, curling towards the shortest axis. The
 // centre stays fixed. Written without the radius 1/k, so small curvatures lose no precision.
-Vec3 bend(const Vec3& p, const Frame& f, double strength) {
+Vec3 bend(const Vec3& p, const RestFrame& f, double strength) {
   const double k = f.length > 0 ? strength / f.length : 0;
   const double u = p[f.longest] - f.center[f.longest], y = p[f.shortest] - f.center[f.shortest];
   const double phi = u * k;
@@ -176,7 +176,7 @@ Mesh deform(const Mesh& rest, const Deformation& d, double t) {
     if (!rest.vertices[v].allFinite())
       throw std::invalid_argument("deform: vertex " + std::to_string(v) + " of '" + rest.name +
                                   "' is not finite");
-  const Frame f = frame_of(rest);
+  const RestFrame f = frame_of(rest);
   const double phase = 2 * std::numbers::pi * d.cycles * (t - std::floor(t));
   const double strength = d.amplitude * std::sin(phase);
   Mesh out = rest;

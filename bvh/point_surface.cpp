@@ -9,7 +9,9 @@
 
 namespace bvhlab {
 
-namespace {
+// A named namespace: PointSurface::Impl holds a CellGrid, and GCC rejects a member of an internal type in a
+// class with linkage when the file is compiled inside a unity build's unit (-Wsubobject-linkage).
+namespace point_surface_detail {
 
 /// Points hashed into cubic cells at least as wide as the largest support radius, so the points that can
 /// reach x lie in the 27 cells around x's cell.
@@ -58,6 +60,12 @@ class CellGrid {
   double cell_ = 1;
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
 };
+
+}  // namespace point_surface_detail
+
+using point_surface_detail::CellGrid;
+
+namespace {
 
 /// Unit eigenvector of the smallest eigenvalue of a symmetric 3x3 matrix.
 Vec3 least_direction(const Mat3& covariance) {

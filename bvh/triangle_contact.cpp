@@ -48,13 +48,13 @@ Vec3 unit_scale(const Vec3& v) {
 
 // A triangle with its unit normal; `flat` ones (segments, points) have none. Fatness, |normal| over the
 // squared longest edge, picks the prism to clip against.
-struct Face {
+struct ContactFace {
   TrianglePoints v;
   Vec3 unit = Vec3::Zero();
   double fatness = 0;
   bool flat = true;
 
-  explicit Face(const TrianglePoints& t) : v(t) {
+  explicit ContactFace(const TrianglePoints& t) : v(t) {
     const int exponent =
         -exponent_above(std::max({(t[1] - t[0]).cwiseAbs().maxCoeff(), (t[2] - t[0]).cwiseAbs().maxCoeff(),
                                   (t[2] - t[1]).cwiseAbs().maxCoeff()}));
@@ -97,7 +97,7 @@ Polygon clip(const Polygon& in, const Vec3& m, const Vec3& base) {
 }
 
 // t within the prism over reference face r (the inward half-spaces through its edges, containing its normal).
-Polygon inside_prism(const Face& r, const TrianglePoints& t) {
+Polygon inside_prism(const ContactFace& r, const TrianglePoints& t) {
   Polygon c;
   for (const Vec3& x : t) c.push(x);
   for (int k = 0; k < 3 && c.size > 0; ++k) {
@@ -113,7 +113,7 @@ struct Section {
   Points<18> points;
   bool all_on_plane = true;
 };
-Section on_plane(const Polygon& c, const Face& r) {
+Section on_plane(const Polygon& c, const ContactFace& r) {
   std::array<double, 9> height;
   for (int i = 0; i < c.size; ++i) height[i] = r.unit.dot(c.v[i] - r.v[0]);
   Section s;
@@ -169,14 +169,14 @@ struct LocalContact {
 // P ∩ Q in local coordinates, or nullopt where rounding lost a contact the exact test saw (the caller falls
 // back to a common point). The fatter triangle gives the prism: a sliver's side planes meet at a needle-sharp
 // corner, where a vertex kept within the slack of two of them can lie far beyond the corner.
-std::optional<LocalContact> local_contact(const Face& p, const Face& q) {
+std::optional<LocalContact> local_contact(const ContactFace& p, const ContactFace& q) {
   if (p.flat && q.flat) {
     const auto overlap = collinear_overlap(p.v, q.v);
     if (!overlap) return std::nullopt;
     return LocalContact{*overlap, false};
   }
   const bool q_reference = q.fatness >= p.fatness;
-  const Face& reference = q_reference ? q : p;
+  const ContactFace& reference = q_reference ? q : p;
   const Polygon c = inside_prism(reference, q_reference ? p.v : q.v);
   if (c.size == 0) return std::nullopt;
   const Section s = on_plane(c, reference);
@@ -185,7 +185,7 @@ std::optional<LocalContact> local_contact(const Face& p, const Face& q) {
   return LocalContact{farthest_pair(s.points), s.all_on_plane && parallel};
 }
 
-Vec3 contact_normal(const Face& p, const Face& q) {
+Vec3 contact_normal(const ContactFace& p, const ContactFace& q) {
   if (p.flat) return q.flat ? Vec3::Zero() : Vec3(-q.unit);
   if (q.flat) return p.unit;
   const Vec3 difference = p.unit - q.unit;
@@ -201,7 +201,7 @@ std::optional<TriangleContact> triangle_contact(const TrianglePoints& p, const T
   if (!triangles_intersect(p, q)) return std::nullopt;
   Frame frame;
   const auto local = frame.enter(p, q);
-  const Face fp(local[0]), fq(local[1]);
+  const ContactFace fp(local[0]), fq(local[1]);
   const Vec3 normal = contact_normal(fp, fq);
   if (const auto c = local_contact(fp, fq))
     return TriangleContact{frame.world(c->ends.first), frame.world(c->ends.second), normal, c->coplanar};

@@ -24,12 +24,12 @@ constexpr double kTinySquared = 1e-280;
 
 // A triangle with its normal. `flat` (collinear, repeated vertices, or a sliver narrower than 1e-70): no
 // plane, its edges are the point set.
-struct Face {
+struct DistanceFace {
   TrianglePoints v;
   Vec3 normal, unit = Vec3::Zero();
   bool flat;
 
-  explicit Face(const TrianglePoints& t) : v(t), normal(accurate_cross(t[1] - t[0], t[2] - t[0])) {
+  explicit DistanceFace(const TrianglePoints& t) : v(t), normal(accurate_cross(t[1] - t[0], t[2] - t[0])) {
     const double squared = normal.squaredNorm();
     flat = !(squared > kTinySquared);
     if (!flat) unit = normal / std::sqrt(squared);
@@ -63,7 +63,7 @@ Vec3 nearest_on_segment(const Vec3& x, const Vec3& a, const Vec3& b) {
   return t < 1 ? Vec3(a + t * d) : b;
 }
 
-double distance_to_face(const Face& f, const Vec3& x) {
+double distance_to_face(const DistanceFace& f, const Vec3& x) {
   double d = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 3; ++k) d = std::min(d, length(x - nearest_on_segment(x, f.v[k], f.next(k))));
   if (const auto height = f.height_over(x)) d = std::min(d, std::abs(*height));
@@ -98,7 +98,7 @@ void edge_edge(Pair& best, const Vec3& a0, const Vec3& a1, const Vec3& b0, const
 
 // The minimum over the features that can hold the nearest pair of disjoint triangles: vertex-edge (18),
 // edge-edge interiors (9) and vertex-face interiors (6). Exact arithmetic would make it the distance.
-Pair nearest_features(const Face& p, const Face& q) {
+Pair nearest_features(const DistanceFace& p, const DistanceFace& q) {
   Pair best;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
@@ -115,7 +115,7 @@ Pair nearest_features(const Face& p, const Face& q) {
 }
 
 // Where segment [a, b] meets the face's plane, when its ends are on opposite sides or one is on it.
-std::optional<Vec3> plane_crossing(const Face& f, const Vec3& a, const Vec3& b) {
+std::optional<Vec3> plane_crossing(const DistanceFace& f, const Vec3& a, const Vec3& b) {
   if (f.flat) return std::nullopt;
   const double da = (a - f.v[0]).dot(f.normal), db = (b - f.v[0]).dot(f.normal);
   if (da == db || (da > 0 && db > 0) || (da < 0 && db < 0)) return std::nullopt;
@@ -126,7 +126,7 @@ std::optional<Vec3> plane_crossing(const Face& f, const Vec3& a, const Vec3& b) 
 // a transversal intersection), or the midpoint of the nearest feature pair (a vertex in the other triangle,
 // coplanar edges crossing, touching features). Whichever is nearest to both triangles after rounding wins, so
 // the fallback is the nearest feature pair itself.
-Vec3 common_point(const Face& p, const Face& q, const Pair& nearest) {
+Vec3 common_point(const DistanceFace& p, const DistanceFace& q, const Pair& nearest) {
   Vec3 best = Vec3::Zero();
   double residual = std::numeric_limits<double>::infinity();
   const auto consider = [&](const Vec3& x) {
@@ -152,7 +152,7 @@ TriangleDistance triangle_distance(const TrianglePoints& p, const TrianglePoints
   const bool touching = triangles_intersect(p, q);
   Frame frame;
   const auto local = frame.enter(p, q);
-  const Face fp(local[0]), fq(local[1]);
+  const DistanceFace fp(local[0]), fq(local[1]);
   const Pair nearest = nearest_features(fp, fq);
   if (touching) {
     const Vec3 x = frame.world(common_point(fp, fq, nearest));

@@ -88,7 +88,7 @@ std::filesystem::path resolve_mesh(const py::handle& argument) {
   return path;
 }
 
-UnitMesh load(const py::object& argument, bool normalize, double scale) {
+UnitMesh load_unit_mesh(const py::object& argument, bool normalize, double scale) {
   if (!std::isfinite(scale) || scale <= 0) throw py::value_error("scale must be finite and positive");
   const std::filesystem::path path = resolve_mesh(argument);
   LoadedMesh loaded = [&] {
@@ -176,7 +176,7 @@ void bind_meshes(py::module_& m) {
       });
 
   m.def(
-      "load_mesh", &load, py::arg("path"), py::arg("normalize") = false, py::arg("scale") = 1.0,
+      "load_mesh", &load_unit_mesh, py::arg("path"), py::arg("normalize") = false, py::arg("scale") = 1.0,
       "Loads a mesh file (OBJ, PLY, STL, OFF, MS3D, glTF 2, GLB) with the library's checks; a name that is "
       "no "
       "file is looked up in the mesh catalog (bundled meshes/, the fetched-mesh cache). The file's own "

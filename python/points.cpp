@@ -24,7 +24,7 @@ UnitCloud cloud_from_arrays(const py::object& points, const py::object& normals,
   return cloud;
 }
 
-UnitCloud load(const py::object& file) {
+UnitCloud load_unit_cloud(const py::object& file) {
   const std::filesystem::path path = path_argument(file, "PointCloud.load");
   require_file(path, "PointCloud.load");
   UnitCloud cloud;  // in the file's units
@@ -73,7 +73,7 @@ void bind_points(py::module_& m) {
            py::arg("areas") = py::none(), py::arg("name") = "",
            "Checks the arrays: finite (N, 3) points, normals of the same shape, areas (N,) >= 0, not all "
            "points at one position.")
-      .def_static("load", &load, py::arg("path"),
+      .def_static("load", &load_unit_cloud, py::arg("path"),
                   "Reads a PLY (the vertex element: x, y, z and optionally nx, ny, nz) or XYZ file (3 or 6 "
                   "numbers a line); raises PointCloudError naming the file and the problem.")
       .def_static("sample", &sample, py::arg("mesh"), py::arg("count"), py::kw_only(), py::arg("seed") = 1,

@@ -81,7 +81,7 @@ AnyTree build_from_points(const UnitCloud& cloud, const std::string& bv, const s
   });
 }
 
-AnyTree load(const py::object& file, const UnitMesh* mesh) {
+AnyTree load_tree(const py::object& file, const UnitMesh* mesh) {
   const std::filesystem::path path = path_argument(file, "Tree.load");
   require_file(path, "Tree.load");
   py::gil_scoped_release release;
@@ -129,7 +129,7 @@ void bind_trees(py::module_& m) {
            "grid=, tau=); leaf: points per leaf at most (8 to 32 keeps leaf tests cheap). Such a tree "
            "queries a cloud's tree or a mesh's of the same volume and density; it cannot be saved.")
       .def_static(
-          "load", &load, py::arg("path"), py::arg("mesh") = nullptr,
+          "load", &load_tree, py::arg("path"), py::arg("mesh") = nullptr,
           "Reads a saved tree, in the units it records. Saved trees carry no polygons: give the mesh it was "
           "built from to run the strategies that test triangles (it is checked against the tree: its units "
           "and its triangles).")

@@ -12,7 +12,7 @@ namespace bvhlab::scene_json {
 
 namespace {
 
-constexpr long long kMaxFrames = 100000;
+constexpr long long kMaxDeformFrames = 100000;
 constexpr long long kMaxSteps = 100000;
 
 const SceneObject& named_object(const Node& node, const Scene& scene) {
@@ -76,7 +76,7 @@ void parse_frames(const Node& d, const std::filesystem::path& base_dir, DeformSp
   } catch (const std::invalid_argument& e) {
     d.child("deformation").fail(e.what());
   }
-  deform.frames = static_cast<int>(d.child("frames").integer(1, kMaxFrames));
+  deform.frames = static_cast<int>(d.child("frames").integer(1, kMaxDeformFrames));
 }
 
 }  // namespace

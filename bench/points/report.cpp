@@ -17,6 +17,7 @@ namespace bvhlab {
 namespace {
 
 using Group = std::vector<const PointsRow*>;
+using report_tables::percent;
 
 /// The totals cut into (pair, density) groups, in run order.
 std::vector<Group> groups_of(const std::vector<PointsRow>& totals) {
@@ -47,10 +48,6 @@ const PointsRow* fastest_inexact(const Group& g, double max_error) {
 
 double ratio(double reference, double value) {
   return value > 0 ? reference / value : 0;
-}
-
-std::string percent(std::size_t part, std::size_t whole) {
-  return report_tables::percent(part, whole);
 }
 
 std::string group_title(const PointsRow& r) {

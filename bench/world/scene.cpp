@@ -16,7 +16,7 @@ namespace bvhlab::scene_json {
 namespace {
 
 constexpr long long kMaxInstances = 100000;
-constexpr long long kMaxFrames = 1000000;
+constexpr long long kMaxWorldFrames = 1000000;
 constexpr double kMaxPoses = 2e6;  // frames x instances: 190 MB of poses
 
 std::vector<std::string> frame_schedule_names() {
@@ -123,7 +123,7 @@ void parse_motion(const Node& m, const std::filesystem::path& base_dir, WorldSpe
     return;
   }
   m.expect_object({"type", "frames", "seed", "step", "turn_deg"});
-  world.frames = static_cast<int>(m.child("frames").integer(1, kMaxFrames));
+  world.frames = static_cast<int>(m.child("frames").integer(1, kMaxWorldFrames));
   world.seed = m.has("seed") ? static_cast<std::uint64_t>(m.child("seed").integer(0, 1LL << 53)) : 0;
   world.step = m.has("step") ? m.child("step").number(0, 1e12) : 0;
   world.turn_deg = m.has("turn_deg") ? m.child("turn_deg").number(0, 180) : 0;
