@@ -38,8 +38,10 @@ function(bvhlab_folder_includes target scope)
 endfunction()
 
 # bvhlab_add_test(NAME name SOURCES a.cpp ... [LIBS ...] [LABELS ...] [TIMEOUT s] [NEEDS_MESHES] [SANITIZED]
-#                 [ONE_PROCESS])
+#                 [ONE_PROCESS] [UNITY n])
 # One GoogleTest executable; each TEST is a separate ctest entry so ctest -j spreads them.
+# UNITY n: its sources compiled n to a unit (bvhlab_unity): test files that build the same kinds of trees
+# share their instantiation.
 # ONE_PROCESS: the tests share a setup that costs more than they do (a static fixture built once per process,
 # such as annotated trees): ctest runs the executable once, as one entry named after it. The asan preset's
 # GTEST_FILTER leaves out there what its name filter leaves out of the other executables.
@@ -47,8 +49,11 @@ endfunction()
 # SANITIZED: the ASan stage builds and runs it too (label `sanitized`, target bvhlab_sanitized_tests; which
 # tests and why: tests/README.md, "Sanitizers and fuzzing"). Every test runs in the Release stage.
 function(bvhlab_add_test)
-  cmake_parse_arguments(T "NEEDS_MESHES;SANITIZED;ONE_PROCESS" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(T "NEEDS_MESHES;SANITIZED;ONE_PROCESS" "NAME;TIMEOUT;UNITY" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
+  if(T_UNITY)
+    bvhlab_unity(${T_NAME} ${T_UNITY})
+  endif()
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main bvhlab_warnings)
   target_include_directories(${T_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   target_precompile_headers(${T_NAME} REUSE_FROM bvhlab_test_pch)  # tests/CMakeLists.txt

@@ -31,7 +31,7 @@ Tree<BV, AdbDensity> crude_annotation(Bvh<BV> bvh) {
 }
 
 template <class BV>
-struct Scene {
+struct OrderScene {
   Mesh a = testing::make_torus(0.7, 0.25, 40, 20);
   Mesh b = testing::make_random_soup(500, 0.1, 3);
   Tree<BV, AdbDensity> tree_a = crude_annotation(Bvh<BV>::build(a));
@@ -51,7 +51,7 @@ using Volumes = ::testing::Types<Aabb, Obb, Dop24, Sphere, RestrictedBox>;
 TYPED_TEST_SUITE(GuidedExactDepthFirst, Volumes);
 
 TYPED_TEST(GuidedExactDepthFirst, EqualsTheExactAnswer) {
-  const Scene<TypeParam> scene;
+  const OrderScene<TypeParam> scene;
   std::mt19937_64 rng(59);
   int colliding = 0;
   for (int k = 0; k < 250; ++k) {
@@ -77,7 +77,7 @@ TYPED_TEST(GuidedExactDepthFirst, EqualsTheExactAnswer) {
 // Without a budget, decisions are made as pairs are filed, and the pairs filed until the queue runs empty do
 // not depend on the order: depth first must give best first's answer, pose by pose.
 TEST(AdbDepthFirst, GivesTheBestFirstAnswersAndIsHonest) {
-  const Scene<Aabb> scene;
+  const OrderScene<Aabb> scene;
   std::mt19937_64 rng(61);
   int collisions = 0, inexact_no = 0, differing_work = 0;
   for (double p_min : {0.3, 0.7, 0.9, 0.99}) {
@@ -130,7 +130,7 @@ struct InspectedHooks : AdbHooks<Aabb, Estimate> {
 };
 
 template <class Order>
-Result budgeted(const Scene<Aabb>& scene, const RigidTransform& pose, const AdbOptions& options,
+Result budgeted(const OrderScene<Aabb>& scene, const RigidTransform& pose, const AdbOptions& options,
                 double* highest_left, double* top_left) {
   Result result;
   BudgetLimit limit(options.budget);
@@ -147,7 +147,7 @@ Result budgeted(const Scene<Aabb>& scene, const RigidTransform& pose, const AdbO
 }
 
 TEST(AdbDepthFirst, BudgetsHoldAndTheBestEffortSeesTheWholeStack) {
-  const Scene<Aabb> scene;
+  const OrderScene<Aabb> scene;
   std::mt19937_64 rng(67);
   int exhausted = 0, top_was_not_best = 0;
   for (std::uint64_t budget : {1u, 2u, 5u, 17u, 60u, 200u}) {
