@@ -30,9 +30,8 @@ namespace bvhlab {
 /// of the runner and CLI cheap to compile (every volume multiplies the density x strategy instantiations).
 using RegisteredVolumes = TypeList<Aabb, Obb>;
 #elif defined(BVHLAB_LEAN_VOLUMES)
-/// The sanitizer builds (BVHLAB_LEAN_VOLUMES): one k-DOP stands for its family, the same template with other
-/// direction tables. The runner's instantiations are most of a sanitized build's time.
-using RegisteredVolumes = TypeList<Aabb, Dop24, Obb, Sphere, RestrictedBox>;
+/// The sanitizer builds (volumes/shipped.hpp): the runner's instantiations are most of their time.
+using RegisteredVolumes = LeanVolumes;
 #else
 using RegisteredVolumes = ShippedVolumes;
 #endif

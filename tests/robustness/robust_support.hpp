@@ -15,6 +15,7 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace bvhlab::robust {
@@ -157,6 +158,19 @@ Result run(Strategy s, const Annotated<BV>& a, const Annotated<BV>& b, const Rig
   PREFIX template Annotated<BV> annotated<BV>(const Mesh&, const BuildOptions&);
 #ifdef BVHLAB_LEAN_VOLUMES
 #define BVHLAB_ROBUST_FOR_EACH_VOLUME(X) X(Aabb) X(Dop24) X(Obb) X(Sphere) X(RestrictedBox)
+// Explicit instantiations need the names, so the lean list is spelled out here: it must stay the one in
+// volumes/shipped.hpp.
+template <class List>
+struct RobustWithVoidFirst;
+template <class... BV>
+struct RobustWithVoidFirst<TypeList<BV...>> {
+  using type = TypeList<void, BV...>;
+};
+#define BVHLAB_ROBUST_LIST_ITEM(BV) , BV
+static_assert(std::is_same_v<TypeList<void BVHLAB_ROBUST_FOR_EACH_VOLUME(BVHLAB_ROBUST_LIST_ITEM)>,
+                             RobustWithVoidFirst<LeanVolumes>::type>,
+              "BVHLAB_ROBUST_FOR_EACH_VOLUME must list LeanVolumes (volumes/shipped.hpp)");
+#undef BVHLAB_ROBUST_LIST_ITEM
 #else
 #define BVHLAB_ROBUST_FOR_EACH_VOLUME(X) \
   X(Aabb) X(Dop<6>) X(Dop<14>) X(Dop<18>) X(Dop24) X(Dop<26>) X(Obb) X(Sphere) X(RestrictedBox)

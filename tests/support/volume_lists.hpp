@@ -47,7 +47,7 @@ using AllShippedVolumes = SelectTypes<AnyVolume, ShippedVolumes>::type;
 /// the family: the k-DOPs share one template, their volume tests still cover every direction table, and the
 /// other four would double the sanitized compile and run time of these tests. Release runs them all.
 #ifdef BVHLAB_LEAN_VOLUMES
-using TraversalTestVolumes = ::testing::Types<Aabb, Dop24, Obb, Sphere, RestrictedBox>;
+using TraversalTestVolumes = SelectTypes<AnyVolume, LeanVolumes>::type;
 #else
 using TraversalTestVolumes = AllShippedVolumes;
 #endif
