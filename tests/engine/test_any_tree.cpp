@@ -20,12 +20,7 @@ namespace bvhlab {
 namespace {
 
 using testing::error_of;
-
-std::vector<RigidTransform> poses_along_x() {
-  std::vector<RigidTransform> poses;
-  for (int i = 0; i < 40; ++i) poses.push_back(RigidTransform::translate(Vec3(0.05 * i, 0.01 * i, 0)));
-  return poses;
-}
+using testing::poses_along_x;
 
 AnyTree torus_tree(const std::string& bv, const std::string& density) {
   return AnyTree::build(testing::make_torus(0.7, 0.25, 24, 12), MeshUnits{}, bv, density_spec(density, {}),

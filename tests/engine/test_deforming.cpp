@@ -27,16 +27,11 @@ Mesh twisted(double t) {
   return deform(rest_torus(), parse_deformation("twist:amplitude=2"), t);
 }
 
-std::vector<RigidTransform> poses_past_the_torus() {
-  std::vector<RigidTransform> poses;
-  for (int i = 0; i < 40; ++i) poses.push_back(RigidTransform::translate(Vec3(0.05 * i, 0.01 * i, 0)));
-  return poses;
-}
-
 /// Every pose's result of `variant` with `a` fixed and `b` moved.
 std::vector<Result> answers(const AnyTree& a, const AnyTree& b, const StrategyVariant& variant) {
-  std::vector<Result> out(poses_past_the_torus().size());
-  a.prepare(b, variant)->run(poses_past_the_torus(), [&](std::size_t k, const Result& r) { out[k] = r; });
+  const std::vector<RigidTransform> poses = testing::poses_along_x();
+  std::vector<Result> out(poses.size());
+  a.prepare(b, variant)->run(poses, [&](std::size_t k, const Result& r) { out[k] = r; });
   return out;
 }
 

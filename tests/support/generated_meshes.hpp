@@ -6,6 +6,7 @@
 #include "random_draws.hpp"
 
 #include <random>
+#include <vector>
 
 namespace bvhlab::testing {
 
@@ -36,6 +37,14 @@ inline RigidTransform random_pose(std::mt19937_64& rng, double r) {
   pose.rotation = q.toRotationMatrix();
   pose.translation = draw_vec3(unit, rng);
   return pose;
+}
+
+/// 40 translations from the origin to (1.95, 0.39, 0): a copy of make_torus(0.7, 0.25, ...) moved along them
+/// goes from overlapping its fixed twin to clear of it.
+inline std::vector<RigidTransform> poses_along_x() {
+  std::vector<RigidTransform> poses;
+  for (int i = 0; i < 40; ++i) poses.push_back(RigidTransform::translate(Vec3(0.05 * i, 0.01 * i, 0)));
+  return poses;
 }
 
 }  // namespace bvhlab::testing
