@@ -33,7 +33,7 @@ const PairOps& ops_of(std::string_view bv, std::string_view density) {
       if constexpr (engine_detail::slot_compiled(v, d))
         return &engine_detail::slot_ops<v, d>();
       else
-        return &engine_detail::left_out_ops<v, d>();
+        return &engine_detail::left_out_ops<v, d, engine_detail::slot_compiled(v, 0)>();  // 0: none
     });
   });
 }

@@ -40,13 +40,12 @@ struct CannotAnnotate {
   }
 };
 
-/// A combination this engine leaves out, and the program that has it.
-template <class BV, class D>
+/// A combination this engine leaves out, and the program that has it; kVolumeCompiled: the engine has the
+/// volume (with other densities), so the density is what is missing.
+template <class BV, class D, bool kVolumeCompiled>
 struct NotCompiled {
   static std::string text() {
-    // Density 0 (none) is in every engine: with it, the volume is there and the density is what is missing.
-    const bool volume_compiled = slot_compiled(type_index<BV>(RegisteredVolumes{}), 0);
-    return (volume_compiled
+    return (kVolumeCompiled
                 ? "density " + std::string(D::name()) + " on " + std::string(BV::name()) + " trees"
                 : "bounding volume " + std::string(BV::name())) +
            " is not compiled into this program (the demo's, which has what bench/scenes/demo.json uses); the "
@@ -54,10 +53,11 @@ struct NotCompiled {
   }
 };
 
-template <std::size_t V, std::size_t D>
+template <std::size_t V, std::size_t D, bool kVolumeCompiled>
 const PairOps& left_out_ops() {
   if constexpr (V < type_list_size(RegisteredVolumes{}) && D < type_list_size(RegisteredDensities{}))
-    return refusing_ops<NotCompiled<TypeAt<V, RegisteredVolumes>, TypeAt<D, RegisteredDensities>>>();
+    return refusing_ops<
+        NotCompiled<TypeAt<V, RegisteredVolumes>, TypeAt<D, RegisteredDensities>, kVolumeCompiled>>();
   else
     throw std::logic_error("engine slot beyond the registered volumes and densities");
 }

@@ -85,8 +85,9 @@ constexpr bool slot_compiled(std::size_t v, std::size_t d) {
 #endif
 }
 
-/// The operations of a volume and density this engine leaves out: refusals naming them (engine/refusals.hpp).
-template <std::size_t V, std::size_t D>
+/// The operations of a volume and density this engine leaves out: refusals naming them (engine/refusals.hpp);
+/// kVolumeCompiled: the engine has the volume with other densities.
+template <std::size_t V, std::size_t D, bool kVolumeCompiled>
 const PairOps& left_out_ops();
 
 }  // namespace bvhlab::engine_detail

@@ -3,7 +3,6 @@
 #include "python/bindings.hpp"
 
 #include <cmath>
-#include <optional>
 
 namespace bvhlab::python {
 
@@ -39,14 +38,14 @@ UnitCloud sample(const UnitMesh& mesh, long long count, long long seed, const py
   if (count < 1) throw py::value_error("count must be >= 1");
   if (seed < 0) throw py::value_error("seed must be >= 0");
   if (k < 1) throw py::value_error("k must be >= 1");
-  const std::optional<double> varying =
-      ratio.is_none() ? std::nullopt : std::optional<double>(py::cast<double>(ratio));
+  const bool varying = !ratio.is_none();
+  const double varying_ratio = varying ? py::cast<double>(ratio) : 0.0;
   UnitCloud cloud;
   cloud.units = mesh.units;  // the sampled points are in the mesh's units
   py::gil_scoped_release release;
   if (varying) {
-    static_cast<PointCloud&>(cloud) =
-        sample_varying(mesh, static_cast<std::size_t>(count), static_cast<std::uint64_t>(seed), *varying);
+    static_cast<PointCloud&>(cloud) = sample_varying(mesh, static_cast<std::size_t>(count),
+                                                     static_cast<std::uint64_t>(seed), varying_ratio);
     assign_knn_areas(cloud, static_cast<std::size_t>(k));
   } else {
     static_cast<PointCloud&>(cloud) =
