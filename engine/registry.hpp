@@ -26,9 +26,9 @@ namespace bvhlab {
 
 /// The shipped volume models, listed once in volumes/shipped.hpp (the typed volume tests use that list too).
 #if defined(BVHLAB_TEST_POLICIES)
-/// The test variant proves the density and strategy axes, not the volumes: two volumes keep its second copy
-/// of the runner and CLI cheap to compile (every volume multiplies the density x strategy instantiations).
-using RegisteredVolumes = TypeList<Aabb, Obb>;
+/// The test variant proves the density and strategy axes, not the volumes: one volume keeps its second copy
+/// of the engine cheap to compile (every volume multiplies the density x strategy instantiations).
+using RegisteredVolumes = TypeList<Aabb>;
 #elif defined(BVHLAB_LEAN_VOLUMES)
 /// The sanitizer builds (volumes/shipped.hpp): the runner's instantiations are most of their time.
 using RegisteredVolumes = LeanVolumes;

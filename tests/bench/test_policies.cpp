@@ -53,10 +53,10 @@ TEST_F(TestPolicies, TheTablesListThemWithTheirParameters) {
 
 TEST_F(TestPolicies, ASceneRunsAndReportsThem) {
   const Scene scene = parse_scene(R"({"name": "policies", "objects": [{"mesh": "torus.obj"}],
-      "hierarchies": [{"bv": "aabb"}, {"bv": "obb"}],
+      "hierarchies": [{"bv": "aabb"}, {"bv": "aabb", "name": "aabb_wide", "max_leaf_triangles": 8}],
       "annotation": {"type": "tricount", "cap": 4},
       "strategies": [{"type": "exact"}, {"type": "root_overlap"}, {"type": "adb", "p_min": [0.5, 0.9]},
-                     {"type": "guided_exact", "hierarchies": ["obb"]}],
+                     {"type": "guided_exact", "hierarchies": ["aabb_wide"]}],
       "workload": {"distances": [0.8, 1.6, 3.5], "steps": 16}, "report": {"cgal_sample": 4}})",
                                   dir.path(), "policies.json");
   EXPECT_EQ(scene.report.operating_strategy, "adb");
