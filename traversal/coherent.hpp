@@ -14,6 +14,7 @@
 //   3. raises: an inner pair whose children are all disjoint again is tested itself, and if disjoint becomes
 //      one front pair (so objects moving apart end up with their root pair alone). A parent that still
 //      overlaps is not tested again for CoherenceOptions::raise_hold queries.
+// While the stored tree is the root pair alone, step 2 is the root pair's test, made without the walk.
 // The answer is exact whatever the state holds: "no contact" only when every front pair was found disjoint
 // or without contact at the current pose, "contact" only with a triangle pair intersecting at it. The state
 // starts from the root when it is new, after a pose jump or when its tree grew past max_pairs.
@@ -65,12 +66,16 @@ class FrontWalk {
       : trees_(trees), stored_(stored), next_(next), hooks_(hooks), raise_hold_(raise_hold) {}
 
   /// The leaf pair of the first contact (the hooks stop there in first-contact mode), or nullopt once the
-  /// whole tree was walked.
-  std::optional<LeafPair> run() {
+  /// whole tree was walked. root_overlaps: the caller took and tested the root pair, which overlaps.
+  std::optional<LeafPair> run(bool root_overlaps = false) {
     next_.clear();
     next_.push_back(FrontPair{});
     items_.clear();
-    items_.push_back({trees_.template root<Pair>(), 0, stored_.empty() ? kCold : 0, false});
+    const Item root{trees_.template root<Pair>(), 0, stored_.empty() ? kCold : 0, false};
+    if (!root_overlaps)
+      items_.push_back(root);
+    else if (auto hit = descend(root))
+      return hit;
     while (!items_.empty()) {
       const Item item = items_.back();
       items_.pop_back();
@@ -107,11 +112,16 @@ class FrontWalk {
 
   /// A front pair, or a pair below one that overlaps: tested as the exact strategy tests it.
   std::optional<LeafPair> test(const Item& item) {
-    const Pair& p = item.pair;
-    if (!trees_.overlap(p)) {
+    if (!trees_.overlap(item.pair)) {
       next_[item.out].separated = 1;
       return std::nullopt;
     }
+    return descend(item);
+  }
+
+  /// A pair that overlaps: its leaf test, or its children to visit.
+  std::optional<LeafPair> descend(const Item& item) {
+    const Pair& p = item.pair;
     if (trees_.is_leaf_pair(p)) {
       if (hooks_.leaf_pair(p) == Step::Decided) return LeafPair{p.a, p.b};
       return std::nullopt;
@@ -232,11 +242,22 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
       return result;
     }
   }
+  // Objects apart at the last query: walking the stored tree is testing the root pair, so it is tested
+  // directly, without the walk's bookkeeping; a root pair that overlaps now is walked from there.
+  const bool root_tested = !cold && state.root_apart();
+  if (root_tested) {
+    ++result.counters.nodes_visited;
+    if (!trees.overlap(trees.template root<typename Walk::Pair>())) {
+      state.restamp(b_to_a);
+      state.record_cost(result.counters, seconds(), CoherentState::Start::Front);
+      return result;
+    }
+  }
   const bool from_front = !cold && state.front_usable(b_to_a);
   if (!from_front) state.pairs().clear();
   std::vector<FrontPair>& next = state.spare();
   Walk walk(trees, state.pairs(), next, hooks, state.options().raise_hold);
-  state.witness = walk.run();
+  state.witness = walk.run(root_tested);  // here the root pair overlaps
   // A contact ends the walk early; the tree it built is still a cut of every pair (each pair not reached yet
   // is a front pair there, to be tested), so the next query starts from it rather than from the root.
   state.store(next, b_to_a);

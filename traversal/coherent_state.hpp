@@ -106,9 +106,15 @@ class CoherentState {
   /// counts a jump otherwise.
   [[nodiscard]] bool front_usable(const RigidTransform& pose);
   std::vector<FrontPair>& pairs() { return pairs_; }
+  /// Whether the stored tree is the root pair alone, disjoint when last tested: the objects were apart.
+  [[nodiscard]] bool root_apart() const {
+    return pairs_.size() == 1 && pairs_[0].count == 0 && pairs_[0].separated != 0;
+  }
   std::vector<FrontPair>& spare() { return spare_; }
   /// Keeps `next` (built for `pose`) as the stored tree, or drops it when larger than max_pairs.
   void store(std::vector<FrontPair>& next, const RigidTransform& pose);
+  /// The stored tree holds at `pose` as it is (a root pair found disjoint there again).
+  void restamp(const RigidTransform& pose) { pose_ = pose; }
   /// The node pair that decided the last answer, if one did: the exact queries' colliding leaf pair, the
   /// ADB queries' deciding pair (traversal/coherent_adb.hpp).
   std::optional<std::pair<std::uint32_t, std::uint32_t>> witness;

@@ -37,6 +37,21 @@ TEST_F(ClearOfContact, MovingApartRaisesTheFrontToTheRoot) {
   EXPECT_EQ(query_exact_coherent(a, b, pose, state).counters.bv_tests, 1u);
 }
 
+TEST_F(ClearOfContact, ObjectsApartTestTheRootAloneUntilTheyMeetAgain) {
+  const RigidTransform touching = RigidTransform::translate(Vec3(1.0, 0.1, 0.05));
+  ASSERT_TRUE(query_exact(a, b, touching).collides);
+  for (const double x : {5.0, 5.1, 1.0, 5.0, 5.1}) {  // apart, apart again, back in contact (a jump), apart
+    pose.translation.x() = x;
+    const Result r = query_exact_coherent(a, b, x == 1.0 ? touching : pose, state);
+    EXPECT_EQ(r.collides, x == 1.0) << x;
+    if (x == 5.1) {
+      EXPECT_EQ(state.front_size(), 1u);
+      EXPECT_EQ(r.counters.bv_tests, 1u);
+      EXPECT_EQ(r.counters.nodes_visited, 1u);
+    }
+  }
+}
+
 TEST(Coherent, TheStoredTreeStaysWithinMaxPairs) {
   const auto a = Bvh<Obb>::build(torus());
   const auto b = Bvh<Obb>::build(soup());
