@@ -66,15 +66,16 @@ class FrontWalk {
       : trees_(trees), stored_(stored), next_(next), hooks_(hooks), raise_hold_(raise_hold) {}
 
   /// The leaf pair of the first contact (the hooks stop there in first-contact mode), or nullopt once the
-  /// whole tree was walked. root_overlaps: the caller took and tested the root pair, which overlaps.
-  std::optional<LeafPair> run(bool root_overlaps = false) {
+  /// whole tree was walked. overlapping_root: the root pair, when the caller took it and found it
+  /// overlapping.
+  std::optional<LeafPair> run(const Pair* overlapping_root = nullptr) {
     next_.clear();
     next_.push_back(FrontPair{});
     items_.clear();
-    const Item root{trees_.template root<Pair>(), 0, stored_.empty() ? kCold : 0, false};
-    if (!root_overlaps)
-      items_.push_back(root);
-    else if (auto hit = descend(root))
+    const std::uint32_t stored = stored_.empty() ? kCold : 0;
+    if (!overlapping_root)
+      items_.push_back({trees_.template root<Pair>(), 0, stored, false});
+    else if (auto hit = descend({*overlapping_root, 0, stored, false}))
       return hit;
     while (!items_.empty()) {
       const Item item = items_.back();
@@ -244,20 +245,22 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   }
   // Objects apart at the last query: walking the stored tree is testing the root pair, so it is tested
   // directly, without the walk's bookkeeping; a root pair that overlaps now is walked from there.
-  const bool root_tested = !cold && state.root_apart();
-  if (root_tested) {
+  std::optional<typename Walk::Pair> overlapping_root;
+  if (!cold && state.root_apart()) {
     ++result.counters.nodes_visited;
-    if (!trees.overlap(trees.template root<typename Walk::Pair>())) {
+    const auto root = trees.template root<typename Walk::Pair>();
+    if (!trees.overlap(root)) {
       state.restamp(b_to_a);
       state.record_cost(result.counters, seconds(), CoherentState::Start::Front);
       return result;
     }
+    overlapping_root = root;
   }
   const bool from_front = !cold && state.front_usable(b_to_a);
   if (!from_front) state.pairs().clear();
   std::vector<FrontPair>& next = state.spare();
   Walk walk(trees, state.pairs(), next, hooks, state.options().raise_hold);
-  state.witness = walk.run(root_tested);  // here the root pair overlaps
+  state.witness = walk.run(overlapping_root ? &*overlapping_root : nullptr);
   // A contact ends the walk early; the tree it built is still a cut of every pair (each pair not reached yet
   // is a front pair there, to be tested), so the next query starts from it rather than from the root.
   state.store(next, b_to_a);
