@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -27,16 +30,25 @@ inline Vec3 accurate_cross(const Vec3& u, const Vec3& v) {
           difference_of_products(u.x(), v.y(), u.y(), v.x())};
 }
 
+/// 2^exponent for |exponent| <= 1000, built from its bits: std::ldexp is a library call, and the triangle
+/// distance makes a dozen of them per pair.
+inline double power_of_two(int exponent) {
+  return std::bit_cast<double>(static_cast<std::uint64_t>(exponent + 1023) << 52);
+}
+
 /// v 2^exponent, exact (barring underflow); ldexp per coordinate only where 2^exponent is out of range.
 inline Vec3 times_power_of_two(const Vec3& v, int exponent) {
   if (exponent == 0) return v;
-  if (std::abs(exponent) <= 1000) return v * std::ldexp(1.0, exponent);
+  if (std::abs(exponent) <= 1000) return v * power_of_two(exponent);
   return {std::ldexp(v.x(), exponent), std::ldexp(v.y(), exponent), std::ldexp(v.z(), exponent)};
 }
 
-/// The smallest e with magnitude < 2^e (0 for 0).
+/// The smallest e with magnitude < 2^e (0 for 0). From the bits for normal numbers (std::ilogb is a library
+/// call), from ilogb for subnormal ones.
 inline int exponent_above(double magnitude) {
-  return magnitude > 0 ? std::ilogb(magnitude) + 1 : 0;
+  if (!(magnitude > 0)) return 0;
+  if (magnitude < std::numeric_limits<double>::min()) return std::ilogb(magnitude) + 1;
+  return static_cast<int>((std::bit_cast<std::uint64_t>(magnitude) >> 52) & 0x7ff) - 1023 + 1;
 }
 
 /// Throws std::invalid_argument naming `function`, the triangle and the vertex with a NaN or infinite
@@ -79,7 +91,10 @@ struct Frame {
   [[nodiscard]] Vec3 world(const Vec3& y) const {
     return times_power_of_two(times_power_of_two(y, exponent) + origin, pre);
   }
-  [[nodiscard]] double world_length(double d) const { return std::ldexp(d, exponent + pre); }
+  [[nodiscard]] double world_length(double d) const {
+    const int e = exponent + pre;
+    return std::abs(e) <= 1000 ? d * power_of_two(e) : std::ldexp(d, e);
+  }
 };
 
 }  // namespace bvhlab::local_frame
