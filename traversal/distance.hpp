@@ -53,6 +53,7 @@ bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t 
     const TrianglePoints moved = {trees.b_to_a.apply(tri_b[tb][0]), trees.b_to_a.apply(tri_b[tb][1]),
                                   trees.b_to_a.apply(tri_b[tb][2])};
     for (std::uint32_t ta = na.first; ta < na.first + na.count; ++ta) {
+      if (triangles_farther_than(tri_a[ta], moved, nearest.distance)) continue;
       ++trees.counters.triangle_tests;
       const TriangleDistance d = triangle_distance(tri_a[ta], moved);
       if (d.distance >= nearest.distance) continue;
@@ -85,7 +86,8 @@ class DistanceHooks {
 
   [[gnu::always_inline]] double evaluate(const Pair& p) {
     ++trees_.counters.bv_tests;
-    return BV::distance_lower_bound(trees_.a.tested_volume(p.a), trees_.b.tested_volume(p.b), trees_.context);
+    return distance_lower_bound_below<BV>(trees_.a.tested_volume(p.a), trees_.b.tested_volume(p.b),
+                                          trees_.context, nearest_.distance);
   }
   [[gnu::always_inline]] Admission admit(Pair& p, double bound) {
     if (bound >= nearest_.distance) return Admission::Drop;

@@ -49,6 +49,11 @@
 //                               pose's rotation is orthonormal to rounding. A volume that has it is a
 //                               `DistanceVolume` (proximity queries, issue #38). Hierarchical volumes
 //                               (below) have none.
+//   BV::distance_lower_bound(a, b, ctx, cutoff)
+//                               Optional for a DistanceVolume: the same bound where it is below `cutoff`,
+//                               else any valid bound of at least `cutoff`, so that a pair the caller will
+//                               drop costs less. The traversals call it through distance_lower_bound_below
+//                               (below), which falls back to the three-argument form.
 //   BV::Unpacked, BV::unpack(a) A form of the volume that is faster to test and larger to keep (an OBB's
 //                               axes as a matrix, not a quaternion). A volume that has it is an
 //                               `UnpackedVolume`: a tree keeps each node's unpacked form beside the stored
@@ -110,6 +115,20 @@ concept DistanceVolume = BoundingVolume<BV> &&
     requires(const BV& a, const BV& b, const typename BV::PairContext& context) {
   { BV::distance_lower_bound(a, b, context) } -> std::same_as<double>;
 };
+
+/// A DistanceVolume's bound for a caller that drops every pair at least `cutoff` apart: a volume may take the
+/// cutoff as a fourth argument and stop refining there (BV::distance_lower_bound(a, b, ctx, cutoff): the
+/// same bound where it is below the cutoff, else a valid bound of at least the cutoff). `V` is the volume's
+/// stored or unpacked form.
+template <DistanceVolume BV, class V>
+[[gnu::always_inline]] inline double distance_lower_bound_below(const V& a, const V& b,
+                                                                const typename BV::PairContext& context,
+                                                                double cutoff) {
+  if constexpr (requires { BV::distance_lower_bound(a, b, context, cutoff); })
+    return BV::distance_lower_bound(a, b, context, cutoff);
+  else
+    return BV::distance_lower_bound(a, b, context);
+}
 
 /// Concept `HierarchicalVolume<HV>`: a node volume stored relative to its parent's, as in Zachmann's
 /// restricted boxtree. Only the root is stored whole (as an `HV::Decoded`, itself a BoundingVolume).

@@ -103,8 +103,12 @@ struct Obb {
   [[gnu::flatten]] static double distance_lower_bound(const Obb& a, const Obb& b, const PairContext& c) {
     return distance_lower_bound(unpack(a), unpack(b), c);
   }
-  [[gnu::flatten]] static double distance_lower_bound(const Unpacked& a, const Unpacked& b,
-                                                      const PairContext& c) {
+  /// With a `cutoff` (the distance the caller already has): a pair whose face gaps alone reach it is answered
+  /// at once, without the edge axes, since the caller drops it either way.
+  [[gnu::flatten]] static double distance_lower_bound(
+      const Unpacked& a, const Unpacked& b, const PairContext& c,
+      double cutoff = std::numeric_limits<double>::infinity()) {
+    constexpr double kRounding = 1 - 16 * std::numeric_limits<double>::epsilon();
     const Placement p = place(a, b, c);
     // Each frame's three face gaps separate A's box from the box around B's along orthogonal axes: their
     // Euclidean length bounds the distance, and unlike the largest single gap it closes in on the distance
@@ -116,6 +120,7 @@ struct Obb {
       on_b += square(std::max(0.0, face_gap_b(p, k) - p.slack));
     }
     double best = std::sqrt(std::max(on_a, on_b));
+    if (best * kRounding >= cutoff) return best * kRounding;
     for (int i = 0; i < 3; ++i) {
       const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
       for (int j = 0; j < 3; ++j) {
@@ -128,7 +133,7 @@ struct Obb {
       }
     }
     // The divisions, square roots and subtractions above round by a few ulps of the result.
-    return best * (1 - 16 * std::numeric_limits<double>::epsilon());
+    return best * kRounding;
   }
 
   [[nodiscard]] bool empty() const { return half[0] < 0; }
