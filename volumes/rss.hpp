@@ -193,10 +193,6 @@ inline double separation(const Vec3& t, const Mat3& m, double ha0, double ha1, d
   return gap > 0 ? gap / w.norm() : 0.0;
 }
 
-}  // namespace detail
-
-namespace detail {
-
 /// B's centre t and axes m (columns) in the frame of A's rectangle, at A's centre.
 inline void place_in_a(const Rectangle& a, const Rectangle& b, Vec3& t, Mat3& m) {
   Mat3 to_a;
