@@ -293,12 +293,16 @@ class ToleranceHooks {
   using Pair = QueuedPair<BV>;
 
   ToleranceHooks(const TreePair<BV>& trees, double tolerance, Result& result)
-      : trees_(trees), tolerance_(tolerance), result_(result) {}
+      : trees_(trees),
+        tolerance_(tolerance),
+        cutoff_(std::nextafter(tolerance, std::numeric_limits<double>::infinity())),
+        result_(result) {}
 
+  /// A bound at or past the cutoff drops the pair whatever its value, so the volume may stop refining there.
   [[gnu::always_inline]] bool evaluate(const Pair& p) {
     ++trees_.counters.bv_tests;
-    return BV::distance_lower_bound(trees_.a.tested_volume(p.a), trees_.b.tested_volume(p.b),
-                                    trees_.context) <= tolerance_;
+    return distance_lower_bound_below<BV>(trees_.a.tested_volume(p.a), trees_.b.tested_volume(p.b),
+                                          trees_.context, cutoff_) <= tolerance_;
   }
   static Admission admit(Pair&, bool near) { return near ? Admission::Queue : Admission::Drop; }
   [[gnu::always_inline]] Step leaf_pair(const Pair& p) { return within(p.a, p.b); }
@@ -324,6 +328,7 @@ class ToleranceHooks {
  private:
   const TreePair<BV>& trees_;
   double tolerance_;
+  double cutoff_;  ///< the least double above the tolerance
   Result& result_;
   std::optional<std::pair<std::uint32_t, std::uint32_t>> deciding_;
 };

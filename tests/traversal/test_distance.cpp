@@ -44,11 +44,11 @@ class DistanceQuery : public ::testing::Test {
   }
 };
 
-// The sanitizer builds keep one k-DOP for the family, as tests/support/volume_lists.hpp explains.
+// The sanitizer builds keep the lean volume list, as tests/support/volume_lists.hpp explains.
 #ifdef BVHLAB_LEAN_VOLUMES
 using DistanceVolumes = ::testing::Types<Aabb, Obb, Sphere, Dop24>;
 #else
-using DistanceVolumes = ::testing::Types<Aabb, Obb, Sphere, Dop<6>, Dop<14>, Dop24>;
+using DistanceVolumes = ::testing::Types<Aabb, Obb, Sphere, Rss, Dop<6>, Dop<14>, Dop24>;
 #endif
 TYPED_TEST_SUITE(DistanceQuery, DistanceVolumes);
 
