@@ -309,7 +309,7 @@ class ToleranceHooks {
   /// Decides when a triangle pair of leaf pair (i, j) lies within the tolerance.
   Step within(std::uint32_t i, std::uint32_t j) {
     NearestPair nearest;
-    nearest.distance = std::nextafter(tolerance_, std::numeric_limits<double>::infinity());
+    nearest.distance = cutoff_;
     distance_detail::nearer_triangles(trees_, i, j, nearest);
     if (!(nearest.distance <= tolerance_)) return Step::Continue;
     result_.collides = true;
