@@ -33,6 +33,13 @@
 #include <numbers>
 #include <vector>
 
+#if defined(__SSE2__) && !defined(BVHLAB_KDOP_SCALAR)
+#define BVHLAB_KDOP_SSE2 1
+#include <emmintrin.h>
+#else
+#define BVHLAB_KDOP_SSE2 0
+#endif
+
 namespace bvhlab {
 
 namespace dop_detail {
@@ -302,17 +309,38 @@ struct KDop {
   /// offsets[m] >= n_m . x for every point x of the volume; default: empty (hi < lo on every axis).
   std::array<float, kPlanes> offsets = filled(-1.0f);
 
+  /// Two of A's axes side by side, lane l holding axis 2j + l of pair j: the layout overlap() reads two axes
+  /// at a time from. With an odd number of axes the last pair's lane 1 repeats its lane 0.
+  struct AxisPair {
+    alignas(16) std::array<std::array<double, 2>, 3> coefficients;  // [k][lane]
+    alignas(16) std::array<double, 2> shift;                        // n_a . t
+    std::array<std::array<std::uint8_t, 2>, 3> upper;               // B's planes bounding n_a, [k][lane]
+    std::array<std::array<std::uint8_t, 2>, 3> lower;               // the same for -n_a
+  };
+
   struct PairContext {
     // Per plane m of A (direction n_m, on axis a = m mod k/2): B's support in n_m is at most
-    //   sum_k coefficients[a][k] * b.offsets[planes[m][k]] + shift(m),
-    // with shift(m) = +axis_shift[a] for m = a < k/2 and -axis_shift[a] for m = a + k/2. A plane and its
-    // opposite share their coefficients (Tables::opposite), so they are kept once per axis.
-    std::array<std::array<std::uint8_t, 3>, kPlanes> planes;
-    std::array<std::array<double, 3>, kAxes> coefficients;
-    std::array<double, kAxes> axis_shift;  // n_a . t
-    double slack_per_a_scale;              // rounding slack per unit of A's coordinate magnitude
+    //   sum_k coefficient(a, k) * b.offsets[plane(m, k)] + shift(m),
+    // with shift(m) = +n_a . t for m = a < k/2 and -n_a . t for m = a + k/2. A plane and its opposite share
+    // their coefficients (Tables::opposite), so they are kept once per axis.
+    std::array<AxisPair, (kAxes + 1) / 2> pairs;
+    double slack_per_a_scale;  // rounding slack per unit of A's coordinate magnitude
     double slack_per_b_scale;
     double slack_translation;
+
+    [[nodiscard]] double coefficient(std::size_t axis, int k) const {
+      return pairs[axis / 2].coefficients[k][axis % 2];
+    }
+    [[nodiscard]] std::uint8_t plane(std::size_t m, int k) const {
+      const std::size_t axis = m % kAxes;
+      const AxisPair& p = pairs[axis / 2];
+      return m < kAxes ? p.upper[k][axis % 2] : p.lower[k][axis % 2];
+    }
+    [[nodiscard]] double shift(std::size_t m) const {
+      const std::size_t axis = m % kAxes;
+      const double s = pairs[axis / 2].shift[axis % 2];
+      return m < kAxes ? s : -s;
+    }
   };
 
   static constexpr std::string_view name() { return Set::name; }
@@ -365,14 +393,31 @@ struct KDop {
     // one vertex search per axis instead of per plane.
     for (std::size_t m = 0; m < kAxes; ++m) {
       const Vec3 v = pose.rotation.transpose() * t.normals[m];
-      t.realign(v, c.planes[m], c.coefficients[m]);
-      for (int k = 0; k < 3; ++k)
-        c.planes[m + kAxes][k] = static_cast<std::uint8_t>(t.opposite(c.planes[m][k]));
+      std::array<std::uint8_t, 3> planes{};
+      std::array<double, 3> coefficients{};
+      t.realign(v, planes, coefficients);
+      const double shift = t.axes[m].dot(pose.translation);
+      AxisPair& p = c.pairs[m / 2];
+      const std::size_t lane = m % 2;
+      for (int k = 0; k < 3; ++k) {
+        p.coefficients[k][lane] = coefficients[k];
+        p.upper[k][lane] = planes[k];
+        p.lower[k][lane] = static_cast<std::uint8_t>(t.opposite(planes[k]));
+      }
+      p.shift[lane] = shift;
       max_coefficient_sum =
-          std::max(max_coefficient_sum, std::abs(c.coefficients[m][0]) + std::abs(c.coefficients[m][1]) +
-                                            std::abs(c.coefficients[m][2]));
+          std::max(max_coefficient_sum,
+                   std::abs(coefficients[0]) + std::abs(coefficients[1]) + std::abs(coefficients[2]));
     }
-    for (std::size_t a = 0; a < kAxes; ++a) c.axis_shift[a] = t.axes[a].dot(pose.translation);
+    if constexpr (kAxes % 2 == 1) {  // the vector test reads the odd last axis twice
+      AxisPair& last = c.pairs.back();
+      for (int k = 0; k < 3; ++k) {
+        last.coefficients[k][1] = last.coefficients[k][0];
+        last.upper[k][1] = last.upper[k][0];
+        last.lower[k][1] = last.lower[k][0];
+      }
+      last.shift[1] = last.shift[0];
+    }
     // Offsets of a fitted or merged DOP are at most sqrt(3) times its largest x/y/z offset in magnitude
     // (each is a support value of points inside that box); errors of the few products and sums below, and
     // of c itself (from R and M^-1), stay far inside 512 ulps of those magnitudes.
@@ -383,12 +428,31 @@ struct KDop {
     return c;
   }
 
-  // Stops at the first separating axis, and works out the slack only for an axis whose intervals are
-  // apart: pairs that overlap, which test every axis, never need it.
+  /// Two axes at a time in the vector unit where there is one (SSE2, every x86-64), else overlap_scalar.
+  /// The same numbers compared in the same order, so both answer alike (tests/volumes/test_dop.cpp).
   static bool overlap(const KDop& a, const KDop& b, const PairContext& c) {
+#if BVHLAB_KDOP_SSE2
+    for (std::size_t j = 0; j < kAxes / 2; ++j) {
+      const __m128d o = pair_overlap(a, b, c.pairs[j], j);
+      if (_mm_movemask_pd(_mm_cmplt_pd(o, _mm_setzero_pd())) != 0 && separated(a, b, c, smaller_lane(o)))
+        return false;
+    }
+    if constexpr (kAxes % 2 == 1) {
+      const double o = axis_overlap(a, b, c, kAxes - 1);
+      if (o < 0 && separated(a, b, c, o)) return false;
+    }
+    return true;
+#else
+    return overlap_scalar(a, b, c);
+#endif
+  }
+
+  /// The reference test, one axis at a time. Stops at the first separating axis, and works out the slack
+  /// only for an axis whose intervals are apart: pairs that overlap, which test every axis, never need it.
+  static bool overlap_scalar(const KDop& a, const KDop& b, const PairContext& c) {
     for (std::size_t m = 0; m < kAxes; ++m) {
       const double o = axis_overlap(a, b, c, m);
-      if (o < 0 && o < -slack(a, b, c)) return false;
+      if (o < 0 && separated(a, b, c, o)) return false;
     }
     return true;
   }
@@ -410,7 +474,9 @@ struct KDop {
     return std::max(largest, std::sqrt(squared) * (1 - 4 * std::numeric_limits<double>::epsilon()));
   }
 
-  [[nodiscard]] bool empty() const { return offsets[0] + offsets[kAxes] < 0; }
+  [[nodiscard]] bool empty() const {
+    return offsets[0] + offsets[kAxes] < 0;
+  }
 
   /// For loaders of raw node bytes: a stored node has finite offsets and no empty slab.
   [[nodiscard]] bool valid() const {
@@ -450,18 +516,52 @@ struct KDop {
   // The signed overlap on A's axis m (axes 0 to 2 are the coordinate axes).
   [[gnu::always_inline]] static double axis_overlap(const KDop& a, const KDop& b, const PairContext& c,
                                                     std::size_t m) {
-    const std::size_t opposite = m + kAxes;
-    const double b_upper = c.coefficients[m][0] * double(b.offsets[c.planes[m][0]]) +
-                           c.coefficients[m][1] * double(b.offsets[c.planes[m][1]]) +
-                           c.coefficients[m][2] * double(b.offsets[c.planes[m][2]]) + c.axis_shift[m];
-    const double b_neg_lower = c.coefficients[m][0] * double(b.offsets[c.planes[opposite][0]]) +
-                               c.coefficients[m][1] * double(b.offsets[c.planes[opposite][1]]) +
-                               c.coefficients[m][2] * double(b.offsets[c.planes[opposite][2]]) -
-                               c.axis_shift[m];
-    // B's interval [-b_neg_lower, b_upper] against A's [-a.offsets[opposite], a.offsets[m]].
-    return std::min(b_upper + double(a.offsets[opposite]), b_neg_lower + double(a.offsets[m]));
+    const AxisPair& p = c.pairs[m / 2];
+    const std::size_t l = m % 2;
+    const float* d = b.offsets.data();
+    const double b_upper = p.coefficients[0][l] * double(d[p.upper[0][l]]) +
+                           p.coefficients[1][l] * double(d[p.upper[1][l]]) +
+                           p.coefficients[2][l] * double(d[p.upper[2][l]]) + p.shift[l];
+    const double b_neg_lower = p.coefficients[0][l] * double(d[p.lower[0][l]]) +
+                               p.coefficients[1][l] * double(d[p.lower[1][l]]) +
+                               p.coefficients[2][l] * double(d[p.lower[2][l]]) - p.shift[l];
+    // B's interval [-b_neg_lower, b_upper] against A's [-a.offsets[m + k/2], a.offsets[m]].
+    return std::min(b_upper + double(a.offsets[m + kAxes]), b_neg_lower + double(a.offsets[m]));
   }
-  // The rounding slack of the axes' overlaps (make_context).
+#if BVHLAB_KDOP_SSE2
+  // axis_overlap of axes 2j and 2j + 1, one per lane, the same operations in the same order.
+  [[gnu::always_inline]] static __m128d pair_overlap(const KDop& a, const KDop& b, const AxisPair& p,
+                                                     std::size_t j) {
+    const float* d = b.offsets.data();
+    const auto gather = [d](const std::array<std::uint8_t, 2>& planes) {
+      return _mm_set_pd(double(d[planes[1]]), double(d[planes[0]]));
+    };
+    const auto two_floats = [](const float* x) {  // x[0], x[1] as doubles; an unaligned 8-byte load
+      return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(x))));
+    };
+    const __m128d c0 = _mm_load_pd(p.coefficients[0].data()), c1 = _mm_load_pd(p.coefficients[1].data()),
+                  c2 = _mm_load_pd(p.coefficients[2].data()), shift = _mm_load_pd(p.shift.data());
+    __m128d upper = _mm_mul_pd(c0, gather(p.upper[0]));
+    upper = _mm_add_pd(upper, _mm_mul_pd(c1, gather(p.upper[1])));
+    upper = _mm_add_pd(upper, _mm_mul_pd(c2, gather(p.upper[2])));
+    upper = _mm_add_pd(upper, shift);
+    __m128d neg_lower = _mm_mul_pd(c0, gather(p.lower[0]));
+    neg_lower = _mm_add_pd(neg_lower, _mm_mul_pd(c1, gather(p.lower[1])));
+    neg_lower = _mm_add_pd(neg_lower, _mm_mul_pd(c2, gather(p.lower[2])));
+    neg_lower = _mm_sub_pd(neg_lower, shift);
+    const __m128d a_upper = two_floats(a.offsets.data() + 2 * j);
+    const __m128d a_neg_lower = two_floats(a.offsets.data() + 2 * j + kAxes);
+    return _mm_min_pd(_mm_add_pd(upper, a_neg_lower), _mm_add_pd(neg_lower, a_upper));
+  }
+  static double smaller_lane(__m128d v) {
+    return _mm_cvtsd_f64(_mm_min_sd(v, _mm_unpackhi_pd(v, v)));
+  }
+#endif
+  // Whether an axis overlap o < 0 is beyond the rounding slack (make_context). Kept out of line: only pairs
+  // that are apart get here, and inlined its loads and maxima would be computed ahead for every pair.
+  [[gnu::noinline]] static bool separated(const KDop& a, const KDop& b, const PairContext& c, double o) {
+    return o < -slack(a, b, c);
+  }
   [[gnu::always_inline]] static double slack(const KDop& a, const KDop& b, const PairContext& c) {
     return c.slack_per_a_scale * a.coordinate_scale() + c.slack_per_b_scale * b.coordinate_scale() +
            c.slack_translation;

@@ -103,12 +103,12 @@ TYPED_TEST(DopTest, RealignedSupportBoundsTheExactSupport) {
       for (std::size_t m = 0; m < BV::kPlanes; ++m) {
         double exact = -std::numeric_limits<double>::infinity();
         for (const Vec3& x : vertices) exact = std::max(exact, normals[m].dot(pose.apply(x)));
-        const double shift = m < BV::kAxes ? c.axis_shift[m] : -c.axis_shift[m - BV::kAxes];
-        double bound = shift;
-        const auto& coefficients = c.coefficients[m % BV::kAxes];  // shared by a plane and its opposite
+        double bound = c.shift(m);
         for (int j = 0; j < 3; ++j) {
-          ASSERT_GE(coefficients[j], -1e-12) << "coefficient outside the normal cone";
-          bound += coefficients[j] * d[c.planes[m][j]];
+          // A plane and its opposite share their coefficients.
+          const double coefficient = c.coefficient(m % BV::kAxes, j);
+          ASSERT_GE(coefficient, -1e-12) << "coefficient outside the normal cone";
+          bound += coefficient * d[c.plane(m, j)];
         }
         ASSERT_GE(bound, exact - 1e-9 * scale) << set.label << ", pose " << k << ", plane " << m;
         if (k == 0) {
@@ -154,6 +154,53 @@ TYPED_TEST(DopTest, KnownVolumes) {
     EXPECT_NEAR(octahedron_volume, 8, 1e-12);
   }
   EXPECT_GE(octahedron_volume, 4.0 / 3.0 - 1e-12);
+}
+
+TYPED_TEST(DopTest, VectorTestAnswersAsTheScalarReference) {
+  // overlap() (two axes per vector instruction where the machine has them) against overlap_scalar on the
+  // same pairs: random poses, each pair also moved along a random direction to just either side of where
+  // the scalar test's answer flips, so the pairs that reach the rounding slack are compared too.
+  using BV = TypeParam;
+  std::mt19937_64 rng(47);
+  const auto sets = sample_point_sets(10);
+  int apart = 0, overlapping = 0;
+  for (const PointSet& a_set : sets)
+    for (const PointSet& b_set : sets) {
+      const BV a = BV::fit(a_set.points), b = BV::fit(b_set.points);
+      // The sets' means lie in their hulls, so in the volumes: placed on each other, the volumes overlap.
+      const auto mean = [](const std::vector<Vec3>& points) {
+        Vec3 sum = Vec3::Zero();
+        for (const Vec3& p : points) sum += p;
+        return Vec3(sum / double(points.size()));
+      };
+      const Vec3 a_mean = mean(a_set.points), b_mean = mean(b_set.points);
+      for (int k = 0; k < 8; ++k) {
+        RigidTransform pose;
+        pose.rotation = random_rotation(rng);
+        const Vec3 direction = gaussian_vec(rng).normalized();
+        const auto answers_alike = [&](double distance) {
+          pose.translation = a_mean - pose.rotation * b_mean + distance * direction;
+          const auto context = BV::make_context(pose);
+          const bool scalar = BV::overlap_scalar(a, b, context);
+          EXPECT_EQ(BV::overlap(a, b, context), scalar)
+              << a_set.label << " / " << b_set.label << ", pose " << k << ", distance " << distance;
+          (scalar ? overlapping : apart) += 1;
+          return scalar;
+        };
+        double near = 0, far = 10 * (a.bounding_box().extent().norm() + b.bounding_box().extent().norm()) + 1;
+        ASSERT_TRUE(answers_alike(near));
+        ASSERT_FALSE(answers_alike(far));
+        for (int step = 0; step < 60; ++step) {  // bisection down to adjacent doubles
+          const double middle = near + (far - near) / 2;
+          if (middle == near || middle == far) break;
+          (answers_alike(middle) ? near : far) = middle;
+        }
+        answers_alike(std::nextafter(near, 0.0));
+        answers_alike(std::nextafter(far, 2 * far));
+      }
+    }
+  EXPECT_GT(apart, 1000);
+  EXPECT_GT(overlapping, 1000);
 }
 
 TEST(DopRealignment, NonSimplePrototypeVerticesUseATripleWhoseConeHoldsTheDirection) {
