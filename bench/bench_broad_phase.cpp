@@ -346,7 +346,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
     std::printf("\nMedian CPU time (us) and ratios bvhlab / FCL:\n");
     std::printf("%-26s %11s %11s %11s %11s %9s %9s %9s %9s\n", "", "bvhlab_sap", "bvhlab_dat", "fcl_dat",
                 "fcl_sap", "sap/fdat", "dat/fdat", "sap/fsap", "dat/fsap");
-    for (const auto& [env, t] : by_env) {
+    for (const auto& [env, impl_times] : by_env) {
+      // A named reference: clang 14 cannot capture a structured binding.
+      const std::map<std::string, double>& t = impl_times;
       auto get = [&](const char* k) { return t.count(k) ? t.at(k) : 0.0; };
       auto ratio = [](double a, double b) { return a > 0 && b > 0 ? a / b : 0.0; };
       const double bs = get("bvhlab_sap"), bd = get("bvhlab_dat"), fd = get("fcl_dat"), fs = get("fcl_sap");
