@@ -310,7 +310,8 @@ struct KDop {
   std::array<float, kPlanes> offsets = filled(-1.0f);
 
   /// Two of A's axes side by side, lane l holding axis 2j + l of pair j: the layout overlap() reads two axes
-  /// at a time from. With an odd number of axes the last pair's lane 1 repeats its lane 0.
+  /// at a time from. With an odd number of axes the last pair's lane 1 is unused: overlap() tests that
+  /// axis alone.
   struct AxisPair {
     alignas(16) std::array<std::array<double, 2>, 3> coefficients;  // [k][lane]
     alignas(16) std::array<double, 2> shift;                        // n_a . t
@@ -408,15 +409,6 @@ struct KDop {
       max_coefficient_sum =
           std::max(max_coefficient_sum,
                    std::abs(coefficients[0]) + std::abs(coefficients[1]) + std::abs(coefficients[2]));
-    }
-    if constexpr (kAxes % 2 == 1) {  // the vector test reads the odd last axis twice
-      AxisPair& last = c.pairs.back();
-      for (int k = 0; k < 3; ++k) {
-        last.coefficients[k][1] = last.coefficients[k][0];
-        last.upper[k][1] = last.upper[k][0];
-        last.lower[k][1] = last.lower[k][0];
-      }
-      last.shift[1] = last.shift[0];
     }
     // Offsets of a fitted or merged DOP are at most sqrt(3) times its largest x/y/z offset in magnitude
     // (each is a support value of points inside that box); errors of the few products and sums below, and
