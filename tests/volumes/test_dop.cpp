@@ -203,6 +203,39 @@ TYPED_TEST(DopTest, VectorTestAnswersAsTheScalarReference) {
   EXPECT_GT(overlapping, 1000);
 }
 
+TYPED_TEST(DopTest, ExtremalVertexSearchAnswersAsTheScalarReference) {
+  // The realignment's vertex search (two antipodal pairs per vector instruction where the machine has them)
+  // against the one-at-a-time reference, and against the definition: a vertex of largest v . x, of the
+  // first antipodal pair (i, i + half) that holds one. Directions at random, along the normals and towards
+  // the vertices, where whole faces and edges tie.
+  using BV = TypeParam;
+  const auto& tables = BV::tables();
+  const std::size_t half = tables.half;
+  ASSERT_EQ(tables.vertices.size(), 2 * half);
+  ASSERT_EQ(tables.xs.size(), half + half % 2);
+  for (std::size_t i = 0; i < half; ++i)
+    ASSERT_LT((tables.vertices[i].position + tables.vertices[i + half].position).norm(), 1e-12);
+  std::vector<Vec3> directions(tables.normals.begin(), tables.normals.end());
+  for (const auto& vertex : tables.vertices) directions.push_back(vertex.position);
+  std::mt19937_64 rng(53);
+  for (int k = 0; k < 2000; ++k) directions.push_back(gaussian_vec(rng).normalized());
+  for (std::size_t k = 0, n = directions.size(); k < n; ++k) directions.push_back(-directions[k]);
+  for (const Vec3& v : directions) {
+    const std::size_t found = tables.extremal_vertex(v);
+    ASSERT_EQ(found, tables.extremal_vertex_scalar(v)) << "direction " << v.transpose();
+    const auto along = [&](std::size_t i) {  // the search's numbers: the first half's, negated for the second
+      const std::size_t j = i % half;
+      const double value = (v[0] * tables.xs[j] + v[1] * tables.ys[j]) + v[2] * tables.zs[j];
+      return i < half ? value : -value;
+    };
+    for (std::size_t i = 0; i < 2 * half; ++i) {
+      EXPECT_LE(along(i), along(found)) << "vertex " << i << " is farther, direction " << v.transpose();
+      if (i % half < found % half)
+        EXPECT_LT(along(i), along(found)) << "an earlier pair ties, direction " << v.transpose();
+    }
+  }
+}
+
 TEST(DopRealignment, NonSimplePrototypeVerticesUseATripleWhoseConeHoldsTheDirection) {
   // The four corner diagonals alone: the prototype is an octahedron, four planes meet at each vertex.
   const dop_detail::DirectionSet<4> set{{{{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}}}};
