@@ -224,6 +224,21 @@ TEST(BadGltf, DeepJsonIsRefused) {
   expect_refused(deep, "obj", "deep.obj", "deep.obj: ");
 }
 
+// The limit is 64 levels: the root object and 63 arrays inside it load, one array more is refused. Brackets
+// inside strings (escaped quotes included) are not nesting.
+TEST(BadGltf, JsonNestingIsCountedOutsideStringsUpToTheLimit) {
+  const auto nested = [](int arrays, const std::string& text) {
+    Json doc = tetrahedron();
+    Json extras = Json::array({text});
+    for (int level = 1; level < arrays; ++level) extras = Json::array({extras});
+    doc["extras"] = extras;
+    return doc.dump();
+  };
+  const std::string brackets = "\\\" " + std::string(100, '[');  // a backslash, a quote, brackets
+  EXPECT_EQ(load(nested(63, brackets), "gltf", "deep63.gltf").mesh.triangle_count(), 4u);
+  expect_refused(nested(64, brackets), "gltf", "deep64.gltf", "nested deeper than 64 levels");
+}
+
 // Nodes must form trees. Two children lists naming the same node 40 times over made assimp build 2^40
 // nodes (killed); a cycle, a root listed twice, or a chain deeper than assimp's recursion can take are
 // refused too.
