@@ -322,7 +322,7 @@ def test_coherent_batches_answer_as_cold_ones_with_less_work(gear_trees, strateg
     """coherent=True starts each pose where the previous one ended: the cold answers, fewer BV tests; a
     CoherentState carries the sequence over to the next call, and chunked or split, the work is the same."""
     tree = gear_trees["none"]
-    poses = np.concatenate([bvhlab.protocol_poses(d, 300) for d in (0.9, 1.4)])
+    poses = np.concatenate([bvhlab.protocol_poses(d, 150) for d in (1.4, 2.0)])
     cold = bvhlab.query_batch(tree, tree, poses, strategy=strategy)
     coherent = bvhlab.query_batch(tree, tree, poses, strategy=strategy, coherent=True)
     for key in ("collides", "exact", "contact_count"):

@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 
@@ -186,6 +188,42 @@ TYPED_TEST(DistanceQuery, CoherentQueriesAnswerAsColdOnesWithLessWork) {
   }
   EXPECT_GT(touching, 0);  // the steps cross into contact
   EXPECT_LT(coherent_bv, cold_bv);
+}
+
+// The reference skips triangle pairs whose enclosing balls are farther apart than its best distance so far:
+// it must still answer as the plain minimum over every pair, near and far from the origin.
+TEST(BruteForceReference, SkipsOnlyPairsThatCannotHoldTheNearest) {
+  const Mesh a = testing::make_torus(0.7, 0.25, 8, 4);
+  const Mesh b = testing::make_random_soup(40, 0.15, 5);
+  const auto every_pair = [](const Mesh& m, const Mesh& n, const RigidTransform& pose) {
+    double best = kInf;
+    for (std::uint32_t i = 0; i < m.triangles.size(); ++i)
+      for (std::uint32_t j = 0; j < n.triangles.size(); ++j) {
+        const TrianglePoints t = n.triangle(j);
+        best = std::min(
+            best, triangle_distance(m.triangle(i), {pose.apply(t[0]), pose.apply(t[1]), pose.apply(t[2])})
+                      .distance);
+      }
+    return best;
+  };
+  const Vec3 far(1e6, -1e6, 1e6);
+  Mesh a_far = a, b_far = b;
+  for (Vec3& v : a_far.vertices) v += far;
+  for (Vec3& v : b_far.vertices) v += far;
+  std::mt19937_64 rng(23);
+  int apart = 0;
+  for (int k = 0; k < 16; ++k) {
+    const RigidTransform pose = testing::random_pose(rng, 0.5 + 0.25 * k);
+    const double expected = every_pair(a, b, pose);
+    ASSERT_EQ(brute_force_distance(a, b, pose), expected) << "pose " << k;
+    RigidTransform far_pose = pose;
+    far_pose.translation = pose.translation + far - pose.rotation * far;
+    ASSERT_EQ(brute_force_distance(a_far, b_far, far_pose), every_pair(a_far, b_far, far_pose))
+        << "pose " << k;
+    apart += expected > 0;
+  }
+  EXPECT_GT(apart, 4);
+  EXPECT_LT(apart, 16);
 }
 
 TEST(DistanceQueryInput, ACoherentStateServesOnePairOfTrees) {
