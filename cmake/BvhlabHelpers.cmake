@@ -53,11 +53,14 @@ endfunction()
 # UNITY n: its sources compiled n to a unit (bvhlab_unity): test files that build the same kinds of trees
 # share their instantiation.
 # ONE_PROCESS: the tests share a setup that costs more than they do (a static fixture built once per process,
-# such as annotated trees): ctest runs the executable once, as one entry named after it. The asan preset's
-# GTEST_FILTER leaves out there what its name filter leaves out of the other executables.
+# such as annotated trees): ctest runs the executable once, as one entry named after it.
 # NEEDS_MESHES: the tests read fetched meshes, so they require the ctest fixture `meshes` (cmake/Meshes.cmake).
 # SANITIZED: the ASan stage builds and runs it too (label `sanitized`, target bvhlab_sanitized_tests; which
 # tests and why: tests/README.md, "Sanitizers and fuzzing"). Every test runs in the Release stage.
+# BVHLAB_TEST_SHARDS n (the sanitizer presets): each executable is n ctest entries <name>/shard_<k>, each
+# running every n-th test (GoogleTest's own sharding) in one process, instead of a process per test: an
+# instrumented process takes 0.1 to 0.2 s to start and exit, a fifth of the ASan stage's test time. The
+# asan preset's GTEST_FILTER leaves tests out by name (tests/README.md, "Sanitizers and fuzzing").
 function(bvhlab_add_test)
   cmake_parse_arguments(T "NEEDS_MESHES;SANITIZED;ONE_PROCESS" "NAME;TIMEOUT;UNITY" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
@@ -70,8 +73,17 @@ function(bvhlab_add_test)
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 600)
   endif()
+  set(shards 0)
+  if(NOT T_ONE_PROCESS AND BVHLAB_TEST_SHARDS GREATER 0)
+    set(shards ${BVHLAB_TEST_SHARDS})
+  endif()
   if(T_ONE_PROCESS)
     add_test(NAME ${T_NAME} COMMAND ${T_NAME})
+  elseif(shards)
+    math(EXPR last_shard "${shards} - 1")
+    foreach(k RANGE ${last_shard})
+      add_test(NAME ${T_NAME}/shard_${k} COMMAND ${T_NAME})
+    endforeach()
   else()
     gtest_discover_tests(${T_NAME} DISCOVERY_TIMEOUT 60)
   endif()
@@ -91,6 +103,14 @@ function(bvhlab_add_test)
   if(T_ONE_PROCESS)
     # A whole executable in one entry: ctest starts it among the first (see tests/python/CMakeLists.txt).
     cmake_language(EVAL CODE "set_tests_properties(${T_NAME} PROPERTIES ${properties} COST 30)")
+    return()
+  endif()
+  if(shards)
+    foreach(k RANGE ${last_shard})
+      cmake_language(EVAL CODE "set_tests_properties(${T_NAME}/shard_${k} PROPERTIES ${properties} COST 10)")
+      set_property(TEST ${T_NAME}/shard_${k} APPEND PROPERTY ENVIRONMENT GTEST_TOTAL_SHARDS=${shards}
+                                                                      GTEST_SHARD_INDEX=${k})
+    endforeach()
     return()
   endif()
   set(script "${CMAKE_CURRENT_BINARY_DIR}/${T_NAME}_properties.cmake")
