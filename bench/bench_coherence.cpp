@@ -2,7 +2,8 @@
 // `--steps` per query at each distance, and every `--strides`-th pose is asked, in order.
 //
 //   bench_coherence [--meshes=a.stl,b.obj] [--volumes=aabb,dop24] [--steps=2000] [--strides=1,8,64]
-//                   [--distances=0.6,1.0,1.4] [--judge=work|time] [--max_cold_run=128] [benchmark flags]
+//                   [--distances=0.6,1.0,1.4] [--judge=work|time] [--max_cold_run=128] [--max_jump=0.5]
+//                   [benchmark flags]
 //
 // One iteration is one cold pass and one coherent pass over the same poses (a fresh state), in alternating
 // order, each timed on its own: the ratio of each iteration's two passes is what is compared, so a stall
@@ -25,6 +26,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -113,7 +115,7 @@ void record(Series& s, const Pass& cold, const Pass& coherent, const CoherentSta
 }
 
 /// Cold and coherent passes over `poses`, alternating which goes first.
-/// The states' options, from --judge and --max_cold_run.
+/// The states' options, from --judge, --max_cold_run and --max_jump.
 CoherenceOptions coherence_options;
 
 template <class BV>
@@ -162,16 +164,18 @@ int main(int argc, char** argv) {
   int steps = 2000;
   std::string judge_name = "work";
   int max_cold_run = static_cast<int>(CoherenceOptions{}.max_cold_run);
-  if (auto exit =
-          initialize_benchmark("bench_coherence",
-                               {{"meshes", &meshes, "meshes to run"},
-                                {"volumes", &volumes, "bounding volumes"},
-                                {"distances", &distances, "protocol distances"},
-                                {"strides", &strides, "ask every m-th pose of the turn (step size)"},
-                                {"steps", &steps, "poses per full turn"},
-                                {"judge", &judge_name, "what decides front or root: work or time"},
-                                {"max_cold_run", &max_cold_run, "longest run of cold queries (0: none)"}},
-                               argc, argv))
+  double max_jump = CoherenceOptions{}.max_jump;
+  if (auto exit = initialize_benchmark(
+          "bench_coherence",
+          {{"meshes", &meshes, "meshes to run"},
+           {"volumes", &volumes, "bounding volumes"},
+           {"distances", &distances, "protocol distances"},
+           {"strides", &strides, "ask every m-th pose of the turn (step size)"},
+           {"steps", &steps, "poses per full turn"},
+           {"judge", &judge_name, "what decides front or root: work or time"},
+           {"max_cold_run", &max_cold_run, "longest run of cold queries (0: none)"},
+           {"max_jump", &max_jump, "a pose jump, in B's root radii, starts from the root"}},
+          argc, argv))
     return *exit;
   if (steps < 1 || std::any_of(strides.begin(), strides.end(), [](double m) { return !(m >= 1); })) {
     std::fprintf(stderr, "bench_coherence: --steps and every stride must be at least 1\n");
@@ -188,6 +192,13 @@ int main(int argc, char** argv) {
   coherence_options.judge =
       judge_name == "time" ? CoherenceOptions::Judge::time : CoherenceOptions::Judge::work;
   coherence_options.max_cold_run = static_cast<std::uint32_t>(max_cold_run);
+  coherence_options.max_jump = max_jump;
+  try {
+    coherence_options.validate();
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "bench_coherence: --max_jump: %s\n", e.what());
+    return 2;
+  }
   static const std::vector<PoseSet> sets = make_pose_sets(distances, steps, strides);
   for_each_protocol_mesh("bench_coherence", meshes, [&](const std::string& label, const auto& mesh) {
     for (const auto& v : volumes)
