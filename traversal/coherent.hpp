@@ -17,7 +17,8 @@
 // While the stored tree is the root pair alone, step 2 is the root pair's test, made without the walk.
 // The answer is exact whatever the state holds: "no contact" only when every front pair was found disjoint
 // or without contact at the current pose, "contact" only with a triangle pair intersecting at it. The state
-// starts from the root when it is new, after a pose jump or when its tree grew past max_pairs.
+// starts from the root when it is new, after a pose jump or when its tree grew past max_pairs; while the
+// poses keep jumping, the query is the cold one and stores no front.
 #pragma once
 
 #include "coherent_state.hpp"
@@ -256,7 +257,20 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
     }
     overlapping_root = root;
   }
-  const bool from_front = !cold && state.front_usable(b_to_a);
+  // A pose that jumped from the last query's: no front of there pays here. After a query that did not
+  // jump, the walk starts from the root and leaves a front for the steps that follow. While the poses keep
+  // jumping, that walk would cost a cold query and more each time for a front never used (bench/RESULTS.md,
+  // "How far a pose may jump"): the cold query answers and the state notes the pose alone.
+  const bool jumped = !cold && state.jumped(b_to_a);
+  if (jumped && state.jumping_on()) {
+    Result cold_result = query_exact(a, b, b_to_a, mode, leaves);
+    cold_result.counters += result.counters;  // the remembered contact's or the root pair's test, if made
+    state.witness.reset();
+    state.forget_front(b_to_a);
+    state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
+    return cold_result;
+  }
+  const bool from_front = !cold && !jumped && !state.pairs().empty();
   if (!from_front) state.pairs().clear();
   std::vector<FrontPair>& next = state.spare();
   Walk walk(trees, state.pairs(), next, hooks, state.options().raise_hold);

@@ -18,6 +18,7 @@ CoherentState::CoherentState(CoherenceOptions options) : options_(options) {
 
 void CoherentState::reset() {
   pairs_.clear();
+  stamped_ = last_jumped_ = jumping_on_ = false;
   witness.reset();
   front_cost_ = root_cost_ = -1;
   cold_left_ = 0;
@@ -55,17 +56,23 @@ CoherentState::InUse::~InUse() {
   state_.busy_.busy.store(false, std::memory_order_release);
 }
 
-bool CoherentState::front_usable(const RigidTransform& pose) {
-  if (pairs_.empty()) return false;
+bool CoherentState::jumped(const RigidTransform& pose) {
+  const bool jump = moved_too_far(pose);
+  jumping_on_ = jump && last_jumped_;
+  last_jumped_ = jump;
+  if (jump) ++jumps_;
+  return jump;
+}
+
+bool CoherentState::moved_too_far(const RigidTransform& pose) const {
+  if (!stamped_) return false;
   // Every point p of B's root sphere moves by (R - R0) p + (t - t0). |R - R0| = 2 sin(angle / 2), which is
   // sqrt(3 - trace(R R0^T)); the trace is the entrywise product of R and R0.
   const Mat3 turn = pose.rotation - pose_.rotation;
   const double trace = pose.rotation.cwiseProduct(pose_.rotation).sum();
   const double spread = std::sqrt(std::max(0.0, 3 - trace));
   const double moved = (turn * b_centre_ + pose.translation - pose_.translation).norm() + spread * b_radius_;
-  if (moved <= options_.max_jump * b_radius_) return true;
-  ++jumps_;
-  return false;
+  return moved > options_.max_jump * b_radius_;
 }
 
 namespace {
@@ -107,13 +114,13 @@ void CoherentState::record_cost(const Counters& counters, double seconds, Start 
 }
 
 void CoherentState::store(std::vector<FrontPair>& next, const RigidTransform& pose) {
+  restamp(pose);
   if (next.size() > options_.max_pairs) {
     pairs_.clear();
     next = {};  // give the memory back: the bound is on what the state holds
     return;
   }
   pairs_.swap(next);
-  pose_ = pose;
 }
 
 }  // namespace bvhlab

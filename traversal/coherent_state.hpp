@@ -20,7 +20,8 @@ struct CoherenceOptions {
   /// query starts from the root. 16 bytes a pair: the default holds 4 MiB.
   std::size_t max_pairs = std::size_t{1} << 18;
   /// The pose jumps when some point of B's root box moves (relative to A) by more than this many of the
-  /// box's radii since the stored query: the front is dropped and the query starts from the root.
+  /// box's radii since the last query: the query starts from the root. While the poses keep jumping (two
+  /// jumps in a row), it runs as the cold one and stores no front.
   double max_jump = 0.5;
   /// A front pair whose parent pair was tested for raising and still overlapped waits this many queries
   /// before its parent is tested again (so pairs close to contact do not pay a useless test every query).
@@ -102,9 +103,11 @@ class CoherentState {
     CoherentState& state_;
   };
 
-  /// True when a front is stored and `pose` is close enough to its pose (CoherenceOptions::max_jump);
-  /// counts a jump otherwise.
-  [[nodiscard]] bool front_usable(const RigidTransform& pose);
+  /// True when `pose` lies farther than max_jump from the pose of the last query that stored its front or
+  /// noted its pose (store, restamp, forget_front); counts the jump. False while no query has.
+  [[nodiscard]] bool jumped(const RigidTransform& pose);
+  /// Whether the last two calls of jumped() were both true: the poses keep jumping.
+  [[nodiscard]] bool jumping_on() const { return jumping_on_; }
   std::vector<FrontPair>& pairs() { return pairs_; }
   /// Whether the stored tree is the root pair alone, disjoint when last tested: the objects were apart.
   [[nodiscard]] bool root_apart() const {
@@ -114,7 +117,15 @@ class CoherentState {
   /// Keeps `next` (built for `pose`) as the stored tree, or drops it when larger than max_pairs.
   void store(std::vector<FrontPair>& next, const RigidTransform& pose);
   /// The stored tree holds at `pose` as it is (a root pair found disjoint there again).
-  void restamp(const RigidTransform& pose) { pose_ = pose; }
+  void restamp(const RigidTransform& pose) {
+    pose_ = pose;
+    stamped_ = true;
+  }
+  /// Drops the stored tree and notes `pose` alone: a query after a pose jump, answered from the root.
+  void forget_front(const RigidTransform& pose) {
+    pairs_.clear();
+    restamp(pose);
+  }
   /// The node pair that decided the last answer, if one did: the exact queries' colliding leaf pair, the
   /// ADB queries' deciding pair (traversal/coherent_adb.hpp).
   std::optional<std::pair<std::uint32_t, std::uint32_t>> witness;
@@ -139,13 +150,17 @@ class CoherentState {
   void record_cost(const Counters& counters, double seconds, Start start);
 
  private:
+  [[nodiscard]] bool moved_too_far(const RigidTransform& pose) const;
+
   CoherenceOptions options_;
   TreeKey a_, b_;
   Vec3 b_centre_ = Vec3::Zero();
   double b_radius_ = 0;
   std::vector<FrontPair> pairs_;  ///< the stored traversal tree; pairs_[0] is the root pair
   std::vector<FrontPair> spare_;  ///< the next tree is built here, then swapped in (no allocation per query)
-  RigidTransform pose_;           ///< the pose pairs_ was computed at
+  RigidTransform pose_;           ///< the pose pairs_ was computed at, or the last query's after a jump
+  bool stamped_ = false;          ///< pose_ is a query's (not the state's initial value)
+  bool last_jumped_ = false, jumping_on_ = false;  ///< the last two answers of jumped()
   std::uint64_t jumps_ = 0, witness_hits_ = 0, cold_queries_ = 0;
   Use use_ = Use::None;
   // The comparison of the front's walks with queries from the root (record_cost); cost < 0: none yet.

@@ -64,7 +64,7 @@ TEST(Coherent, TheStoredTreeStaysWithinMaxPairs) {
   EXPECT_GT(most, 0u);
 }
 
-TEST_F(ClearOfContact, APoseJumpStartsFromTheRoot) {
+TEST_F(ClearOfContact, APoseJumpStartsFromTheRootAndJumpsInARowRunTheColdQuery) {
   pose.translation.x() += 0.01;
   ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
   EXPECT_EQ(state.jumps(), 0u);
@@ -72,8 +72,44 @@ TEST_F(ClearOfContact, APoseJumpStartsFromTheRoot) {
       -pose.translation.x();  // to the other side of A: B's box moves by far more than its radius
   const Result far = query_exact_coherent(a, b, pose, state);
   EXPECT_EQ(state.jumps(), 1u);
-  CoherentState fresh;  // the query from the root: the same work
+  CoherentState fresh;  // the query from the root: the same work, and a front for the next step
   EXPECT_EQ(far.counters.bv_tests, query_exact_coherent(a, b, pose, fresh).counters.bv_tests);
+  EXPECT_GE(state.stored_pairs(), 1u);
+  pose.translation.y() += 2;  // a second jump right after: the cold query, and no front kept
+  const Result again = query_exact_coherent(a, b, pose, state);
+  EXPECT_EQ(state.jumps(), 2u);
+  const Result cold = query_exact(a, b, pose);
+  EXPECT_EQ(again.collides, cold.collides);
+  EXPECT_EQ(again.counters.bv_tests, cold.counters.bv_tests);
+  EXPECT_EQ(again.counters.nodes_visited, cold.counters.nodes_visited);
+  EXPECT_EQ(state.stored_pairs(), 0u);
+  pose.translation.y() -= 0.01;  // a step from there: no jump, a walk from the root stores the front
+  const Result next = query_exact_coherent(a, b, pose, state);
+  EXPECT_EQ(state.jumps(), 2u);
+  EXPECT_EQ(next.collides, query_exact(a, b, pose).collides);
+  EXPECT_GE(state.stored_pairs(), 1u);
+}
+
+TEST(Coherent, PosesThatKeepJumpingCostTheColdQueries) {
+  const auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  CoherentState state{CoherenceOptions{.max_jump = 0.05, .max_cold_run = 0}};
+  int in_a_row = 0;
+  for (const RigidTransform& pose : path(40, 0.2)) {  // each step moves B far past 0.05 of its radius
+    const std::uint64_t jumps = state.jumps();
+    const Result r = query_exact_coherent(a, b, pose, state);
+    const Result cold = query_exact(a, b, pose);
+    ASSERT_EQ(r.collides, cold.collides);
+    if (state.jumps() == jumps || !state.jumping_on()) continue;
+    // The cold query's work, and at most the root pair (objects apart before) and the remembered contact
+    // (one triangle pair a leaf) tried first.
+    ++in_a_row;
+    EXPECT_LE(r.counters.bv_tests, cold.counters.bv_tests + 1);
+    EXPECT_LE(r.counters.nodes_visited, cold.counters.nodes_visited + 1);
+    EXPECT_LE(r.counters.triangle_tests, cold.counters.triangle_tests + 1);
+    EXPECT_EQ(state.stored_pairs(), 0u);
+  }
+  EXPECT_GT(in_a_row, 20);
 }
 
 TEST(Coherent, ARepeatedContactIsAnsweredByItsWitness) {
