@@ -219,15 +219,18 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   const CoherentState::InUse in_use(state);
   coherent_detail::attach(state, a, b);
   state.serve(CoherentState::Use::Exact);
-  // In a cold turn (the front cost more than starting from the root) neither the contact nor the front is
-  // tried: the query is the cold one, but for the turn's last, a walk from the root that leaves its front.
-  const bool cold = state.cold_turns_left() > 0;
-  if (state.cold_turns_left() > 1) {
+  // The cold query's answer, with what this query spent before it, recorded as a query from the root.
+  const auto cold_answer = [&](const Counters& spent) {
     Result cold_result = query_exact(a, b, b_to_a, mode, leaves);
+    cold_result.counters += spent;
     state.witness.reset();
     state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
     return cold_result;
-  }
+  };
+  // In a cold turn (the front cost more than starting from the root) neither the contact nor the front is
+  // tried: the query is the cold one, but for the turn's last, a walk from the root that leaves its front.
+  const bool cold = state.cold_turns_left() > 0;
+  if (state.cold_turns_left() > 1) return cold_answer({});
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;
@@ -263,12 +266,8 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   // "How far a pose may jump"): the cold query answers and the state notes the pose alone.
   const bool jumped = !cold && state.jumped(b_to_a);
   if (jumped && state.jumping_on()) {
-    Result cold_result = query_exact(a, b, b_to_a, mode, leaves);
-    cold_result.counters += result.counters;  // the remembered contact's or the root pair's test, if made
-    state.witness.reset();
     state.forget_front(b_to_a);
-    state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
-    return cold_result;
+    return cold_answer(result.counters);  // with the remembered contact's or the root pair's test, if made
   }
   const bool from_front = !cold && !jumped && !state.pairs().empty();
   if (!from_front) state.pairs().clear();

@@ -13,15 +13,18 @@
 
 namespace bvhlab::testing {
 
-/// A triangle's centroid and the radius of the ball about it that holds the triangle.
+/// A triangle's centroid, the radius of the ball about it that holds the triangle, and the centroid's largest
+/// coordinate (the scale of its rounding).
 struct TriangleBall {
   Vec3 center;
   double radius = 0;
+  double magnitude = 0;
 };
 
 inline TriangleBall ball_around(const TrianglePoints& t) {
   const Vec3 c = (t[0] + t[1] + t[2]) / 3.0;
-  return {c, std::max({(t[0] - c).norm(), (t[1] - c).norm(), (t[2] - c).norm()})};
+  return {c, std::max({(t[0] - c).norm(), (t[1] - c).norm(), (t[2] - c).norm()}),
+          c.lpNorm<Eigen::Infinity>()};
 }
 
 /// The smallest triangle_distance over every triangle pair, B moved by the pose: what the query must find.
@@ -43,8 +46,7 @@ inline double brute_force_distance(const Mesh& a, const Mesh& b, const RigidTran
     for (std::size_t j = 0; j < moved.size(); ++j) {
       const double centers = (ball_a.center - balls_b[j].center).norm();
       const double gap = centers - ball_a.radius - balls_b[j].radius;
-      const double scale =
-          1 + centers + ball_a.center.lpNorm<Eigen::Infinity>() + balls_b[j].center.lpNorm<Eigen::Infinity>();
+      const double scale = 1 + centers + ball_a.magnitude + balls_b[j].magnitude;
       if (gap > best + 1e-9 * scale) continue;
       best = std::min(best, triangle_distance(ta, moved[j]).distance);
     }
