@@ -10,7 +10,8 @@
 //      that is the answer;
 //   2. otherwise walks the stored tree from its root without testing its inner pairs, and tests each front
 //      pair again at the new pose: a pair still disjoint stays; one that overlaps now is descended as the
-//      exact strategy would (it may find a contact); a leaf pair is tested by its triangles;
+//      exact strategy would (it may find a contact); a leaf pair is tested by its triangles. The walk goes
+//      first the way that led to the remembered contact, where a contact that moved is most likely found;
 //   3. raises: an inner pair whose children are all disjoint again is tested itself, and if disjoint becomes
 //      one front pair (so objects moving apart end up with their root pair alone). A parent that still
 //      overlaps is not tested again for CoherenceOptions::raise_hold queries.
@@ -76,8 +77,10 @@ class FrontWalk {
     const std::uint32_t stored = stored_.empty() ? kCold : 0;
     if (!overlapping_root)
       items_.push_back({trees_.template root<Pair>(), 0, stored, false});
-    else if (auto hit = descend({*overlapping_root, 0, stored, false}))
+    else if (auto hit = descend({*overlapping_root, 0, stored, false})) {
+      mark_path(0);
       return hit;
+    }
     while (!items_.empty()) {
       const Item item = items_.back();
       items_.pop_back();
@@ -90,7 +93,10 @@ class FrontWalk {
         reuse(item);
         continue;
       }
-      if (auto hit = test(item)) return hit;
+      if (auto hit = test(item)) {
+        mark_path(item.out);
+        return hit;
+      }
     }
     return std::nullopt;
   }
@@ -150,10 +156,34 @@ class FrontWalk {
     pair.count = old.count;
     pair.hold = old.hold > 0 ? static_cast<std::uint8_t>(old.hold - 1) : std::uint8_t{0};
     if (pair.hold == 0) items_.push_back({item.pair, item.out, item.stored, true});
+    std::uint32_t towards_witness = kCold;
     for (std::uint32_t c = 0; c < old.count; ++c) {
       const FrontPair& child = stored_[old.first + c];
       next_.push_back(FrontPair{child.a, child.b});
+      if (child.leads_to_witness) {
+        towards_witness = c;
+        continue;
+      }
       items_.push_back({child_pair(item.pair, child.a, child.b), first + c, old.first + c, false});
+    }
+    // Pushed last, so visited first: a contact lost at the remembered leaf pair is most likely found near it
+    // (on the pipes at every step, 2 to 4 times fewer BV tests a query; bench/RESULTS.md).
+    if (towards_witness != kCold) {
+      const FrontPair& child = stored_[old.first + towards_witness];
+      items_.push_back({child_pair(item.pair, child.a, child.b), first + towards_witness,
+                        old.first + towards_witness, false});
+    }
+  }
+
+  /// Marks the pair at `out` in next_ and its ancestors as leading to the contact found there. A parent is
+  /// stored before its children, so one backward pass finds them all.
+  void mark_path(std::uint32_t out) {
+    next_[out].leads_to_witness = 1;
+    for (std::uint32_t i = out; i-- > 0;) {
+      FrontPair& pair = next_[i];
+      if (pair.count == 0 || out < pair.first || out >= pair.first + pair.count) continue;
+      pair.leads_to_witness = 1;
+      out = i;
     }
   }
 

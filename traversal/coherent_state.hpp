@@ -48,9 +48,11 @@ struct FrontPair {
   std::uint32_t a = 0, b = 0;
   std::uint32_t first = 0;
   std::uint8_t count = 0;
-  std::uint8_t separated = 0;  ///< a front pair whose volumes were disjoint when last tested
-  std::uint8_t hold = 0;       ///< queries before raising this pair's children is tried again
+  std::uint8_t separated = 0;         ///< a front pair whose volumes were disjoint when last tested
+  std::uint8_t hold = 0;              ///< queries before raising this pair's children is tried again
+  std::uint8_t leads_to_witness = 0;  ///< the pair or an ancestor of the remembered contact's leaf pair
 };
+static_assert(sizeof(FrontPair) == 16, "CoherenceOptions::max_pairs counts 16 bytes a pair");
 
 /// The memory of one pair of trees across queries. Belongs to one caller: a state used by two queries at
 /// once is refused (std::logic_error), and a state made for other trees too (std::invalid_argument).

@@ -108,9 +108,10 @@ TYPED_TEST_P(Coherent, WhereTheFrontDoesNotPayTheQueriesStartFromTheRoot) {
     falling_back += work_of(r.counters);
   }
   EXPECT_GT(walked, 1.2 * cold);  // the stale fronts cost more: the case the fallback is for
-  // The probes of the front, and the walks from the root: about 1.16 of the cold work on RSS trees, whose
-  // tight volumes make the cold queries cheapest, 1.05 to 1.11 on the others.
-  const double bound = TypeParam::name() == "rss" ? 1.2 : 1.15;
+  // The probes of the front, and the walks from the root: 1.04 to 1.11 of the cold work, but 1.22 on RSS
+  // trees, whose tight volumes make the cold queries cheapest, and 1.18 on spheres (1.16 and under 1.15
+  // before walks went first towards the remembered contact, which at an unrelated pose is anywhere).
+  const double bound = TypeParam::name() == "rss" || TypeParam::name() == "sphere" ? 1.25 : 1.15;
   EXPECT_LT(falling_back, bound * cold);
   EXPECT_GT(state.cold_queries(), 250u);
   EXPECT_EQ(always.cold_queries(), 0u);

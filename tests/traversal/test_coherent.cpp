@@ -5,7 +5,9 @@
 #include "coherent_suite.hpp"
 #include "support/errors.hpp"
 
+#include <algorithm>
 #include <optional>
+#include <utility>
 
 namespace bvhlab::coherent_tests {
 namespace {
@@ -125,6 +127,76 @@ TEST(Coherent, ARepeatedContactIsAnsweredByItsWitness) {
   EXPECT_EQ(again.witness, first.witness);
   EXPECT_EQ(again.counters.bv_tests, 0u);
   EXPECT_EQ(state.witness_hits(), 1u);
+}
+
+/// The stored pairs marked as leading to the remembered contact: a chain from the root pair to the contact's
+/// leaf pair, one marked child per marked inner pair, and no other mark (none without a contact). Returns
+/// the chain's length.
+std::size_t checked_witness_path(CoherentState& state) {
+  const std::vector<FrontPair>& pairs = state.pairs();
+  const auto marked =
+      std::count_if(pairs.begin(), pairs.end(), [](const FrontPair& p) { return p.leads_to_witness != 0; });
+  if (!state.witness || pairs.empty()) {
+    EXPECT_EQ(marked, 0);
+    return 0;
+  }
+  std::size_t at = 0, length = 1;
+  EXPECT_TRUE(pairs[0].leads_to_witness);
+  while (pairs[at].count > 0) {
+    const FrontPair& parent = pairs[at];
+    int marked_children = 0;
+    for (std::uint32_t c = 0; c < parent.count; ++c)
+      if (pairs[parent.first + c].leads_to_witness) ++marked_children, at = parent.first + c;
+    EXPECT_EQ(marked_children, 1);
+    if (marked_children != 1) return 0;
+    ++length;
+  }
+  EXPECT_EQ(std::make_pair(pairs[at].a, pairs[at].b), *state.witness);
+  EXPECT_EQ(std::size_t(marked), length);
+  return length;
+}
+
+template <TreeVolume BV>
+void expect_paths_to_the_witness() {
+  const auto a = Bvh<BV>::build(torus());
+  const auto b = Bvh<BV>::build(soup());
+  CoherentState state{CoherenceOptions{.max_cold_run = 0}};
+  int walks_to_a_new_contact = 0;
+  for (const RigidTransform& pose : path(160)) {
+    const auto witness = state.witness;
+    ASSERT_EQ(query_exact_coherent(a, b, pose, state).collides, query_exact(a, b, pose).collides);
+    const std::size_t length = checked_witness_path(state);
+    if (state.witness && state.witness != witness && length > 1) ++walks_to_a_new_contact;
+  }
+  EXPECT_GT(walks_to_a_new_contact, 3);
+}
+
+// After a walk that found a contact, the stored tree marks the way to it: a walk after the contact is lost
+// goes that way first (the contact moved, most likely not far).
+TEST(Coherent, TheStoredTreeMarksTheWayToItsContact) {
+  expect_paths_to_the_witness<Aabb>();
+  expect_paths_to_the_witness<Obb>();
+}
+
+// The same path twice: one state as it is, one whose marks are wiped before every query (its walks go in
+// the stored order). Both answer as the cold query; the one that goes the marked way first tests fewer pairs.
+TEST(Coherent, AWalkAfterALostContactGoesTheMarkedWayFirst) {
+  const auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  CoherentState marked{CoherenceOptions{.max_cold_run = 0}}, unmarked{CoherenceOptions{.max_cold_run = 0}};
+  Counters marked_work, unmarked_work;
+  for (const RigidTransform& pose : path(240)) {
+    for (FrontPair& p : unmarked.pairs()) p.leads_to_witness = 0;
+    const Result cold = query_exact(a, b, pose);
+    const Result r = query_exact_coherent(a, b, pose, marked);
+    const Result u = query_exact_coherent(a, b, pose, unmarked);
+    ASSERT_EQ(r.collides, cold.collides);
+    ASSERT_EQ(u.collides, cold.collides);
+    marked_work += r.counters;
+    unmarked_work += u.counters;
+  }
+  EXPECT_LT(marked_work.bv_tests, unmarked_work.bv_tests);
+  EXPECT_LT(marked_work.triangle_tests, unmarked_work.triangle_tests);
 }
 
 TEST(Coherent, RefusesWhatItCannotServe) {
