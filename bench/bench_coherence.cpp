@@ -2,7 +2,7 @@
 // `--steps` per query at each distance, and every `--strides`-th pose is asked, in order.
 //
 //   bench_coherence [--meshes=a.stl,b.obj] [--volumes=aabb,dop24] [--steps=2000] [--strides=1,8,64]
-//                   [--distances=0.6,1.0,1.4] [--judge=work|time] [--max_cold_run=128] [--max_jump=0.5]
+//                   [--distances=0.6,1.0,1.4] [--judge=work|time] [--max_cold_run=128] [--max_jump=0.2]
 //                   [benchmark flags]
 //
 // One iteration is one cold pass and one coherent pass over the same poses (a fresh state), in alternating

@@ -21,8 +21,9 @@ struct CoherenceOptions {
   std::size_t max_pairs = std::size_t{1} << 18;
   /// The pose jumps when some point of B's root box moves (relative to A) by more than this many of the
   /// box's radii since the last query: the query starts from the root. While the poses keep jumping (two
-  /// jumps in a row), it runs as the cold one and stores no front.
-  double max_jump = 0.5;
+  /// jumps in a row), it runs as the cold one and stores no front. 0.2: on the protocol, steps of up to
+  /// about 3 degrees keep their front and steps of 11 run cold (bench/RESULTS.md, "The default max_jump").
+  double max_jump = 0.2;
   /// A front pair whose parent pair was tested for raising and still overlapped waits this many queries
   /// before its parent is tested again (so pairs close to contact do not pay a useless test every query).
   std::uint8_t raise_hold = 8;
