@@ -306,9 +306,10 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   state.witness = walk.run(overlapping_root ? &*overlapping_root : nullptr);
   // A contact ends the walk early; the tree it built is still a cut of every pair (each pair not reached yet
   // is a front pair there, to be tested), so the next query starts from it rather than from the root.
+  const std::size_t written = next.size();
   state.store(next, b_to_a);
   state.record_cost(result.counters, seconds(),
-                    from_front ? CoherentState::Start::Front : CoherentState::Start::Root);
+                    from_front ? CoherentState::Start::Front : CoherentState::Start::Root, written);
   return result;
 }
 

@@ -76,7 +76,9 @@ bool CoherentState::moved_too_far(const RigidTransform& pose) const {
 }
 
 namespace {
-/// A query's work: a node pair taken, a BV test, and a triangle test worth about four BV tests.
+/// A query's work: a node pair taken, a BV test, and a triangle test worth about four BV tests. A walk also
+/// stores its tree, half a unit a pair: without it, on the pipes at m = 16 a walk looked a little cheaper
+/// than the cold query by work and took 1.5 times its time (bench/RESULTS.md, "Storing counts as work").
 double work_of(const Counters& c) {
   return static_cast<double>(c.nodes_visited + c.bv_tests + 4 * c.triangle_tests);
 }
@@ -91,9 +93,12 @@ void average_into(double& average, double sample, double weight) {
 }
 }  // namespace
 
-void CoherentState::record_cost(const Counters& counters, double seconds, Start start) {
+void CoherentState::record_cost(const Counters& counters, double seconds, Start start,
+                                std::size_t pairs_written) {
   if (options_.max_cold_run == 0) return;
-  const double cost = options_.judge == CoherenceOptions::Judge::time ? seconds : work_of(counters);
+  const double cost = options_.judge == CoherenceOptions::Judge::time
+                          ? seconds
+                          : work_of(counters) + 0.5 * static_cast<double>(pairs_written);
   if (start == Start::Root) {
     average_into(root_cost_, cost, 0.125);  // queries from the root vary with the pose: a longer memory
     if (cold_left_ > 0) {

@@ -33,7 +33,8 @@ struct CoherenceOptions {
   /// the front loses again, at most this many. 0: always walk the front.
   std::uint32_t max_cold_run = 128;
   /// What "cost" means there. `work` (the default): node pairs, BV tests and triangle tests (four BV tests
-  /// each), which repeat exactly from run to run, so the counters do too. `time`: each query's own
+  /// each), and half a unit per pair a walk stores (the cold query stores none), which repeat exactly from
+  /// run to run, so the counters do too. `time`: each query's own
   /// seconds, what the caller pays: a walk's node pair costs 1.05 to 2.5 times a cold traversal's, by
   /// volume (bench/RESULTS.md), which the work does not see; the counters then vary from run to run.
   enum class Judge : std::uint8_t { work, time };
@@ -150,7 +151,8 @@ class CoherentState {
   enum class Start : std::uint8_t { Front, Root };
   /// Records one query's cost (its seconds or its work: CoherenceOptions::judge) and decides whether the
   /// next queries walk the front or start from the root.
-  void record_cost(const Counters& counters, double seconds, Start start);
+  /// `pairs_written`: the pairs of the tree a walk stored.
+  void record_cost(const Counters& counters, double seconds, Start start, std::size_t pairs_written = 0);
 
  private:
   [[nodiscard]] bool moved_too_far(const RigidTransform& pose) const;
