@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <span>
@@ -302,13 +303,48 @@ py::dict query_batch(const AnyTree& a, const AnyTree& b, const py::object& poses
   return columns.dict();
 }
 
+/// The options of a state from Python's keywords (CoherenceOptions; validated by the state).
+CoherenceOptions coherence_options(double max_jump, std::size_t max_pairs, std::uint32_t max_cold_run,
+                                   int raise_hold, const std::string& judge) {
+  if (raise_hold < 0 || raise_hold > 255) throw py::value_error("raise_hold must be 0 to 255");
+  if (judge != "work" && judge != "time")
+    throw py::value_error("judge must be \"work\" or \"time\", not \"" + judge + "\"");
+  CoherenceOptions options;
+  options.max_jump = max_jump;
+  options.max_pairs = max_pairs;
+  options.max_cold_run = max_cold_run;
+  options.raise_hold = static_cast<std::uint8_t>(raise_hold);
+  options.judge = judge == "time" ? CoherenceOptions::Judge::time : CoherenceOptions::Judge::work;
+  return options;
+}
+
+py::dict options_of(const CoherentState& state) {
+  const CoherenceOptions& o = state.options();
+  py::dict out;
+  out["max_jump"] = o.max_jump;
+  out["max_pairs"] = o.max_pairs;
+  out["max_cold_run"] = o.max_cold_run;
+  out["raise_hold"] = int{o.raise_hold};
+  out["judge"] = o.judge == CoherenceOptions::Judge::time ? "time" : "work";
+  return out;
+}
+
 void bind_coherent_state(py::module_& m) {
+  const CoherenceOptions defaults;
   py::class_<CoherentState>(m, "CoherentState",
                             "What coherent queries of one pair of trees keep between calls: the front where "
                             "the last query stopped, its contact, its pose. Pass it to query_batch(..., "
                             "coherent=True, state=s) to continue a sequence of poses across calls. It "
-                            "belongs to one pair of trees and one caller at a time.")
-      .def(py::init<>())
+                            "belongs to one pair of trees and one caller at a time. The keywords are the "
+                            "state's bounds (traversal/README.md, \"Coherent queries\").")
+      .def(py::init([](double max_jump, std::size_t max_pairs, std::uint32_t max_cold_run, int raise_hold,
+                       const std::string& judge) {
+             return CoherentState(coherence_options(max_jump, max_pairs, max_cold_run, raise_hold, judge));
+           }),
+           py::kw_only(), py::arg("max_jump") = defaults.max_jump, py::arg("max_pairs") = defaults.max_pairs,
+           py::arg("max_cold_run") = defaults.max_cold_run, py::arg("raise_hold") = int{defaults.raise_hold},
+           py::arg("judge") = "work")
+      .def_property_readonly("options", &options_of, "the keywords the state was made with, as a dict")
       .def("reset", &CoherentState::reset, "Forget the front and the contact: the next query starts cold.")
       .def_property_readonly("front_size", &CoherentState::front_size, "node pairs the next query re-tests")
       .def_property_readonly("jumps", &CoherentState::jumps,

@@ -176,7 +176,7 @@ class FrontWalk {
   }
 
   /// Marks the pair at `out` in next_ and its ancestors as leading to the contact found there. A parent is
-  /// stored before its children, so one backward pass finds them all.
+  /// stored before its children, so one backward pass finds them all: a step per pair this walk wrote.
   void mark_path(std::uint32_t out) {
     next_[out].leads_to_witness = 1;
     for (std::uint32_t i = out; i-- > 0;) {

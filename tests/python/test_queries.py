@@ -337,6 +337,31 @@ def test_coherent_batches_answer_as_cold_ones_with_less_work(gear_trees, strateg
     np.testing.assert_array_equal(np.concatenate([first["bv_tests"], second["bv_tests"]]), coherent["bv_tests"])
 
 
+def test_coherent_states_take_their_bounds(gear_trees):
+    """CoherentState's keywords are its bounds: with max_jump 0 every pose that is not answered by the
+    remembered contact or the root pair alone jumps, and jumps in a row cost the cold query's work (and at
+    most that test more); the default sees no jump on small steps. Nonsense is refused by name."""
+    tree = gear_trees["none"]
+    poses = bvhlab.protocol_poses(1.4, 2000)[:60]  # steps of 0.18 degrees
+    cold = bvhlab.query_batch(tree, tree, poses)
+    jumping = bvhlab.CoherentState(max_jump=0.0, max_cold_run=0)
+    assert jumping.options["max_jump"] == 0.0 and jumping.options["max_cold_run"] == 0
+    every = bvhlab.query_batch(tree, tree, poses, coherent=True, state=jumping)
+    np.testing.assert_array_equal(every["collides"], cold["collides"])
+    assert jumping.jumps > len(poses) // 2
+    assert (every["bv_tests"][2:] <= cold["bv_tests"][2:] + 1).all()
+    steady = bvhlab.CoherentState()
+    assert steady.options == {"max_jump": 0.2, "max_pairs": 2**18, "max_cold_run": 128, "raise_hold": 8,
+                              "judge": "work"}
+    bvhlab.query_batch(tree, tree, poses, coherent=True, state=steady)
+    assert steady.jumps == 0
+    for bad, name in [({"max_jump": -1.0}, "max_jump"), ({"max_jump": float("nan")}, "max_jump"),
+                      ({"max_pairs": 0}, "max_pairs"), ({"raise_hold": 256}, "raise_hold"),
+                      ({"judge": "fast"}, "judge")]:
+        with pytest.raises(ValueError, match=name):
+            bvhlab.CoherentState(**bad)
+
+
 def test_coherent_batches_refuse_what_cannot_run_coherent(gear_trees):
     tree, annotated = gear_trees["none"], gear_trees["adb"]
     poses = bvhlab.protocol_poses(1.0, 10)

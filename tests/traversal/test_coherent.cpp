@@ -199,6 +199,24 @@ TEST(Coherent, AWalkAfterALostContactGoesTheMarkedWayFirst) {
   EXPECT_LT(marked_work.triangle_tests, unmarked_work.triangle_tests);
 }
 
+// Judged by work, a walk pays for the tree it stores (half a unit a pair): a walk of the cold query's
+// counters that stores pairs costs more than the cold query, and the next queries start from the root.
+TEST(Coherent, AWalksStoredPairsCountAsItsWork) {
+  Counters work;
+  work.nodes_visited = 100;
+  work.bv_tests = 100;
+  CoherentState state;
+  state.record_cost(work, 0, CoherentState::Start::Root);
+  state.record_cost(work, 0, CoherentState::Start::Front);
+  EXPECT_EQ(state.cold_turns_left(), 0u);  // the same work: the front does not lose
+  state.record_cost(work, 0, CoherentState::Start::Front, 100);
+  EXPECT_EQ(state.cold_turns_left(), 2u);
+  CoherentState timed{CoherenceOptions{.judge = CoherenceOptions::Judge::time}};  // seconds alone
+  timed.record_cost(work, 1.0, CoherentState::Start::Root);
+  timed.record_cost(work, 1.0, CoherentState::Start::Front, 100);
+  EXPECT_EQ(timed.cold_turns_left(), 0u);
+}
+
 TEST(Coherent, RefusesWhatItCannotServe) {
   const auto a = Bvh<Aabb>::build(torus());
   const auto b = Bvh<Aabb>::build(soup());
