@@ -181,16 +181,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_coherence: --steps and every stride must be at least 1\n");
     return 2;
   }
-  if (judge_name != "work" && judge_name != "time") {
-    std::fprintf(stderr, "bench_coherence: --judge is work or time, not '%s'\n", judge_name.c_str());
+  try {
+    coherence_options.judge = judge_from_string(judge_name);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "bench_coherence: --judge: %s\n", e.what());
     return 2;
   }
   if (max_cold_run < 0) {
     std::fprintf(stderr, "bench_coherence: --max_cold_run must be at least 0\n");
     return 2;
   }
-  coherence_options.judge =
-      judge_name == "time" ? CoherenceOptions::Judge::time : CoherenceOptions::Judge::work;
   coherence_options.max_cold_run = static_cast<std::uint32_t>(max_cold_run);
   coherence_options.max_jump = max_jump;
   try {

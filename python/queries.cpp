@@ -307,14 +307,12 @@ py::dict query_batch(const AnyTree& a, const AnyTree& b, const py::object& poses
 CoherenceOptions coherence_options(double max_jump, std::size_t max_pairs, std::uint32_t max_cold_run,
                                    int raise_hold, const std::string& judge) {
   if (raise_hold < 0 || raise_hold > 255) throw py::value_error("raise_hold must be 0 to 255");
-  if (judge != "work" && judge != "time")
-    throw py::value_error("judge must be \"work\" or \"time\", not \"" + judge + "\"");
   CoherenceOptions options;
   options.max_jump = max_jump;
   options.max_pairs = max_pairs;
   options.max_cold_run = max_cold_run;
   options.raise_hold = static_cast<std::uint8_t>(raise_hold);
-  options.judge = judge == "time" ? CoherenceOptions::Judge::time : CoherenceOptions::Judge::work;
+  options.judge = judge_from_string(judge);
   return options;
 }
 
@@ -325,7 +323,7 @@ py::dict options_of(const CoherentState& state) {
   out["max_pairs"] = o.max_pairs;
   out["max_cold_run"] = o.max_cold_run;
   out["raise_hold"] = int{o.raise_hold};
-  out["judge"] = o.judge == CoherenceOptions::Judge::time ? "time" : "work";
+  out["judge"] = std::string(to_string(o.judge));
   return out;
 }
 
@@ -343,7 +341,7 @@ void bind_coherent_state(py::module_& m) {
            }),
            py::kw_only(), py::arg("max_jump") = defaults.max_jump, py::arg("max_pairs") = defaults.max_pairs,
            py::arg("max_cold_run") = defaults.max_cold_run, py::arg("raise_hold") = int{defaults.raise_hold},
-           py::arg("judge") = "work")
+           py::arg("judge") = std::string(to_string(defaults.judge)))
       .def_property_readonly("options", &options_of, "the keywords the state was made with, as a dict")
       .def("reset", &CoherentState::reset, "Forget the front and the contact: the next query starts cold.")
       .def_property_readonly("front_size", &CoherentState::front_size, "node pairs the next query re-tests")

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace bvhlab {
 
@@ -14,6 +15,16 @@ void CoherenceOptions::validate() const {
 
 CoherentState::CoherentState(CoherenceOptions options) : options_(options) {
   options_.validate();
+}
+
+std::string_view to_string(CoherenceOptions::Judge judge) {
+  return judge == CoherenceOptions::Judge::time ? "time" : "work";
+}
+
+CoherenceOptions::Judge judge_from_string(std::string_view name) {
+  if (name == "work") return CoherenceOptions::Judge::work;
+  if (name == "time") return CoherenceOptions::Judge::time;
+  throw std::invalid_argument("unknown judge '" + std::string(name) + "' (expected work or time)");
 }
 
 void CoherentState::reset() {

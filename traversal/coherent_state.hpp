@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 namespace bvhlab {
@@ -43,6 +44,10 @@ struct CoherenceOptions {
   /// Throws std::invalid_argument for nonsense values (max_pairs 0, a NaN or negative max_jump).
   void validate() const;
 };
+/// "work" or "time".
+std::string_view to_string(CoherenceOptions::Judge judge);
+/// Parses "work" or "time"; throws std::invalid_argument naming the bad value.
+CoherenceOptions::Judge judge_from_string(std::string_view name);
 
 /// One pair of the stored traversal tree: the node pairs the last query reached, each either a front pair
 /// (count 0: tested again by the next query) or an inner pair whose `count` children follow at `first`.
