@@ -4,18 +4,22 @@
 //   bench_protocol [--meshes=a.stl,b.obj] [--steps=500] [--volumes=aabb,dop24] [benchmark flags]
 //
 // Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
-// protocol's mean time per query. Counters: BV tests and triangle tests per query, bytes per triangle.
+// protocol's mean time per query. With aabb among the volumes, the series aabb_wide runs its wide form
+// (four children a node, traversal/wide_exact.hpp). Counters: BV tests and triangle tests per query, bytes
+// per triangle.
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
 #include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "traversal/exact.hpp"
+#include "traversal/wide_exact.hpp"
 
 #include <benchmark/benchmark.h>
 #ifdef BVHLAB_HAVE_FCL
 #include "bench/core/fcl_model.hpp"
 #endif
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -79,6 +83,36 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
   }
 }
 
+/// The AABB tree's wide form (traversal/wide_exact.hpp) as the series "aabb_wide"; its bytes per triangle
+/// count both forms (the wide walk reads the binary leaves).
+void register_wide(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
+                   const std::vector<PoseSet>& sets) {
+  auto tree = std::make_shared<const Bvh<Aabb>>(Bvh<Aabb>::build(*mesh));
+  auto wide = std::make_shared<const WideAabbTree>(WideAabbTree::build(*tree));
+  const BvhStats stats = tree->stats();
+  const double bytes_per_triangle =
+      double(stats.nodes * stats.bytes_per_node + wide->bytes()) / double(stats.triangles);
+  for (const auto& set : sets) {
+    const std::string name = "exact/" + mesh_name + "/aabb_wide/d:" + set.label;
+    benchmark::RegisterBenchmark(name.c_str(), [tree, wide, bytes_per_triangle,
+                                                &set](benchmark::State& state) {
+      Counters pass;
+      std::size_t colliding = 0;
+      for (auto _ : state) {
+        pass = {};
+        colliding = 0;
+        for (const auto& pose : set.poses) {
+          const Result r = query_exact_wide(*tree, *wide, *tree, *wide, pose);
+          pass += r.counters;
+          colliding += r.collides;
+        }
+        benchmark::DoNotOptimize(colliding);
+      }
+      set_per_query_counters(state, set.poses.size(), pass, colliding, bytes_per_triangle);
+    })->Unit(benchmark::kMillisecond);
+  }
+}
+
 #ifdef BVHLAB_HAVE_FCL
 template <class FclBV>
 void register_fcl(const std::string& mesh_name, const std::string& bv_name,
@@ -127,6 +161,7 @@ int main(int argc, char** argv) {
   for_each_protocol_mesh("bench_protocol", meshes, [&](const std::string& label, const auto& mesh) {
     for (const auto& v : volumes)
       with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_bvhlab<BV>(label, mesh, sets); });
+    if (std::find(volumes.begin(), volumes.end(), "aabb") != volumes.end()) register_wide(label, mesh, sets);
 #ifdef BVHLAB_HAVE_FCL
     register_fcl<fcl::OBBd>(label, "fcl_obb", mesh, sets);
     register_fcl<fcl::OBBRSSd>(label, "fcl_obbrss", mesh, sets);
