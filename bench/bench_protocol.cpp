@@ -1,12 +1,13 @@
 // The exact-query protocol (adb/README.md, section 4) as Google Benchmark suites: mesh x BV x distance,
 // with FCL 0.7's OBB and OBBRSS on the same meshes and poses in the same binary, so ratios come from one run.
 //
-//   bench_protocol [--meshes=a.stl,b.obj] [--steps=500] [--volumes=aabb,dop24] [benchmark flags]
+//   bench_protocol [--meshes=a.stl,b.obj] [--steps=500] [--volumes=aabb,dop24] [--wide=false] [benchmark
+//   flags]
 //
 // Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
-// protocol's mean time per query. With aabb among the volumes, the series aabb_wide runs its wide form
-// (four children a node, traversal/wide_exact.hpp). Counters: BV tests and triangle tests per query, bytes
-// per triangle.
+// protocol's mean time per query. Each volume with a wide layout (AABB, k-DOPs) also runs its wide form
+// (four children a node, traversal/wide_exact.hpp) as the series <volume>_wide, unless --wide=false.
+// Counters: BV tests and triangle tests per query, bytes per triangle.
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
 #include "engine/protocol.hpp"
@@ -19,7 +20,6 @@
 #include "bench/core/fcl_model.hpp"
 #endif
 
-#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -83,17 +83,18 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
   }
 }
 
-/// The AABB tree's wide form (traversal/wide_exact.hpp) as the series "aabb_wide"; its bytes per triangle
+/// A tree's wide form (traversal/wide_exact.hpp) as the series "<volume>_wide"; its bytes per triangle
 /// count both forms (the wide walk reads the binary leaves).
+template <HasWideLayout BV>
 void register_wide(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
                    const std::vector<PoseSet>& sets) {
-  auto tree = std::make_shared<const Bvh<Aabb>>(Bvh<Aabb>::build(*mesh));
-  auto wide = std::make_shared<const WideAabbTree>(WideAabbTree::build(*tree));
+  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
+  auto wide = std::make_shared<const WideTreeOf<BV>>(WideTreeOf<BV>::build(*tree));
   const BvhStats stats = tree->stats();
   const double bytes_per_triangle =
       double(stats.nodes * stats.bytes_per_node + wide->bytes()) / double(stats.triangles);
   for (const auto& set : sets) {
-    const std::string name = "exact/" + mesh_name + "/aabb_wide/d:" + set.label;
+    const std::string name = "exact/" + mesh_name + "/" + std::string(BV::name()) + "_wide/d:" + set.label;
     benchmark::RegisterBenchmark(name.c_str(), [tree, wide, bytes_per_triangle,
                                                 &set](benchmark::State& state) {
       Counters pass;
@@ -147,10 +148,12 @@ int main(int argc, char** argv) {
   std::vector<std::string> meshes{"injector_pipes.stl", "occt_tr12j_housing.stl", "jeep1.ms3d", "bunny.obj"};
   std::vector<std::string> volumes = volume_names();
   int steps = 500;
+  bool wide = true;
   if (auto exit = initialize_benchmark("bench_protocol",
                                        {{"meshes", &meshes, "meshes to run"},
                                         {"volumes", &volumes, "bounding volumes"},
-                                        {"steps", &steps, "poses per distance"}},
+                                        {"steps", &steps, "poses per distance"},
+                                        {"wide", &wide, "also the wide form of volumes that have one"}},
                                        argc, argv))
     return *exit;
   if (steps < 1) {
@@ -160,8 +163,11 @@ int main(int argc, char** argv) {
   static const std::vector<PoseSet> sets = make_pose_sets(steps);
   for_each_protocol_mesh("bench_protocol", meshes, [&](const std::string& label, const auto& mesh) {
     for (const auto& v : volumes)
-      with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_bvhlab<BV>(label, mesh, sets); });
-    if (std::find(volumes.begin(), volumes.end(), "aabb") != volumes.end()) register_wide(label, mesh, sets);
+      with_volume(v, [&]<class BV>(std::type_identity<BV>) {
+        register_bvhlab<BV>(label, mesh, sets);
+        if constexpr (HasWideLayout<BV>)
+          if (wide) register_wide<BV>(label, mesh, sets);
+      });
 #ifdef BVHLAB_HAVE_FCL
     register_fcl<fcl::OBBd>(label, "fcl_obb", mesh, sets);
     register_fcl<fcl::OBBRSSd>(label, "fcl_obbrss", mesh, sets);

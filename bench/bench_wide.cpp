@@ -1,18 +1,20 @@
-// Wide against binary trees of boxes: the exact first-contact query on the binary AABB tree (query_exact)
-// and on its wide form (query_exact_wide: four children a node, tested at once), side by side.
+// Wide against binary trees: the exact first-contact query on a binary tree (query_exact) and on its wide
+// form (query_exact_wide: four children a node, tested at once), side by side, for every volume that has a
+// wide layout (AABB and the k-DOPs).
 //
-//   bench_wide [--meshes=jeep1.ms3d,bunny.obj] [--distances=0.4,0.8,1.2,1.6,2.0] [--steps=200]
-//              [benchmark flags]
+//   bench_wide [--meshes=jeep1.ms3d,bunny.obj] [--volumes=aabb,dop18,dop24] [--distances=0.4,0.8,1.2,1.6,2.0]
+//              [--steps=200] [benchmark flags]
 //
-// Per mesh (against itself, protocol poses of every distance), one iteration makes one pass over all poses
-// with each query, in alternating order, each pass timed as a whole. Counters, medians over the iterations
-// (q1, q3: quartiles): µs per query for each, the speed-up binary over wide (per iteration, then its
-// median), and per query the BV tests (the wide count includes empty lanes), node pairs taken and triangle
-// tests of each. A pose where the two answer otherwise ends the run with an error.
+// Per mesh and volume (a mesh against itself, protocol poses of every distance), one iteration makes one pass
+// over all poses with each query, in alternating order, each pass timed as a whole. Counters, medians over
+// the iterations (q1, q3: quartiles): µs per query for each, the speed-up binary over wide (per iteration,
+// then its median), and per query the BV tests (the wide count includes empty lanes), node pairs taken and
+// triangle tests of each. A pose where the two answer otherwise ends the run with an error.
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
 #include "bench/report_tables.hpp"
 #include "engine/protocol.hpp"
+#include "engine/registry.hpp"
 #include "traversal/wide_exact.hpp"
 
 #include <benchmark/benchmark.h>
@@ -20,6 +22,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -28,12 +31,14 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+template <class BV>
 struct Trees {
-  Bvh<Aabb> binary;
-  WideAabbTree wide;
+  Bvh<BV> binary;
+  WideTreeOf<BV> wide;
 };
 
-void run_series(benchmark::State& state, const Trees& t, const std::vector<RigidTransform>& poses) {
+template <class BV>
+void run_series(benchmark::State& state, const Trees<BV>& t, const std::vector<RigidTransform>& poses) {
   std::vector<double> binary_us, wide_us, speedup;
   Counters binary_work, wide_work;
   std::vector<char> binary_answers(poses.size()), wide_answers(poses.size());
@@ -96,10 +101,12 @@ void run_series(benchmark::State& state, const Trees& t, const std::vector<Rigid
 int main(int argc, char** argv) {
   using namespace bvhlab;
   std::vector<std::string> meshes{"jeep1.ms3d", "bunny.obj"};
+  std::vector<std::string> volumes{"aabb", "dop18", "dop24"};
   std::vector<double> distances{0.4, 0.8, 1.2, 1.6, 2.0};
   int steps = 200;
   if (auto exit = initialize_benchmark("bench_wide",
                                        {{"meshes", &meshes, "meshes to run"},
+                                        {"volumes", &volumes, "bounding volumes with a wide layout"},
                                         {"distances", &distances, "protocol distances"},
                                         {"steps", &steps, "poses per full turn"}},
                                        argc, argv))
@@ -111,13 +118,33 @@ int main(int argc, char** argv) {
   static std::vector<RigidTransform> poses;
   for (double d : distances)
     for (const RigidTransform& pose : protocol_poses(d, steps)) poses.push_back(pose);
+  for (const auto& v : volumes) {
+    bool wide = false;
+    try {
+      with_volume(v, [&]<class BV>(std::type_identity<BV>) { wide = HasWideLayout<BV>; });
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "bench_wide: --volumes: %s\n", e.what());
+      return 2;
+    }
+    if (!wide) {
+      std::fprintf(stderr, "bench_wide: --volumes: %s has no wide layout (aabb and the k-DOPs have)\n",
+                   v.c_str());
+      return 2;
+    }
+  }
   for_each_protocol_mesh("bench_wide", meshes, [&](const std::string& label, const auto& mesh) {
-    auto binary = Bvh<Aabb>::build(*mesh);
-    auto wide = WideAabbTree::build(binary);
-    const auto trees = std::make_shared<const Trees>(Trees{std::move(binary), std::move(wide)});
-    benchmark::RegisterBenchmark((label + "/aabb").c_str(), [trees](benchmark::State& state) {
-      run_series(state, *trees, poses);
-    })->Unit(benchmark::kMillisecond);
+    for (const auto& v : volumes)
+      with_volume(v, [&]<class BV>(std::type_identity<BV>) {
+        if constexpr (HasWideLayout<BV>) {
+          auto binary = Bvh<BV>::build(*mesh);
+          auto wide = WideTreeOf<BV>::build(binary);
+          const auto trees = std::make_shared<const Trees<BV>>(Trees<BV>{std::move(binary), std::move(wide)});
+          const std::string name = label + "/" + std::string(BV::name());
+          benchmark::RegisterBenchmark(name.c_str(), [trees](benchmark::State& state) {
+            run_series(state, *trees, poses);
+          })->Unit(benchmark::kMillisecond);
+        }
+      });
   });
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

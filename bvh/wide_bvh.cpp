@@ -50,28 +50,4 @@ WideTopology collapse_topology(std::span<const TreeNode> nodes, std::span<const 
   return out;
 }
 
-WideAabbTree WideAabbTree::build(const Bvh<Aabb>& tree) {
-  if (tree.empty()) throw std::invalid_argument("wide tree: the binary tree is empty");
-  std::vector<float> sizes(tree.nodes().size());
-  for (std::uint32_t i = 0; i < sizes.size(); ++i) sizes[i] = tree.size(i);
-  const WideTopology topology = collapse_topology(tree.nodes(), sizes);
-  WideAabbTree out;
-  out.binary_identity_ = tree.identity();
-  out.origin_ = tree.volume(0).bounding_box().center();
-  // Node 0: the root's own box in lane 0; the wide nodes follow, shifted by one.
-  out.nodes_.resize(topology.nodes.size() + 1);
-  out.nodes_[0].boxes.set(0, tree.volume(0), out.origin_);
-  out.nodes_[0].child[0] = tree.node(0).is_leaf() ? (kLeaf | 0u) : 1u;
-  for (std::size_t w = 0; w < topology.nodes.size(); ++w) {
-    const WideTopology::Node& from = topology.nodes[w];
-    Node& to = out.nodes_[w + 1];
-    for (std::uint32_t k = 0; k < from.count; ++k) {
-      const std::uint32_t c = from.child[k];
-      to.boxes.set(static_cast<int>(k), tree.volume(c), out.origin_);
-      to.child[k] = tree.node(c).is_leaf() ? (kLeaf | c) : topology.wide_of[c] + 1;
-    }
-  }
-  return out;
-}
-
 }  // namespace bvhlab

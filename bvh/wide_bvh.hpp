@@ -1,13 +1,15 @@
 // Wide trees: a binary tree's topology collapsed to four children a node (after Embree: the topology first,
-// then a node layout for it), and the layout of axis-aligned boxes for it, four children's boxes side by
-// side (volumes/aabb4.hpp), so that one node's children are tested against a box of the other tree at once.
+// then a node layout for it), and the layout of the volumes for it, four children's volumes side by side
+// (volumes/aabb4.hpp, volumes/kdop4.hpp), so that one node's children are tested against a volume of the
+// other tree at once.
 //
-// A wide tree is built from a Bvh<Aabb> and refers to it for the leaves: a child that is a leaf names the
+// A wide tree is built from a binary Bvh and refers to it for the leaves: a child that is a leaf names the
 // binary leaf, whose triangles the binary tree holds. The queries take both trees and refuse a wide tree
 // built from another binary one (binary_identity()).
 #pragma once
 
 #include "../volumes/aabb4.hpp"
+#include "../volumes/kdop4.hpp"
 #include "bvh.hpp"
 
 #include <array>
@@ -42,26 +44,59 @@ struct WideTopology {
 /// choose what to absorb. Throws std::invalid_argument when the two differ in length.
 WideTopology collapse_topology(std::span<const TreeNode> nodes, std::span<const float> sizes);
 
-/// The axis-aligned boxes of a wide topology: per wide node, its children's boxes (Aabb4, one lane each)
-/// and what each child is: another wide node, or a binary leaf. A pseudo-node at index 0 holds the root's
-/// own box in lane 0, so every box the walk needs sits in some node's lane: a walk starts at (0, lane 0).
-class WideAabbTree {
+/// The volumes of a wide topology, laid out by `Lanes` (a block of four volumes side by side: Aabb4 for
+/// AABB trees, KDop4 for k-DOP trees): per wide node its children's volumes, one lane each, and what each
+/// child is, another wide node or a binary leaf. A pseudo-node at index 0 holds the root's own volume in
+/// lane 0, so every volume the walk needs sits in some node's lane: a walk starts at (0, lane 0). Lanes are
+/// stored relative to origin(), the centre of the root's bounding box.
+///
+/// Lanes provides: `Volume` (the binary tree's volume type), `set(lane, volume, origin)` (a default Lanes is
+/// four empty lanes), `volume(lane)` (its bounding box's volume, for the descent), and the test used by
+/// traversal/wide_exact.hpp: `PairContext`, `make_context(pose, origin_a, origin_b)`, `broadcast`, `place`,
+/// `overlap_placed`.
+template <class Lanes>
+class WideBvh {
  public:
+  using Volume = typename Lanes::Volume;
   /// Child reference: a wide node index, or kLeaf | binary leaf index.
   static constexpr std::uint32_t kLeaf = 0x8000'0000u;
   struct Node {
-    Aabb4 boxes;
+    Lanes boxes;
     std::array<std::uint32_t, 4> child{};
   };
 
-  /// From a built (or loaded) binary tree; throws std::invalid_argument for an empty tree.
-  static WideAabbTree build(const Bvh<Aabb>& tree);
+  /// From a built (or loaded) binary tree; throws std::invalid_argument for an empty tree or one of 2^31
+  /// nodes or more.
+  static WideBvh build(const Bvh<Volume>& tree) {
+    if (tree.empty()) throw std::invalid_argument("wide tree: the binary tree is empty");
+    if (tree.nodes().size() >= kLeaf) throw std::invalid_argument("wide tree: too many nodes");
+    std::vector<float> sizes(tree.nodes().size());
+    for (std::uint32_t i = 0; i < sizes.size(); ++i) sizes[i] = tree.size(i);
+    const WideTopology topology = collapse_topology(tree.nodes(), sizes);
+    WideBvh out;
+    out.binary_identity_ = tree.identity();
+    out.origin_ = tree.volume(0).bounding_box().center();
+    // Node 0: the root's own volume in lane 0; the wide nodes follow, shifted by one.
+    out.nodes_.resize(topology.nodes.size() + 1);
+    out.nodes_[0].boxes.set(0, tree.volume(0), out.origin_);
+    out.nodes_[0].child[0] = tree.node(0).is_leaf() ? kLeaf : 1u;
+    for (std::size_t w = 0; w < topology.nodes.size(); ++w) {
+      const WideTopology::Node& from = topology.nodes[w];
+      Node& to = out.nodes_[w + 1];
+      for (std::uint32_t k = 0; k < from.count; ++k) {
+        const std::uint32_t c = from.child[k];
+        to.boxes.set(static_cast<int>(k), tree.volume(c), out.origin_);
+        to.child[k] = tree.node(c).is_leaf() ? (kLeaf | c) : topology.wide_of[c] + 1;
+      }
+    }
+    return out;
+  }
 
   [[nodiscard]] const Node& node(std::uint32_t i) const { return nodes_[i]; }
   [[nodiscard]] std::size_t size() const { return nodes_.size(); }
   [[nodiscard]] std::uint64_t binary_identity() const { return binary_identity_; }
-  /// The lanes' boxes are stored less this point (the root box's centre): a tree far from its frame's
-  /// origin keeps small numbers, and so does the pose between two near trees (Aabb4::make_context).
+  /// The lanes' volumes are stored less this point (the root box's centre): a tree far from its frame's
+  /// origin keeps small numbers, and so does the pose between two near trees (Lanes::make_context).
   [[nodiscard]] const Vec3& origin() const { return origin_; }
   [[nodiscard]] std::size_t bytes() const { return nodes_.size() * sizeof(Node); }
 
@@ -70,5 +105,28 @@ class WideAabbTree {
   std::uint64_t binary_identity_ = 0;
   Vec3 origin_ = Vec3::Zero();
 };
+
+using WideAabbTree = WideBvh<Aabb4>;
+template <class Set>
+using WideDopTree = WideBvh<KDop4<Set>>;
+
+/// The four-lane layout of a binary tree's volume, where it has one: WideLanes<Aabb>::type is Aabb4,
+/// WideLanes<KDop<Set>>::type KDop4<Set>. `HasWideLayout<BV>` says whether a volume has one.
+template <class BV>
+struct WideLanes {};
+template <>
+struct WideLanes<Aabb> {
+  using type = Aabb4;
+};
+template <class Set>
+struct WideLanes<KDop<Set>> {
+  using type = KDop4<Set>;
+};
+template <class BV>
+concept HasWideLayout = requires {
+  typename WideLanes<BV>::type;
+};
+template <HasWideLayout BV>
+using WideTreeOf = WideBvh<typename WideLanes<BV>::type>;
 
 }  // namespace bvhlab

@@ -1,10 +1,11 @@
-// Exact first-contact (or all-contacts) query on wide trees of boxes (bvh/wide_bvh.hpp): depth-first, like
-// query_exact on the binary trees, but one step tests a box of one tree against all four children of a
-// node of the other at once (Aabb4::overlap). The same answers as query_exact<Aabb> on the binary trees
-// the wide ones were built from: the triangle tests are the same, the box tests conservative.
+// Exact first-contact (or all-contacts) query on wide trees (bvh/wide_bvh.hpp): depth-first, like
+// query_exact on the binary trees, but one step tests a volume of one tree against all four children of a
+// node of the other at once (the Lanes' place and overlap_placed). The same answers as query_exact on the
+// binary trees the wide ones were built from: the triangle tests are the same, the volume tests
+// conservative.
 //
-// Counters: bv_tests counts four a vector test (each lane is a box test, occupied or not: a node of fewer
-// than four children pays for four), nodes_visited the pairs taken off the stack, triangle_tests as usual.
+// Counters: bv_tests counts four a step (each lane is a volume test, occupied or not: a node of fewer than
+// four children pays for four), nodes_visited the pairs taken off the stack, triangle_tests as usual.
 #pragma once
 
 #include "../bvh/wide_bvh.hpp"
@@ -17,16 +18,15 @@ namespace bvhlab {
 
 namespace wide_detail {
 
-/// A pair on the walk's stack: A's box (lane a_lane of wide node a_node) and B's, kept already placed in
-/// A's frame (Aabb4::place, lane `from` of `b_placed` when it was pushed) together with where it sits in B's
-/// tree, so that splitting A tests A's children against it without placing it again.
+/// A pair on the walk's stack: lane a_lane of A's wide node a_node, lane b_lane of B's b_node, whose volume,
+/// placed in A's frame, is lane b_lane of the walk's placed block `placed` (where the walk keeps them).
 struct WidePair {
-  std::uint32_t a_node, a_lane, b_node, b_lane;
-  float center[3], half[3], mag;
+  std::uint32_t a_node, a_lane, b_node, b_lane, placed;
 };
 
-inline void require_pair(const Bvh<Aabb>& a, const WideAabbTree& wide_a, const Bvh<Aabb>& b,
-                         const WideAabbTree& wide_b) {
+template <class Lanes>
+void require_pair(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wide_a,
+                  const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b) {
   if (wide_a.binary_identity() != a.identity())
     throw std::invalid_argument("wide exact query: wide tree A was not built from binary tree A");
   if (wide_b.binary_identity() != b.identity())
@@ -35,82 +35,89 @@ inline void require_pair(const Bvh<Aabb>& a, const WideAabbTree& wide_a, const B
 
 }  // namespace wide_detail
 
-/// Exact query on the wide trees of two binary AABB trees (same contract as query_exact<Aabb>; throws
-/// std::invalid_argument for a non-rigid pose or wide trees of other binary trees). Const and thread-safe
-/// on shared trees.
-inline Result query_exact_wide(const Bvh<Aabb>& a, const WideAabbTree& wide_a, const Bvh<Aabb>& b,
-                               const WideAabbTree& wide_b, const RigidTransform& b_to_a,
-                               ContactMode mode = ContactMode::First) {
+/// Exact query on the wide trees of two binary trees (same contract as query_exact; throws
+/// std::invalid_argument for a non-rigid pose or wide trees of other binary trees). Const and thread-safe on
+/// shared trees.
+template <class Lanes>
+Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wide_a,
+                        const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b,
+                        const RigidTransform& b_to_a, ContactMode mode = ContactMode::First) {
+  using BV = typename Lanes::Volume;
+  using Tree = WideBvh<Lanes>;
   check_exact_query<TriangleLeaves>(b_to_a, mode);
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;
   wide_detail::require_pair(a, wide_a, b, wide_b);
   TriangleLeaves::require(a, b, "wide exact query");
-  const auto context = Aabb::make_context(b_to_a);
-  const TreePair<Aabb> trees(a, b, b_to_a, context, result.counters);
-  const Aabb4::PairContext lanes = Aabb4::make_context(b_to_a, wide_a.origin(), wide_b.origin());
+  const auto context = VolumeWalker<BV>::make_context(b_to_a);  // TreePair's; its leaf test needs none
+  const TreePair<BV> trees(a, b, b_to_a, context, result.counters);
+  const typename Lanes::PairContext lanes = Lanes::make_context(b_to_a, wide_a.origin(), wide_b.origin());
   Counters& counters = result.counters;
 
+  // Where placing costs more than keeping the result (Lanes::kKeepsPlaced: the k-DOPs' twelve or so
+  // supports a lane), B's volumes are placed in A's frame once, four at a time, when their node is split,
+  // and a pair keeps the block its B volume sits in: splitting A then compares against it without placing
+  // it again. A box is cheaper to place again than to keep (bench/RESULTS.md, "Wide trees of k-DOPs").
+  constexpr bool keep = Lanes::kKeepsPlaced;
+  std::vector<typename Lanes::Placed> placed;
+  if constexpr (keep) placed.reserve(32);
   std::vector<wide_detail::WidePair> stack;
   stack.reserve(64);
-  // Pushes the pairs of A's lane (node_a, lane_a) and B's lanes of `placed` (node_b's boxes, placed) that
-  // `hits` marks, last to first: the first is taken first, as in the binary walk.
-  const auto push_b_lanes = [&](std::uint32_t a_node, std::uint32_t a_lane, std::uint32_t b_node,
-                                const Aabb4& placed, unsigned hits) {
-    for (int k = Aabb4::kLanes - 1; k >= 0; --k)
-      if (hits & (1u << k))
-        stack.push_back({a_node,
-                         a_lane,
-                         b_node,
-                         std::uint32_t(k),
-                         {placed.cx[k], placed.cy[k], placed.cz[k]},
-                         {placed.hx[k], placed.hy[k], placed.hz[k]},
-                         placed.mag[k]});
+  // Pushes the pairs of the lanes `hits` marks, last to first, so that the first is taken first, as in the
+  // binary walk: `base` with the lane set on the split side.
+  const auto push = [&stack](unsigned hits, const wide_detail::WidePair& base, bool split_b) {
+    for (std::uint32_t k = 4; k-- > 0;)
+      if (hits & (1u << k)) {
+        wide_detail::WidePair child = base;
+        (split_b ? child.b_lane : child.a_lane) = k;
+        stack.push_back(child);
+      }
   };
-  // The roots, as any pair: B's root box placed against A's.
+  // The roots, as any pair.
   counters.bv_tests += 1;
-  {
-    const Aabb4 placed = Aabb4::place(wide_b.node(0).boxes, lanes);
-    push_b_lanes(0, 0, 0, placed, Aabb4::overlap_placed(wide_a.node(0).boxes, placed, lanes) & 1u);
-  }
+  placed.push_back(Lanes::place(wide_b.node(0).boxes, lanes));
+  push(Lanes::overlap_placed(wide_a.node(0).boxes, placed[0], lanes) & 1u, {0, 0, 0, 0, 0}, false);
+  if constexpr (!keep) placed.clear();
   while (!stack.empty()) {
     const wide_detail::WidePair p = stack.back();
     stack.pop_back();
     ++counters.nodes_visited;
-    const WideAabbTree::Node& node_a = wide_a.node(p.a_node);
-    const WideAabbTree::Node& node_b = wide_b.node(p.b_node);
+    const typename Tree::Node& node_a = wide_a.node(p.a_node);
+    const typename Tree::Node& node_b = wide_b.node(p.b_node);
     const std::uint32_t child_a = node_a.child[p.a_lane], child_b = node_b.child[p.b_lane];
-    const bool leaf_a = (child_a & WideAabbTree::kLeaf) != 0, leaf_b = (child_b & WideAabbTree::kLeaf) != 0;
+    const bool leaf_a = (child_a & Tree::kLeaf) != 0, leaf_b = (child_b & Tree::kLeaf) != 0;
     if (leaf_a && leaf_b) {
-      const bool done = trees.intersecting_triangles(
-          child_a & ~WideAabbTree::kLeaf, child_b & ~WideAabbTree::kLeaf, [&](const TrianglePair& hit) {
-            result.collides = true;
-            result.probability = 1;
-            if (!result.witness) result.witness = hit;
-            if (mode == ContactMode::First) return true;
-            result.contacts.push_back(hit);
-            return false;
-          });
+      const bool done = trees.intersecting_triangles(child_a & ~Tree::kLeaf, child_b & ~Tree::kLeaf,
+                                                     [&](const TrianglePair& hit) {
+                                                       result.collides = true;
+                                                       result.probability = 1;
+                                                       if (!result.witness) result.witness = hit;
+                                                       if (mode == ContactMode::First) return true;
+                                                       result.contacts.push_back(hit);
+                                                       return false;
+                                                     });
       if (done) return result;
       continue;
     }
-    // Split the larger of the two (a leaf cannot be split): its four children against the other's box.
-    counters.bv_tests += Aabb4::kLanes;
+    // Split the larger of the two (a leaf cannot be split): its four children against the other's volume.
+    counters.bv_tests += 4;
     if (leaf_a || (!leaf_b && node_b.boxes.volume(int(p.b_lane)) > node_a.boxes.volume(int(p.a_lane)))) {
-      const Aabb4 placed = Aabb4::place(wide_b.node(child_b).boxes, lanes);
-      push_b_lanes(p.a_node, p.a_lane, child_b, placed,
-                   Aabb4::overlap_placed(Aabb4::broadcast(node_a.boxes, int(p.a_lane)), placed, lanes));
+      const typename Lanes::Placed children = Lanes::place(wide_b.node(child_b).boxes, lanes);
+      const unsigned hits =
+          Lanes::overlap_placed(Lanes::broadcast(node_a.boxes, int(p.a_lane)), children, lanes);
+      const auto block = static_cast<std::uint32_t>(placed.size());
+      if constexpr (keep) placed.push_back(children);
+      push(hits, {p.a_node, p.a_lane, child_b, 0, block}, true);
     } else {
-      const Aabb4 placed_b = Aabb4::splat(p.center, p.half, p.mag);
-      const unsigned hits = Aabb4::overlap_placed(wide_a.node(child_a).boxes, placed_b, lanes);
-      for (int k = Aabb4::kLanes - 1; k >= 0; --k)
-        if (hits & (1u << k)) {
-          wide_detail::WidePair child = p;
-          child.a_node = child_a;
-          child.a_lane = std::uint32_t(k);
-          stack.push_back(child);
-        }
+      const auto placed_b = [&] {
+        if constexpr (keep)
+          return Lanes::broadcast_placed(placed[p.placed], int(p.b_lane));
+        else
+          return Lanes::place(Lanes::broadcast(node_b.boxes, int(p.b_lane)), lanes);
+      };
+      const unsigned hits = Lanes::overlap_placed(wide_a.node(child_a).boxes, placed_b(), lanes);
+      push(hits, {child_a, 0, p.b_node, p.b_lane, p.placed}, false);
     }
   }
   return result;

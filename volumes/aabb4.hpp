@@ -23,6 +23,7 @@
 namespace bvhlab {
 
 struct alignas(16) Aabb4 {
+  using Volume = Aabb;
   static constexpr int kLanes = 4;
   /// An unused lane: a box no test can reach (negative half-extents far beyond any coordinate).
   static constexpr float kEmptyHalf = -1e30f;
@@ -111,14 +112,11 @@ struct alignas(16) Aabb4 {
     }
     return out;
   }
-  /// Four lanes holding one box given by centre, half-extents and mag.
-  static Aabb4 splat(const float (&center)[3], const float (&half)[3], float mag_of_box) {
-    Aabb4 out;
-    out.cx.fill(center[0]), out.cy.fill(center[1]), out.cz.fill(center[2]);
-    out.hx.fill(half[0]), out.hy.fill(half[1]), out.hz.fill(half[2]);
-    out.mag.fill(mag_of_box);
-    return out;
-  }
+  /// B's boxes placed in A's frame (place()) are Aabb4s too. A wide walk places them again when it needs
+  /// them rather than keep them: three products a lane are cheaper than the memory (kKeepsPlaced).
+  using Placed = Aabb4;
+  static constexpr bool kKeepsPlaced = false;
+  static Placed broadcast_placed(const Placed& from, int lane) { return broadcast(from, lane); }
   /// The box volume of a lane (the descent splits the larger of two nodes).
   [[nodiscard]] float volume(int lane) const { return hx[lane] * hy[lane] * hz[lane]; }
   [[nodiscard]] bool empty(int lane) const { return hx[lane] < 0; }
@@ -156,7 +154,7 @@ struct alignas(16) Aabb4 {
 
 #if BVHLAB_AABB4_SSE2
   /// B's four boxes placed in A's frame: centres R c + t, half-extents |R| h (float, the pose's context);
-  /// mag stays B's own, for the slack. A walk keeps a placed box to test it against A's children later.
+  /// mag stays B's own, for the slack.
   [[gnu::always_inline]] static Aabb4 place(const Aabb4& b, const PairContext& c) {
     const __m128 bcx = _mm_load_ps(b.cx.data()), bcy = _mm_load_ps(b.cy.data()),
                  bcz = _mm_load_ps(b.cz.data());

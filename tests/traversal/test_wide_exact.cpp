@@ -1,8 +1,9 @@
-// The exact query on wide trees (traversal/wide_exact.hpp) against CGAL's exact predicates and against the
-// binary query it stands in for, on generated meshes.
+// The exact query on wide trees (traversal/wide_exact.hpp), of boxes and of k-DOPs, against CGAL's exact
+// predicates and against the binary query it stands in for, on generated meshes.
 #include "bench/core/ground_truth.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/wide_exact.hpp"
+#include "volumes/dop24.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,23 +13,32 @@
 namespace bvhlab {
 namespace {
 
+template <class Lanes>
 struct WidePair {
-  Bvh<Aabb> a, b;
-  WideAabbTree wide_a, wide_b;
+  using BV = typename Lanes::Volume;
+  Bvh<BV> a, b;
+  WideBvh<Lanes> wide_a, wide_b;
   WidePair(const Mesh& mesh_a, const Mesh& mesh_b, const BuildOptions& options = {})
-      : a(Bvh<Aabb>::build(mesh_a, options)),
-        b(Bvh<Aabb>::build(mesh_b, options)),
-        wide_a(WideAabbTree::build(a)),
-        wide_b(WideAabbTree::build(b)) {}
+      : a(Bvh<BV>::build(mesh_a, options)),
+        b(Bvh<BV>::build(mesh_b, options)),
+        wide_a(WideBvh<Lanes>::build(a)),
+        wide_b(WideBvh<Lanes>::build(b)) {}
   Result query(const RigidTransform& pose, ContactMode mode = ContactMode::First) const {
     return query_exact_wide(a, wide_a, b, wide_b, pose, mode);
   }
 };
 
-TEST(WideExact, FirstContactMatchesCgalOnRandomPoses) {
+// Every layout of four lanes: boxes, and the k-DOPs from the fewest axes to the most.
+using LaneTypes = ::testing::Types<Aabb4, KDop4<dop_sets::Dop6>, KDop4<dop_sets::Dop14>, KDop4<dop_sets::Dop18>,
+                                   KDop4<dop_sets::Zachmann24>, KDop4<dop_sets::Dop26>>;
+template <class Lanes>
+class WideExact : public ::testing::Test {};
+TYPED_TEST_SUITE(WideExact, LaneTypes);
+
+TYPED_TEST(WideExact, FirstContactMatchesCgalOnRandomPoses) {
   const Mesh a = testing::make_torus(0.7, 0.25, 40, 20);
   const Mesh b = testing::make_random_soup(600, 0.08, 11);
-  const WidePair trees(a, b);
+  const WidePair<TypeParam> trees(a, b);
   const CgalGroundTruth truth(a, b);
   std::mt19937_64 rng(5);
   int colliding = 0;
@@ -47,12 +57,12 @@ TEST(WideExact, FirstContactMatchesCgalOnRandomPoses) {
   EXPECT_LT(colliding, 270);
 }
 
-TEST(WideExact, AllContactsEqualCgalEnumeration) {
+TYPED_TEST(WideExact, AllContactsEqualCgalEnumeration) {
   const Mesh a = testing::make_torus(0.7, 0.25, 24, 12);
   const Mesh b = testing::make_torus(0.6, 0.2, 20, 10);
   BuildOptions small_leaves;
   small_leaves.max_leaf_triangles = 3;
-  const WidePair trees(a, b, small_leaves);
+  const WidePair<TypeParam> trees(a, b, small_leaves);
   const CgalGroundTruth truth(a, b);
   std::mt19937_64 rng(9);
   std::size_t total = 0;
@@ -70,9 +80,9 @@ TEST(WideExact, AllContactsEqualCgalEnumeration) {
 
 // The wide walk takes fewer pairs off its stack than the binary one (a step settles four children) for about
 // as many box tests.
-TEST(WideExact, VisitsFewerPairsThanTheBinaryWalk) {
+TYPED_TEST(WideExact, VisitsFewerPairsThanTheBinaryWalk) {
   const Mesh a = testing::make_torus(0.7, 0.25, 40, 20);
-  const WidePair trees(a, a);
+  const WidePair<TypeParam> trees(a, a);
   std::mt19937_64 rng(17);
   Counters wide, binary;
   for (int k = 0; k < 200; ++k) {
@@ -93,12 +103,12 @@ TEST(WideExact, VisitsFewerPairsThanTheBinaryWalk) {
 // the same ratio of BV tests as at the origin (in float about the origin the slack alone would be several
 // units there, and every box would overlap). Both walks do more work there than at the origin: the binary
 // tree's float boxes are rounded outwards by 1/16 at 1e6.
-TEST(WideExact, FarFromTheOriginKeepsItsPruning) {
+TYPED_TEST(WideExact, FarFromTheOriginKeepsItsPruning) {
   Mesh near_mesh = testing::make_torus(0.7, 0.25, 40, 20);
   Mesh far_mesh = near_mesh;
   const Vec3 far = Vec3::Constant(1e6);
   for (Vec3& v : far_mesh.vertices) v += far;
-  const WidePair near_trees(near_mesh, near_mesh), far_trees(far_mesh, far_mesh);
+  const WidePair<TypeParam> near_trees(near_mesh, near_mesh), far_trees(far_mesh, far_mesh);
   std::mt19937_64 rng(23);
   Counters near_work, far_work, near_binary, far_binary;
   for (int k = 0; k < 100; ++k) {
@@ -118,18 +128,18 @@ TEST(WideExact, FarFromTheOriginKeepsItsPruning) {
   EXPECT_LT(far_ratio, 1.2 * near_ratio) << near_ratio;
 }
 
-TEST(WideExact, EmptyAndSingleLeafTrees) {
+TYPED_TEST(WideExact, EmptyAndSingleLeafTrees) {
   const Mesh one = testing::make_random_soup(1, 0.3, 3);
-  const WidePair trees(one, one);
+  const WidePair<TypeParam> trees(one, one);
   EXPECT_TRUE(trees.query(RigidTransform::identity()).collides);
   EXPECT_FALSE(trees.query(RigidTransform::translate({2, 0, 0})).collides);
-  EXPECT_THROW(WideAabbTree::build(Bvh<Aabb>{}), std::invalid_argument);
+  EXPECT_THROW(WideBvh<TypeParam>::build(Bvh<typename TypeParam::Volume>{}), std::invalid_argument);
 }
 
-TEST(WideExact, RefusesWideTreesOfOtherTreesAndNonRigidPoses) {
+TYPED_TEST(WideExact, RefusesWideTreesOfOtherTreesAndNonRigidPoses) {
   const Mesh a = testing::make_torus(0.7, 0.25, 12, 8);
-  const WidePair trees(a, a);
-  const auto other = Bvh<Aabb>::build(a);
+  const WidePair<TypeParam> trees(a, a);
+  const auto other = Bvh<typename TypeParam::Volume>::build(a);
   const auto expect_message = [](const auto& call, const std::string& part) {
     try {
       call();
