@@ -29,8 +29,9 @@ struct WidePair {
 };
 
 // Every layout of four lanes: boxes, and the k-DOPs from the fewest axes to the most.
-using LaneTypes = ::testing::Types<Aabb4, KDop4<dop_sets::Dop6>, KDop4<dop_sets::Dop14>, KDop4<dop_sets::Dop18>,
-                                   KDop4<dop_sets::Zachmann24>, KDop4<dop_sets::Dop26>>;
+using LaneTypes =
+    ::testing::Types<Aabb4, KDop4<dop_sets::Dop6>, KDop4<dop_sets::Dop14>, KDop4<dop_sets::Dop18>,
+                     KDop4<dop_sets::Zachmann24>, KDop4<dop_sets::Dop26>>;
 template <class Lanes>
 class WideExact : public ::testing::Test {};
 TYPED_TEST_SUITE(WideExact, LaneTypes);

@@ -98,7 +98,8 @@ TYPED_TEST(KDop4Test, PairsAtTheDoubleTestsEdgeStayOverlappingFarFromTheOrigin) 
     ASSERT_TRUE(TypeParam::overlap(la, lb, TypeParam::make_context(pose, origin_a, origin_b)) & 1u)
         << "round " << round;
     pose.translation.x() = inside + 1e-3;
-    apart_outside += (TypeParam::overlap(la, lb, TypeParam::make_context(pose, origin_a, origin_b)) & 1u) == 0;
+    apart_outside +=
+        (TypeParam::overlap(la, lb, TypeParam::make_context(pose, origin_a, origin_b)) & 1u) == 0;
   }
   EXPECT_GT(apart_outside, 280);
 }
