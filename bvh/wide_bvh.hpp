@@ -1,7 +1,7 @@
 // Wide trees: a binary tree's topology collapsed to four children a node (after Embree: the topology first,
 // then a node layout for it), and the layout of the volumes for it, four children's volumes side by side
-// (volumes/aabb4.hpp, volumes/kdop4.hpp, volumes/sphere4.hpp), so that one node's children are tested against
-// a volume of the other tree at once.
+// (volumes/aabb4.hpp, volumes/kdop4.hpp, volumes/sphere4.hpp, volumes/obb4.hpp), so that one node's children
+// are tested against a volume of the other tree at once.
 //
 // A wide tree is built from a binary Bvh and refers to it for the leaves: a child that is a leaf names the
 // binary leaf, whose triangles the binary tree holds. The queries take both trees and refuse a wide tree
@@ -10,6 +10,7 @@
 
 #include "../volumes/aabb4.hpp"
 #include "../volumes/kdop4.hpp"
+#include "../volumes/obb4.hpp"
 #include "../volumes/sphere4.hpp"
 #include "bvh.hpp"
 
@@ -51,10 +52,11 @@ WideTopology collapse_topology(std::span<const TreeNode> nodes, std::span<const 
 /// lane 0, so every volume the walk needs sits in some node's lane: a walk starts at (0, lane 0). Lanes are
 /// stored relative to origin(), the centre of the root's bounding box.
 ///
-/// (Aabb4 for boxes, KDop4 for k-DOPs, Sphere4 for spheres.) Lanes provides: `Volume` (the binary tree's
-/// volume type), `set(lane, volume, origin)` (a default Lanes is four empty lanes), `volume(lane)` (its
-/// bounding box's volume, for the descent), and the test used by traversal/wide_exact.hpp: `PairContext`,
-/// `make_context(pose, origin_a, origin_b)`, `broadcast`, `place`, `overlap_placed`.
+/// (Aabb4 for boxes, KDop4 for k-DOPs, Sphere4 for spheres, Obb4 for oriented boxes.) Lanes provides:
+/// `Volume` (the binary tree's volume type), `set(lane, volume, origin)` (a default Lanes is four empty
+/// lanes), `volume(lane)` (its bounding box's volume, for the descent), and the test used by
+/// traversal/wide_exact.hpp: `PairContext`, `make_context(pose, origin_a, origin_b)`, `broadcast`, `place`,
+/// `overlap_placed`.
 template <class Lanes>
 class WideBvh {
  public:
@@ -112,8 +114,8 @@ template <class Set>
 using WideDopTree = WideBvh<KDop4<Set>>;
 
 /// The four-lane layout of a binary tree's volume, where it has one: WideLanes<Aabb>::type is Aabb4,
-/// WideLanes<KDop<Set>>::type KDop4<Set>, WideLanes<Sphere>::type Sphere4. `HasWideLayout<BV>` says whether a
-/// volume has one.
+/// WideLanes<KDop<Set>>::type KDop4<Set>, WideLanes<Sphere>::type Sphere4, WideLanes<Obb>::type Obb4.
+/// `HasWideLayout<BV>` says whether a volume has one.
 template <class BV>
 struct WideLanes {};
 template <>
@@ -127,6 +129,10 @@ struct WideLanes<KDop<Set>> {
 template <>
 struct WideLanes<Sphere> {
   using type = Sphere4;
+};
+template <>
+struct WideLanes<Obb> {
+  using type = Obb4;
 };
 template <class BV>
 concept HasWideLayout = requires {

@@ -1,5 +1,5 @@
-// The exact query on wide trees (traversal/wide_exact.hpp), of boxes, spheres and k-DOPs, against CGAL's
-// exact predicates and against the binary query it stands in for, on generated meshes.
+// The exact query on wide trees (traversal/wide_exact.hpp), of boxes, spheres, oriented boxes and k-DOPs,
+// against CGAL's exact predicates and against the binary query it stands in for, on generated meshes.
 #include "bench/core/ground_truth.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/wide_exact.hpp"
@@ -28,10 +28,11 @@ struct WidePair {
   }
 };
 
-// Every layout of four lanes: boxes, spheres, and the k-DOPs from the fewest axes to the most.
+// Every layout of four lanes: boxes, spheres, oriented boxes, and the k-DOPs from the fewest axes to the
+// most.
 using LaneTypes =
-    ::testing::Types<Aabb4, Sphere4, KDop4<dop_sets::Dop6>, KDop4<dop_sets::Dop14>, KDop4<dop_sets::Dop18>,
-                     KDop4<dop_sets::Zachmann24>, KDop4<dop_sets::Dop26>>;
+    ::testing::Types<Aabb4, Sphere4, Obb4, KDop4<dop_sets::Dop6>, KDop4<dop_sets::Dop14>,
+                     KDop4<dop_sets::Dop18>, KDop4<dop_sets::Zachmann24>, KDop4<dop_sets::Dop26>>;
 template <class Lanes>
 class WideExact : public ::testing::Test {};
 TYPED_TEST_SUITE(WideExact, LaneTypes);

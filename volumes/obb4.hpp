@@ -1,0 +1,270 @@
+// Four oriented boxes side by side (structure of arrays: each axis entry, centre coordinate and half-extent
+// for four lanes together, in float), tested against four others in one pass of the vector unit: the
+// children of a wide node (bvh/wide_bvh.hpp) against one box of the other tree, broadcast. The test is the
+// OBB's 15-axis separating-axis test (obb.hpp) on four lanes; one template computes it for the vector unit
+// and, lane by lane, for the scalar reference, in the same order. Centres are stored relative to an origin.
+#pragma once
+
+#include "obb.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#if defined(__SSE2__) && !defined(BVHLAB_OBB4_SCALAR)
+#define BVHLAB_OBB4_SSE2 1
+#include <emmintrin.h>
+#else
+#define BVHLAB_OBB4_SSE2 0
+#endif
+
+namespace bvhlab {
+
+namespace obb4_detail {
+#if BVHLAB_OBB4_SSE2
+/// Four floats in the vector unit, with the few operations the test needs.
+struct F4 {
+  __m128 v;
+};
+inline F4 operator+(F4 a, F4 b) {
+  return {_mm_add_ps(a.v, b.v)};
+}
+inline F4 operator-(F4 a, F4 b) {
+  return {_mm_sub_ps(a.v, b.v)};
+}
+inline F4 operator*(F4 a, F4 b) {
+  return {_mm_mul_ps(a.v, b.v)};
+}
+inline F4 abs(F4 a) {
+  return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)};
+}
+inline F4 max(F4 a, F4 b) {
+  return {_mm_max_ps(a.v, b.v)};
+}
+#endif
+inline float abs(float a) {
+  return std::abs(a);
+}
+inline float max(float a, float b) {
+  return a > b ? a : b;
+}
+}  // namespace obb4_detail
+
+struct alignas(16) Obb4 {
+  using Volume = Obb;
+  static constexpr int kLanes = 4;
+  static constexpr float kEmptyHalf = -1e30f;
+  using Row = std::array<float, 4>;
+
+  /// Entry (k, i) of the frame (axis i's k-th coordinate) at axes[3 k + i]; centre relative to the origin.
+  std::array<Row, 9> axes{};
+  std::array<Row, 3> center{};
+  std::array<Row, 3> half = {Row{kEmptyHalf, kEmptyHalf, kEmptyHalf, kEmptyHalf},
+                             Row{kEmptyHalf, kEmptyHalf, kEmptyHalf, kEmptyHalf},
+                             Row{kEmptyHalf, kEmptyHalf, kEmptyHalf, kEmptyHalf}};
+  Row mag{};  ///< per lane, max |centre| + the sum of the half-extents: the slack's scale
+
+  struct PairContext {
+    std::array<float, 9> rotation;  // row-major, rounded to nearest
+    std::array<float, 3> translation;
+    float translation_magnitude;
+  };
+
+  /// Rounding bound, relative to M = mag_a + mag_b + |t| (u = 2^-24): the frames' and the pose's rounding to
+  /// float moves every projection by a few u of the half-extents; B's axes in A's box frame (m = A^T R B)
+  /// round by about 10u a unit entry, covered by widening |m| by kWidenM; B's centre in A's box frame by
+  /// about 20u M; the face gaps of B and the edge gaps combine the centre with m, up to about 60u M. The
+  /// slack 64 FLT_EPSILON M = 128u M is twice that.
+  static constexpr float kSlackFactor = 64 * std::numeric_limits<float>::epsilon();
+  static constexpr float kWidenM = 32 * std::numeric_limits<float>::epsilon();
+
+  /// As Aabb4::make_context: the two origins folded into the translation in double.
+  static PairContext make_context(const RigidTransform& pose, const Vec3& origin_a = Vec3::Zero(),
+                                  const Vec3& origin_b = Vec3::Zero()) {
+    PairContext c{};
+    const Vec3 moved_origin = pose.rotation * origin_b;
+    const Vec3 shift = moved_origin + pose.translation - origin_a;
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 3; ++k) c.rotation[3 * r + k] = static_cast<float>(pose.rotation(r, k));
+      c.translation[r] = static_cast<float>(shift[r]);
+    }
+    const double terms = moved_origin.cwiseAbs().maxCoeff() + pose.translation.cwiseAbs().maxCoeff() +
+                         origin_a.cwiseAbs().maxCoeff();
+    c.translation_magnitude = widened(static_cast<float>(shift.cwiseAbs().maxCoeff() + 1e-8 * terms));
+    return c;
+  }
+  /// A float above x's real value (x rounded once): see Aabb4::widened.
+  static float widened(float x) { return x * (1 + 1.0f / (1 << 20)); }
+
+  /// Lane `lane` holds `box` (not empty) less `origin`: its frame (axes_of, as the double test uses it) and
+  /// centre rounded to nearest, the half-extents grown by the centre's move and rounded up.
+  void set(int lane, const Obb& box, const Vec3& origin = Vec3::Zero()) {
+    const Mat3 frame = Obb::axes_of(box.orientation);
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) axes[3 * k + i][lane] = static_cast<float>(frame(k, i));
+    const Vec3 exact = to_vec(box.center) - origin;
+    double moved = 0, largest = 0, sum = 0;
+    for (int k = 0; k < 3; ++k) {
+      center[k][lane] = rounded_to_float(exact[k]);
+      moved += std::abs(exact[k] - center[k][lane]);
+      largest = std::max(largest, std::abs(double(center[k][lane])));
+    }
+    const double rounding = 8 * std::numeric_limits<double>::epsilon() *
+                            (to_vec(box.center).cwiseAbs().sum() + origin.cwiseAbs().sum());
+    for (int k = 0; k < 3; ++k) {
+      half[k][lane] = float_up(double(box.half[k]) + moved + rounding);
+      sum += half[k][lane];
+    }
+    mag[lane] = float_up(largest + sum);
+  }
+  static Obb4 broadcast(const Obb4& from, int lane) {
+    Obb4 out;
+    for (int e = 0; e < 9; ++e) out.axes[e].fill(from.axes[e][lane]);
+    for (int k = 0; k < 3; ++k)
+      out.center[k].fill(from.center[k][lane]), out.half[k].fill(from.half[k][lane]);
+    out.mag.fill(from.mag[lane]);
+    return out;
+  }
+  /// The volume of a lane's box (the descent splits the larger of two nodes).
+  [[nodiscard]] float volume(int lane) const { return half[0][lane] * half[1][lane] * half[2][lane]; }
+  [[nodiscard]] bool empty(int lane) const { return half[0][lane] < 0; }
+
+  /// B's boxes placed in A's object frame (axes R B, centres R c + t) are Obb4s too. Keeping them for later
+  /// steps (kKeepsPlaced) measured no faster than placing again (bench/RESULTS.md, "Wide trees").
+  using Placed = Obb4;
+  static constexpr bool kKeepsPlaced = false;
+  static Placed broadcast_placed(const Placed& from, int lane) { return broadcast(from, lane); }
+
+  /// Bit k set: lane k of `a` and lane k of `b` (placed by the pose) may overlap; empty lanes never do.
+  static unsigned overlap(const Obb4& a, const Obb4& b, const PairContext& c) {
+    return overlap_placed(a, place(b, c), c);
+  }
+
+  /// The reference: lane by lane in scalar float, the same template as the vector path.
+  static unsigned overlap_scalar(const Obb4& a, const Obb4& b, const PairContext& c) {
+    unsigned mask = 0;
+    for (int k = 0; k < kLanes; ++k) {
+      Lane<float> la = load_lane(a, k), lb = load_lane(b, k);
+      lb = place_lane(lb, c, [](float x) { return x; });
+      const float slack = kSlackFactor * ((a.mag[k] + b.mag[k]) + c.translation_magnitude);
+      if (!(largest_gap(la, lb, kWidenM) > slack)) mask |= 1u << k;
+    }
+    return mask;
+  }
+
+#if BVHLAB_OBB4_SSE2
+  [[gnu::always_inline]] static Placed place(const Obb4& b, const PairContext& c) {
+    const Lane<obb4_detail::F4> placed =
+        place_lane(load_vector(b), c, [](float x) { return obb4_detail::F4{_mm_set1_ps(x)}; });
+    Obb4 out;
+    for (int e = 0; e < 9; ++e) _mm_store_ps(out.axes[e].data(), placed.axes[e].v);
+    for (int k = 0; k < 3; ++k) _mm_store_ps(out.center[k].data(), placed.center[k].v);
+    out.half = b.half;
+    out.mag = b.mag;
+    return out;
+  }
+  [[gnu::always_inline]] static unsigned overlap_placed(const Obb4& a, const Placed& b,
+                                                        const PairContext& c) {
+    using obb4_detail::F4;
+    const F4 slack =
+        F4{_mm_set1_ps(kSlackFactor)} * ((F4{_mm_load_ps(a.mag.data())} + F4{_mm_load_ps(b.mag.data())}) +
+                                         F4{_mm_set1_ps(c.translation_magnitude)});
+    const F4 gap = largest_gap(load_vector(a), load_vector(b), F4{_mm_set1_ps(kWidenM)});
+    return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(gap.v, slack.v))) ^ 0xFu;
+  }
+#else
+  static Placed place(const Obb4& b, const PairContext& c) {
+    Obb4 out = b;
+    for (int k = 0; k < kLanes; ++k) {
+      const Lane<float> placed = place_lane(load_lane(b, k), c, [](float x) { return x; });
+      for (int e = 0; e < 9; ++e) out.axes[e][k] = placed.axes[e];
+      for (int r = 0; r < 3; ++r) out.center[r][k] = placed.center[r];
+    }
+    return out;
+  }
+  static unsigned overlap_placed(const Obb4& a, const Placed& b, const PairContext& c) {
+    unsigned mask = 0;
+    for (int k = 0; k < kLanes; ++k) {
+      const float slack = kSlackFactor * ((a.mag[k] + b.mag[k]) + c.translation_magnitude);
+      if (!(largest_gap(load_lane(a, k), load_lane(b, k), kWidenM) > slack)) mask |= 1u << k;
+    }
+    return mask;
+  }
+#endif
+
+ private:
+  /// One box in the lane type V (float for one lane, F4 for four).
+  template <class V>
+  struct Lane {
+    V axes[9], center[3], half[3];
+  };
+  static Lane<float> load_lane(const Obb4& b, int k) {
+    Lane<float> out;
+    for (int e = 0; e < 9; ++e) out.axes[e] = b.axes[e][k];
+    for (int r = 0; r < 3; ++r) out.center[r] = b.center[r][k], out.half[r] = b.half[r][k];
+    return out;
+  }
+#if BVHLAB_OBB4_SSE2
+  [[gnu::always_inline]] static Lane<obb4_detail::F4> load_vector(const Obb4& b) {
+    Lane<obb4_detail::F4> out;
+    for (int e = 0; e < 9; ++e) out.axes[e] = {_mm_load_ps(b.axes[e].data())};
+    for (int r = 0; r < 3; ++r)
+      out.center[r] = {_mm_load_ps(b.center[r].data())}, out.half[r] = {_mm_load_ps(b.half[r].data())};
+    return out;
+  }
+#endif
+  /// B's frame and centre moved into A's object frame: R B and R c + t (`splat` makes a V of a float).
+  template <class V, class Splat>
+  [[gnu::always_inline]] static Lane<V> place_lane(Lane<V> b, const PairContext& c, Splat splat) {
+    const float* R = c.rotation.data();
+    Lane<V> out = b;
+    for (int r = 0; r < 3; ++r) {
+      for (int i = 0; i < 3; ++i)
+        out.axes[3 * r + i] = (splat(R[3 * r]) * b.axes[i] + splat(R[3 * r + 1]) * b.axes[3 + i]) +
+                              splat(R[3 * r + 2]) * b.axes[6 + i];
+      out.center[r] = ((splat(R[3 * r]) * b.center[0] + splat(R[3 * r + 1]) * b.center[1]) +
+                       splat(R[3 * r + 2]) * b.center[2]) +
+                      splat(c.translation[r]);
+    }
+    return out;
+  }
+  /// The largest gap over the 15 axes of A's box `a` and B's placed box `b` (obb.hpp's test; > 0 where an
+  /// axis separates), |m| widened by `widen`.
+  template <class V, class W>
+  [[gnu::always_inline]] static V largest_gap(const Lane<V>& a, const Lane<V>& b, W widen_by) {
+    using obb4_detail::abs;
+    using obb4_detail::max;
+    const V widen = V(widen_by);
+    V m[3][3], am[3][3], t[3];
+    const V d[3] = {b.center[0] - a.center[0], b.center[1] - a.center[1], b.center[2] - a.center[2]};
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        m[i][j] = (a.axes[i] * b.axes[j] + a.axes[3 + i] * b.axes[3 + j]) + a.axes[6 + i] * b.axes[6 + j];
+        am[i][j] = abs(m[i][j]) + widen;
+      }
+      t[i] = (a.axes[i] * d[0] + a.axes[3 + i] * d[1]) + a.axes[6 + i] * d[2];
+    }
+    const V* ha = a.half;
+    const V* hb = b.half;
+    V gap = abs(t[0]) - ha[0] - ((am[0][0] * hb[0] + am[0][1] * hb[1]) + am[0][2] * hb[2]);
+    for (int i = 1; i < 3; ++i)
+      gap = max(gap, abs(t[i]) - ha[i] - ((am[i][0] * hb[0] + am[i][1] * hb[1]) + am[i][2] * hb[2]));
+    for (int j = 0; j < 3; ++j)
+      gap = max(gap, abs((t[0] * m[0][j] + t[1] * m[1][j]) + t[2] * m[2][j]) -
+                         ((am[0][j] * ha[0] + am[1][j] * ha[1]) + am[2][j] * ha[2]) - hb[j]);
+    for (int i = 0; i < 3; ++i) {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+      for (int j = 0; j < 3; ++j) {
+        const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+        const V distance = abs(t[i2] * m[i1][j] - t[i1] * m[i2][j]);
+        const V radius_a = ha[i1] * am[i2][j] + ha[i2] * am[i1][j];
+        const V radius_b = hb[j1] * am[i][j2] + hb[j2] * am[i][j1];
+        gap = max(gap, distance - radius_a - radius_b);
+      }
+    }
+    return gap;
+  }
+};
+
+}  // namespace bvhlab
