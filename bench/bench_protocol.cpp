@@ -59,28 +59,38 @@ void set_per_query_counters(benchmark::State& state, std::size_t queries, const 
   if (bytes_per_triangle > 0) state.counters["bytes_per_tri"] = bytes_per_triangle;
 }
 
-template <class BV>
-void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
-                     const std::vector<PoseSet>& sets) {
-  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
+/// One series per pose set: `query(pose)` answers a Result, timed over the set's poses per iteration.
+template <class Query>
+void register_series(const std::string& prefix, const std::vector<PoseSet>& sets, Query query,
+                     double bytes_per_triangle) {
   for (const auto& set : sets) {
-    const std::string name = "exact/" + mesh_name + "/" + std::string(BV::name()) + "/d:" + set.label;
-    benchmark::RegisterBenchmark(name.c_str(), [tree, &set](benchmark::State& state) {
+    const std::string name = prefix + "/d:" + set.label;
+    benchmark::RegisterBenchmark(name.c_str(), [query, bytes_per_triangle, &set](benchmark::State& state) {
       Counters pass;
       std::size_t colliding = 0;
       for (auto _ : state) {
         pass = {};
         colliding = 0;
         for (const auto& pose : set.poses) {
-          const Result r = query_exact(*tree, *tree, pose);
+          const Result r = query(pose);
           pass += r.counters;
           colliding += r.collides;
         }
         benchmark::DoNotOptimize(colliding);
       }
-      set_per_query_counters(state, set.poses.size(), pass, colliding, tree->stats().bytes_per_triangle);
+      set_per_query_counters(state, set.poses.size(), pass, colliding, bytes_per_triangle);
     })->Unit(benchmark::kMillisecond);
   }
+}
+
+template <class BV>
+void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
+                     const std::vector<PoseSet>& sets) {
+  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
+  register_series(
+      "exact/" + mesh_name + "/" + std::string(BV::name()), sets,
+      [tree](const RigidTransform& pose) { return query_exact(*tree, *tree, pose); },
+      tree->stats().bytes_per_triangle);
 }
 
 /// A tree's wide form (traversal/wide_exact.hpp) as the series "<volume>_wide"; its bytes per triangle
@@ -91,27 +101,10 @@ void register_wide(const std::string& mesh_name, const std::shared_ptr<const Mes
   auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
   auto wide = std::make_shared<const WideTreeOf<BV>>(WideTreeOf<BV>::build(*tree));
   const BvhStats stats = tree->stats();
-  const double bytes_per_triangle =
-      double(stats.nodes * stats.bytes_per_node + wide->bytes()) / double(stats.triangles);
-  for (const auto& set : sets) {
-    const std::string name = "exact/" + mesh_name + "/" + std::string(BV::name()) + "_wide/d:" + set.label;
-    benchmark::RegisterBenchmark(name.c_str(), [tree, wide, bytes_per_triangle,
-                                                &set](benchmark::State& state) {
-      Counters pass;
-      std::size_t colliding = 0;
-      for (auto _ : state) {
-        pass = {};
-        colliding = 0;
-        for (const auto& pose : set.poses) {
-          const Result r = query_exact_wide(*tree, *wide, *tree, *wide, pose);
-          pass += r.counters;
-          colliding += r.collides;
-        }
-        benchmark::DoNotOptimize(colliding);
-      }
-      set_per_query_counters(state, set.poses.size(), pass, colliding, bytes_per_triangle);
-    })->Unit(benchmark::kMillisecond);
-  }
+  register_series(
+      "exact/" + mesh_name + "/" + std::string(BV::name()) + "_wide", sets,
+      [tree, wide](const RigidTransform& pose) { return query_exact_wide(*tree, *wide, *tree, *wide, pose); },
+      double(stats.nodes * stats.bytes_per_node + wide->bytes()) / double(stats.triangles));
 }
 
 #ifdef BVHLAB_HAVE_FCL

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "aabb.hpp"
+#include "float_pose.hpp"
 
 #include <array>
 #include <bit>
@@ -34,13 +35,10 @@ struct alignas(16) Aabb4 {
   std::array<float, 4> hz{kEmptyHalf, kEmptyHalf, kEmptyHalf, kEmptyHalf};
   std::array<float, 4> mag{};
 
-  /// The pose B -> A in float: R rounded to nearest, |R| rounded and widened so that it is >= the exact |R|,
-  /// t rounded to nearest, and the slack's factor.
-  struct PairContext {
-    std::array<float, 9> rotation;      // row-major
-    std::array<float, 9> abs_rotation;  // row-major, >= |R| entrywise
-    std::array<float, 3> translation;
-    float translation_magnitude;  // >= max |t_i|
+  /// The pose in float (FloatPose: R, t' = R o_b + t - o_a, a bound on |t'|) and |R| rounded and widened so
+  /// that it is >= the exact |R| entrywise.
+  struct PairContext : FloatPose {
+    std::array<float, 9> abs_rotation;  // row-major
   };
 
   /// Rounding bound of the float test, relative to the magnitudes it combines: B's centre moved by R_f and
@@ -51,34 +49,13 @@ struct alignas(16) Aabb4 {
   static constexpr float kSlackFactor = 16 * std::numeric_limits<float>::epsilon();
 
   /// The context for lanes stored relative to origins (set() with `origin`): A's lanes around origin_a, B's
-  /// around origin_b. The pose then moves B's lanes by R and t' = R o_b + t - o_a (in double, then rounded):
-  /// near objects keep small numbers wherever they lie. The double rounding of t' (a few DBL_EPSILON of the
-  /// terms) is folded into the slack through translation_magnitude.
+  /// around origin_b (float_pose.hpp).
   static PairContext make_context(const RigidTransform& pose, const Vec3& origin_a = Vec3::Zero(),
                                   const Vec3& origin_b = Vec3::Zero()) {
-    PairContext c{};
-    const Vec3 moved_origin = pose.rotation * origin_b;
-    const Vec3 shift = moved_origin + pose.translation - origin_a;
-    for (int r = 0; r < 3; ++r) {
-      for (int k = 0; k < 3; ++k) {
-        const float f = static_cast<float>(pose.rotation(r, k));
-        c.rotation[3 * r + k] = f;
-        c.abs_rotation[3 * r + k] = widened(std::abs(f));
-      }
-      c.translation[r] = static_cast<float>(shift[r]);
-    }
-    // 1e-8 of the terms, times the slack factor 16 FLT_EPSILON, is far above t's double rounding error.
-    const double terms = moved_origin.cwiseAbs().maxCoeff() + pose.translation.cwiseAbs().maxCoeff() +
-                         origin_a.cwiseAbs().maxCoeff();
-    c.translation_magnitude = widened(static_cast<float>(shift.cwiseAbs().maxCoeff() + 1e-8 * terms));
+    PairContext c{FloatPose::of(pose, origin_a, origin_b), {}};
+    for (int e = 0; e < 9; ++e) c.abs_rotation[e] = widened(std::abs(c.rotation[e]));
     return c;
   }
-
-  /// A float above x's real value: x is within u = 2^-24 of it (rounded once), and x (1 + 2^-20), rounded,
-  /// is at least x (1 + 2^-21). Arithmetic instead of nextafter: a context is made per query. Where the
-  /// value underflowed to 0 (below 1e-38), what it leaves out is far inside the slack's 2 mag terms; adding
-  /// FLT_MIN instead made products with half-extents subnormal, and the test 10% slower.
-  static float widened(float x) { return x * (1 + 1.0f / (1 << 20)); }
 
   /// Lane `lane` holds `box` (a non-empty Aabb) less `origin`: centre rounded to nearest, half-extents
   /// rounded up, with a margin for the double subtraction, so that the lane's box contains the stored one.

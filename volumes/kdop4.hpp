@@ -6,6 +6,7 @@
 // stays conservative. Offsets are stored relative to an origin (the wide tree's root box centre).
 #pragma once
 
+#include "float_pose.hpp"
 #include "kdop.hpp"
 
 #include <algorithm>
@@ -59,10 +60,8 @@ struct alignas(16) KDop4 {
   /// re-alignment for the pose with translation t' = R o_b + t - o_a (in double), rounded to float.
   static PairContext make_context(const RigidTransform& pose, const Vec3& origin_a = Vec3::Zero(),
                                   const Vec3& origin_b = Vec3::Zero()) {
-    RigidTransform shifted = pose;
-    const Vec3 moved_origin = pose.rotation * origin_b;
-    shifted.translation = moved_origin + pose.translation - origin_a;
-    const typename Volume::PairContext exact = Volume::make_context(shifted);
+    const ShiftedPose shifted = ShiftedPose::of(pose, origin_a, origin_b);
+    const typename Volume::PairContext exact = Volume::make_context(shifted.pose);
     PairContext c{};
     double coefficient_sum = 0, largest_shift = 0;
     for (std::size_t a = 0; a < kAxes; ++a) {
@@ -78,15 +77,10 @@ struct alignas(16) KDop4 {
       coefficient_sum = std::max(coefficient_sum, sum);
       largest_shift = std::max(largest_shift, std::abs(exact.shift(a)));
     }
-    // 1e-8 of t's terms, times the slack factor, is far above the double rounding of t' and n . t'.
-    const double terms = moved_origin.cwiseAbs().maxCoeff() + pose.translation.cwiseAbs().maxCoeff() +
-                         origin_a.cwiseAbs().maxCoeff();
     c.coefficient_sum = widened(static_cast<float>(coefficient_sum));
-    c.translation_magnitude = widened(static_cast<float>(largest_shift + 1e-8 * terms));
+    c.translation_magnitude = shifted.magnitude(largest_shift);
     return c;
   }
-  /// A float above x's real value (x rounded once): see Aabb4::widened.
-  static float widened(float x) { return x * (1 + 1.0f / (1 << 20)); }
 
   /// Lane `lane` holds `dop` (not empty) less `origin`: offset m becomes d_m - n_m . origin, rounded up with
   /// a margin for the double arithmetic, so that the lane's DOP contains the stored one.
@@ -139,7 +133,7 @@ struct alignas(16) KDop4 {
 
   /// Bit k set: lane k of `a` (A's frame) and lane k of `b` (B's, placed by the pose) may overlap. Lanes of
   /// an empty DOP never do. place() then overlap_placed(), in the vector unit where there is SSE2: the float
-  /// operations of overlap_scalar in the same order, so both answer alike (tests/volumes/test_kdop4.cpp).
+  /// operations of overlap_scalar in the same order, so both answer alike (tests/volumes/test_lanes.cpp).
   static unsigned overlap(const KDop4& a, const KDop4& b, const PairContext& c) {
     return overlap_placed(a, place(b, c), c);
   }

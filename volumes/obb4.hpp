@@ -5,6 +5,7 @@
 // and, lane by lane, for the scalar reference, in the same order. Centres are stored relative to an origin.
 #pragma once
 
+#include "float_pose.hpp"
 #include "obb.hpp"
 
 #include <algorithm>
@@ -65,11 +66,7 @@ struct alignas(16) Obb4 {
                              Row{kEmptyHalf, kEmptyHalf, kEmptyHalf, kEmptyHalf}};
   Row mag{};  ///< per lane, max |centre| + the sum of the half-extents: the slack's scale
 
-  struct PairContext {
-    std::array<float, 9> rotation;  // row-major, rounded to nearest
-    std::array<float, 3> translation;
-    float translation_magnitude;
-  };
+  using PairContext = FloatPose;
 
   /// Rounding bound, relative to M = mag_a + mag_b + |t| (u = 2^-24): the frames' and the pose's rounding to
   /// float moves every projection by a few u of the half-extents; B's axes in A's box frame (m = A^T R B)
@@ -79,23 +76,11 @@ struct alignas(16) Obb4 {
   static constexpr float kSlackFactor = 64 * std::numeric_limits<float>::epsilon();
   static constexpr float kWidenM = 32 * std::numeric_limits<float>::epsilon();
 
-  /// As Aabb4::make_context: the two origins folded into the translation in double.
+  /// The pose for lanes stored relative to origin_a (A's) and origin_b (B's): float_pose.hpp.
   static PairContext make_context(const RigidTransform& pose, const Vec3& origin_a = Vec3::Zero(),
                                   const Vec3& origin_b = Vec3::Zero()) {
-    PairContext c{};
-    const Vec3 moved_origin = pose.rotation * origin_b;
-    const Vec3 shift = moved_origin + pose.translation - origin_a;
-    for (int r = 0; r < 3; ++r) {
-      for (int k = 0; k < 3; ++k) c.rotation[3 * r + k] = static_cast<float>(pose.rotation(r, k));
-      c.translation[r] = static_cast<float>(shift[r]);
-    }
-    const double terms = moved_origin.cwiseAbs().maxCoeff() + pose.translation.cwiseAbs().maxCoeff() +
-                         origin_a.cwiseAbs().maxCoeff();
-    c.translation_magnitude = widened(static_cast<float>(shift.cwiseAbs().maxCoeff() + 1e-8 * terms));
-    return c;
+    return FloatPose::of(pose, origin_a, origin_b);
   }
-  /// A float above x's real value (x rounded once): see Aabb4::widened.
-  static float widened(float x) { return x * (1 + 1.0f / (1 << 20)); }
 
   /// Lane `lane` holds `box` (not empty) less `origin`: its frame (axes_of, as the double test uses it) and
   /// centre rounded to nearest, the half-extents grown by the centre's move and rounded up.

@@ -4,6 +4,7 @@
 // origin; the slack covers the float rounding (below), so the test stays conservative.
 #pragma once
 
+#include "float_pose.hpp"
 #include "sphere.hpp"
 
 #include <algorithm>
@@ -30,11 +31,7 @@ struct alignas(16) Sphere4 {
   std::array<float, 4> radius{kEmptyRadius, kEmptyRadius, kEmptyRadius, kEmptyRadius};
   std::array<float, 4> mag{};  ///< per lane, max |centre| + radius: the slack's scale
 
-  struct PairContext {
-    std::array<float, 9> rotation;  // row-major, rounded to nearest
-    std::array<float, 3> translation;
-    float translation_magnitude;
-  };
+  using PairContext = FloatPose;
 
   /// Rounding bound: the centre offset R c_b + t' - c_a rounds per coordinate as the AABB's centre does
   /// (Aabb4: under 14u max|c_b| + 8u |t| + 3u max|c_a|, u = 2^-24), its length at most sqrt(3) times that,
@@ -42,23 +39,11 @@ struct alignas(16) Sphere4 {
   /// 16 FLT_EPSILON (|t| + 2 mag_a + 2 mag_b) = 32u (...) covers all of it with room to spare.
   static constexpr float kSlackFactor = 16 * std::numeric_limits<float>::epsilon();
 
-  /// As Aabb4::make_context: the two origins folded into the translation in double.
+  /// The pose for lanes stored relative to origin_a (A's) and origin_b (B's): float_pose.hpp.
   static PairContext make_context(const RigidTransform& pose, const Vec3& origin_a = Vec3::Zero(),
                                   const Vec3& origin_b = Vec3::Zero()) {
-    PairContext c{};
-    const Vec3 moved_origin = pose.rotation * origin_b;
-    const Vec3 shift = moved_origin + pose.translation - origin_a;
-    for (int r = 0; r < 3; ++r) {
-      for (int k = 0; k < 3; ++k) c.rotation[3 * r + k] = static_cast<float>(pose.rotation(r, k));
-      c.translation[r] = static_cast<float>(shift[r]);
-    }
-    const double terms = moved_origin.cwiseAbs().maxCoeff() + pose.translation.cwiseAbs().maxCoeff() +
-                         origin_a.cwiseAbs().maxCoeff();
-    c.translation_magnitude = widened(static_cast<float>(shift.cwiseAbs().maxCoeff() + 1e-8 * terms));
-    return c;
+    return FloatPose::of(pose, origin_a, origin_b);
   }
-  /// A float above x's real value (x rounded once): see Aabb4::widened.
-  static float widened(float x) { return x * (1 + 1.0f / (1 << 20)); }
 
   /// Lane `lane` holds `sphere` (not empty) less `origin`: the centre rounded to nearest, the radius grown by
   /// the centre's move and rounded up, so that the lane's sphere contains the stored one.

@@ -1,6 +1,7 @@
 // Four boxes a test (volumes/aabb4.hpp): the vector path answers as the scalar reference, lane by lane, and
 // both are conservative: a lane reported apart is apart in exact arithmetic, also for pairs bisected to
 // touching within rounding and far from the origin.
+#include "support/generated_meshes.hpp"
 #include "support/random_draws.hpp"
 #include "volumes/aabb4.hpp"
 
@@ -34,15 +35,6 @@ Aabb random_box(std::mt19937_64& rng, double offset, double size) {
   return Aabb::from_box({c - h, c + h});
 }
 
-RigidTransform random_pose(std::mt19937_64& rng, double reach) {
-  std::normal_distribution<double> normal;
-  std::uniform_real_distribution<double> unit(-reach, reach);
-  RigidTransform pose;
-  pose.rotation = testing::draw_quaternion(normal, rng).normalized().toRotationMatrix();
-  pose.translation = testing::draw_vec3(unit, rng);
-  return pose;
-}
-
 // B's box placed on A's (centres together), then moved along A's x axis until the placed boxes just touch
 // (bisected in exact arithmetic), then `beyond` further out: a pair at the edge of the test's slack.
 RigidTransform touching_pose(const Aabb& a, const Aabb& b, RigidTransform pose, double beyond) {
@@ -69,7 +61,7 @@ TEST_P(Aabb4Test, VectorPathAnswersAsTheScalarReference) {
     for (int k = 0; k < 4; ++k) a.set(k, random_box(rng, GetParam(), 0.6)), b.set(k, random_box(rng, 0, 0.6));
     if (round % 7 == 0) a.clear(round % 4);
     if (round % 5 == 0) b.clear((round + 1) % 4);
-    RigidTransform pose = random_pose(rng, 1.2);  // B's boxes brought near A's
+    RigidTransform pose = testing::random_pose(rng, 1.2);  // B's boxes brought near A's
     pose.translation += Vec3::Constant(GetParam());
     const auto context = Aabb4::make_context(pose);
     const unsigned mask = Aabb4::overlap(a, b, context);
@@ -98,7 +90,7 @@ TEST_P(Aabb4Test, TouchingPairsStayOverlapping) {
   int said_apart_just_outside = 0;
   for (int round = 0; round < 500; ++round) {
     const Aabb a = random_box(rng, GetParam(), 0.5), b = random_box(rng, 0, 0.5);
-    const RigidTransform start = random_pose(rng, 0);
+    const RigidTransform start = testing::random_pose(rng, 0);
     Aabb4 la, lb;
     la.set(0, a), lb.set(0, b);
     // Just inside (touching to rounding): the lane test must say overlap.
