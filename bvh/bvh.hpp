@@ -165,6 +165,10 @@ class Bvh {
   /// bound to (traversal/coherent_state.hpp): its stored node pairs mean something only in the topology they
   /// came from, and a new tree may be given the address of one that is gone.
   [[nodiscard]] std::uint64_t identity() const { return identity_; }
+  /// Names this tree's volumes within the process: a new number whenever they are (re)computed (a build, a
+  /// load, every refit), kept by copies. What a structure derived from the volumes is bound to (a wide
+  /// tree, bvh/wide_bvh.hpp), where identity() would survive a refit that moved them.
+  [[nodiscard]] std::uint64_t volumes_revision() const { return volumes_revision_; }
   [[nodiscard]] const std::vector<BV>& volumes() const { return volumes_; }
   [[nodiscard]] const TreeNode& node(std::uint32_t i) const { return nodes_[i]; }
   [[nodiscard]] const BV& volume(std::uint32_t i) const { return volumes_[i]; }
@@ -295,6 +299,7 @@ class Bvh {
 
   // The volumes' derived data: each node's box volume (sizes_) and, for an UnpackedVolume, its unpacked form.
   void derive_from_volumes() {
+    volumes_revision_ = bvh_detail::next_identity();
     if constexpr (UnpackedVolume<BV>) {
       unpacked_.clear();
       unpacked_.reserve(volumes_.size());
@@ -411,6 +416,7 @@ class Bvh {
   std::uint64_t topology_ = 0;    ///< topology_fingerprint of the source mesh; 0 for a tree from saved parts
   std::size_t vertex_count_ = 0;  ///< of the source mesh; 0 for a tree from saved parts
   std::uint64_t identity_ = 0;    ///< identity()
+  std::uint64_t volumes_revision_ = 0;  ///< volumes_revision()
   double built_spread_ = 0;
 };
 

@@ -5,7 +5,8 @@
 //
 // A wide tree is built from a binary Bvh and refers to it for the leaves: a child that is a leaf names the
 // binary leaf, whose triangles the binary tree holds. The queries take both trees and refuse a wide tree
-// built from another binary one (binary_identity()).
+// built from another binary one (binary_identity()), or from this one before a refit moved its volumes
+// (binary_revision()): build the wide tree again after a refit.
 #pragma once
 
 #include "../volumes/aabb4.hpp"
@@ -78,6 +79,7 @@ class WideBvh {
     const WideTopology topology = collapse_topology(tree.nodes(), sizes);
     WideBvh out;
     out.binary_identity_ = tree.identity();
+    out.binary_revision_ = tree.volumes_revision();
     out.origin_ = tree.volume(0).bounding_box().center();
     // Node 0: the root's own volume in lane 0; the wide nodes follow, shifted by one.
     out.nodes_.resize(topology.nodes.size() + 1);
@@ -98,6 +100,9 @@ class WideBvh {
   [[nodiscard]] const Node& node(std::uint32_t i) const { return nodes_[i]; }
   [[nodiscard]] std::size_t size() const { return nodes_.size(); }
   [[nodiscard]] std::uint64_t binary_identity() const { return binary_identity_; }
+  /// The binary tree's volumes_revision() when this was built: a refit of the binary tree leaves this
+  /// wide tree behind, and the queries refuse it.
+  [[nodiscard]] std::uint64_t binary_revision() const { return binary_revision_; }
   /// The lanes' volumes are stored less this point (the root box's centre): a tree far from its frame's
   /// origin keeps small numbers, and so does the pose between two near trees (Lanes::make_context).
   [[nodiscard]] const Vec3& origin() const { return origin_; }
@@ -106,6 +111,7 @@ class WideBvh {
  private:
   std::vector<Node> nodes_;
   std::uint64_t binary_identity_ = 0;
+  std::uint64_t binary_revision_ = 0;
   Vec3 origin_ = Vec3::Zero();
 };
 

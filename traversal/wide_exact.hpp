@@ -12,6 +12,7 @@
 #include "exact.hpp"
 
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace bvhlab {
@@ -27,10 +28,16 @@ struct WidePair {
 template <class Lanes>
 void require_pair(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wide_a,
                   const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b) {
-  if (wide_a.binary_identity() != a.identity())
-    throw std::invalid_argument("wide exact query: wide tree A was not built from binary tree A");
-  if (wide_b.binary_identity() != b.identity())
-    throw std::invalid_argument("wide exact query: wide tree B was not built from binary tree B");
+  const auto check = [](const auto& tree, const auto& wide, const char* side) {
+    if (wide.binary_identity() != tree.identity())
+      throw std::invalid_argument(std::string("wide exact query: wide tree ") + side +
+                                  " was not built from binary tree " + side);
+    if (wide.binary_revision() != tree.volumes_revision())
+      throw std::invalid_argument(std::string("wide exact query: binary tree ") + side +
+                                  " was refitted after wide tree " + side + " was built; build it again");
+  };
+  check(a, wide_a, "A");
+  check(b, wide_b, "B");
 }
 
 }  // namespace wide_detail

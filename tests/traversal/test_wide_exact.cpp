@@ -137,7 +137,7 @@ TYPED_TEST(WideExact, EmptyAndSingleLeafTrees) {
   EXPECT_THROW(WideBvh<TypeParam>::build(Bvh<typename TypeParam::Volume>{}), std::invalid_argument);
 }
 
-TYPED_TEST(WideExact, RefusesWideTreesOfOtherTreesAndNonRigidPoses) {
+TYPED_TEST(WideExact, RefusesWideTreesOfOtherOrRefittedTreesAndNonRigidPoses) {
   const Mesh a = testing::make_torus(0.7, 0.25, 12, 8);
   const WidePair<TypeParam> trees(a, a);
   const auto other = Bvh<typename TypeParam::Volume>::build(a);
@@ -155,6 +155,15 @@ TYPED_TEST(WideExact, RefusesWideTreesOfOtherTreesAndNonRigidPoses) {
   RigidTransform scaled;
   scaled.rotation *= 2;
   expect_message([&] { trees.query(scaled); }, "rotation");
+  // A refit moves the binary tree's volumes: the wide tree built before it is refused, not used.
+  Mesh moved = a;
+  for (Vec3& v : moved.vertices) v *= 1.5;
+  auto refitted = Bvh<typename TypeParam::Volume>::build(a);
+  const auto wide = WideBvh<TypeParam>::build(refitted);
+  refitted.refit(moved);
+  expect_message([&] { query_exact_wide(refitted, wide, refitted, wide, pose); }, "refitted");
+  const auto rebuilt = WideBvh<TypeParam>::build(refitted);
+  EXPECT_TRUE(query_exact_wide(refitted, rebuilt, refitted, rebuilt, pose).collides);
 }
 
 }  // namespace
