@@ -147,11 +147,8 @@ struct alignas(16) KDop4 {
       bool apart = false;
       for (std::size_t m = 0; m < kAxes; ++m) {
         const Axis& x = c.axes[m];
-        const auto support = [&](const std::array<std::uint8_t, 3>& planes) {
-          return (x.coefficient[0] * b.offsets[planes[0]][k] + x.coefficient[1] * b.offsets[planes[1]][k]) +
-                 x.coefficient[2] * b.offsets[planes[2]][k];
-        };
-        const float upper = support(x.upper) + x.shift, neg_lower = support(x.lower) - x.shift;
+        const float upper = lane_support(b, x, x.upper, k) + x.shift;
+        const float neg_lower = lane_support(b, x, x.lower, k) - x.shift;
         const float o = std::min(upper + a.offsets[m + kAxes][k], neg_lower + a.offsets[m][k]);
         apart = apart || o < -slack;
       }
@@ -202,12 +199,8 @@ struct alignas(16) KDop4 {
     for (std::size_t m = 0; m < kAxes; ++m) {
       const Axis& x = c.axes[m];
       for (int k = 0; k < kLanes; ++k) {
-        const auto support = [&](const std::array<std::uint8_t, 3>& planes) {
-          return (x.coefficient[0] * b.offsets[planes[0]][k] + x.coefficient[1] * b.offsets[planes[1]][k]) +
-                 x.coefficient[2] * b.offsets[planes[2]][k];
-        };
-        out.upper[m][k] = support(x.upper) + x.shift;
-        out.neg_lower[m][k] = support(x.lower) - x.shift;
+        out.upper[m][k] = lane_support(b, x, x.upper, k) + x.shift;
+        out.neg_lower[m][k] = lane_support(b, x, x.lower, k) - x.shift;
       }
     }
     out.mag = b.mag;
@@ -229,6 +222,11 @@ struct alignas(16) KDop4 {
 #endif
 
  private:
+  /// Lane k of B's support bound on axis x from three of its planes, in the vector path's order.
+  static float lane_support(const KDop4& b, const Axis& x, const std::array<std::uint8_t, 3>& planes, int k) {
+    return (x.coefficient[0] * b.offsets[planes[0]][k] + x.coefficient[1] * b.offsets[planes[1]][k]) +
+           x.coefficient[2] * b.offsets[planes[2]][k];
+  }
   static constexpr std::array<Row, kPlanes> filled(float value) {
     std::array<Row, kPlanes> out{};
     for (auto& row : out) row = {value, value, value, value};
