@@ -17,7 +17,7 @@
 #include "bench/core/bench_flags.hpp"
 #include "engine/mesh_catalog.hpp"
 #include "traversal/exact.hpp"
-#include "traversal/frame_budget.hpp"
+#include "traversal/frame_schedule.hpp"
 #include "volumes/aabb.hpp"
 
 #include <benchmark/benchmark.h>

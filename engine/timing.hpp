@@ -1,16 +1,16 @@
-// How the run-time layer times a query: one record per pose, each pose timed on its own, the loop compiled
-// around the typed query (no virtual call per query). The runner, `bvhlab query --repeat` and Python's
-// timings all time through this loop.
+// How the run-time layer times a query: one record per pose, each pose timed on its own. The loop is
+// compiled once and calls the typed query through one indirect call (no virtual call per query). The
+// runner, `bvhlab query --repeat` and Python's timings all time through this loop.
 #pragma once
 
 #include "traversal/result.hpp"
 #include "volumes/geometry.hpp"
 
-#include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <limits>
+#include <memory>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 namespace bvhlab {
@@ -35,35 +35,36 @@ struct QueryRecord {
   double lower_bound = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// A non-owning reference to a callable `Result(const RigidTransform&)` (a lambda around the typed query):
+/// the timing loop calls it, so that the loop is compiled once (engine/timing.cpp) instead of once per
+/// strategy, volume and density. The cost is one indirect call per query, beside the query itself.
+class PoseQueryRef {
+ public:
+  template <class F>
+  requires(!std::is_same_v<std::remove_cvref_t<F>, PoseQueryRef> &&
+           std::is_invocable_r_v<Result, F&, const RigidTransform&>)
+      PoseQueryRef(F&& f)  // NOLINT(google-explicit-constructor): a reference to any such callable
+      : object_(const_cast<void*>(static_cast<const void*>(std::addressof(f)))),
+        call_([](void* object, const RigidTransform& pose) -> Result {
+          return (*static_cast<std::remove_reference_t<F>*>(object))(pose);
+        }) {}
+
+  Result operator()(const RigidTransform& pose) const { return call_(object_, pose); }
+
+ private:
+  void* object_;
+  Result (*call_)(void*, const RigidTransform&);
+};
+
 /// The timing loop: `warmup` untimed queries through `warm_up`, then each pose timed on its own through
-/// `query`. A separate warm-up query lets a coherent series warm up on a copy of its state.
-template <class WarmUp, class Query>
+/// `query`. A separate warm-up query lets a coherent series warm up on a copy of its state. The callables
+/// must outlive the call (a lambda written in the call does).
 void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
-                  WarmUp&& warm_up, Query&& query) {
-  out.clear();
-  out.reserve(poses.size());
-  bool sink = false;
-  for (std::size_t k = 0; k < poses.size() && k < static_cast<std::size_t>(std::max(warmup, 0)); ++k)
-    sink ^= warm_up(poses[k]).collides;
-  for (const RigidTransform& pose : poses) {
-    const auto start = Clock::now();
-    const Result r = query(pose);
-    const auto stop = Clock::now();
-    QueryRecord& record = out.emplace_back(
-        QueryRecord{r.collides, r.exact, r.budget_exhausted, r.probability,
-                    std::chrono::duration<double, std::micro>(stop - start).count(), r.counters});
-    if (r.proximity) {
-      record.distance = r.proximity->distance;
-      record.lower_bound = r.proximity->lower_bound;
-    }
-  }
-  if (sink && out.empty()) std::fputc(' ', stderr);  // keeps the warm-up from being optimised away
-}
+                  PoseQueryRef warm_up, PoseQueryRef query);
 
 /// The timing loop with the timed query as its own warm-up.
-template <class Query>
-void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
-                  Query&& query) {
+inline void timed_series(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
+                         PoseQueryRef query) {
   timed_series(poses, warmup, out, query, query);
 }
 

@@ -11,7 +11,7 @@
 #include "engine/registry.hpp"
 #include "engine/tree_model.hpp"
 #include "traversal/contact_geometry.hpp"
-#include "traversal/frame_budget.hpp"
+#include "traversal/frame_schedule.hpp"
 #include "traversal/strategies.hpp"
 
 #include <algorithm>

@@ -8,7 +8,7 @@
 #include "support/meshes.hpp"
 #include "support/random_draws.hpp"
 #include "traversal/exact.hpp"
-#include "traversal/frame_budget.hpp"
+#include "traversal/frame_schedule.hpp"
 #include "volumes/aabb.hpp"
 #include "volumes/obb.hpp"
 
