@@ -140,25 +140,12 @@ class TypedQuery final : public PreparedQuery {
   void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
             CoherentState& state) const override {
     if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
-    // The warm-up runs on a copy, so the caller's state continues as if there had been none.
-    CoherentState scratch = warmup > 0 ? state : CoherentState{};
-    timed_series(
-        poses, warmup, out, [&](const RigidTransform& pose) { return query(pose, scratch); },
-        [&](const RigidTransform& pose) { return query(pose, state); });
+    timed_coherent_series(poses, warmup, out, coherent_query(), state);
   }
   void time_per_pose(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
                      std::span<CoherentState> states) const override {
     if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
-    if (states.size() != poses.size())
-      throw std::invalid_argument("time_per_pose: " + std::to_string(states.size()) + " states for " +
-                                  std::to_string(poses.size()) + " poses (one per pose)");
-    // timed_series warms up on poses 0, 1, ... and then times every pose, in order.
-    std::vector<CoherentState> scratch(
-        states.begin(), states.begin() + std::min<std::ptrdiff_t>(std::max(warmup, 0), std::ssize(states)));
-    std::size_t warmed = 0, timed = 0;
-    timed_series(
-        poses, warmup, out, [&](const RigidTransform& pose) { return query(pose, scratch[warmed++]); },
-        [&](const RigidTransform& pose) { return query(pose, states[timed++]); });
+    timed_per_pose_series(poses, warmup, out, coherent_query(), states);
   }
   [[nodiscard]] bool coherent() const override { return coherent_; }
 
@@ -187,6 +174,10 @@ class TypedQuery final : public PreparedQuery {
     } else {
       return with_geometry(pose, S::query_coherent(a(), b(), pose, options_, state));
     }
+  }
+  /// The coherent query as the timing loops call it.
+  auto coherent_query() const {
+    return [this](const RigidTransform& pose, CoherentState& state) { return query(pose, state); };
   }
   const auto& a() const { return tree_of(trees_.a); }
   const auto& b() const { return tree_of(trees_.b); }
