@@ -18,6 +18,13 @@ inline float widened(float x) {
   return x * (1 + 1.0f / (1 << 20));
 }
 
+/// The margin a lane's value (of size `scale`, a centre's |c|_1 or a plane offset) needs for being taken
+/// less `origin` in double before its rounding to float: the subtraction or dot product rounds a few times
+/// within DBL_EPSILON of (scale + |origin|_1); 8 of them cover it. Every layout's set() grows by it.
+inline double origin_shift_rounding(double scale, const Vec3& origin) {
+  return 8 * std::numeric_limits<double>::epsilon() * (scale + origin.cwiseAbs().sum());
+}
+
 /// The pose with its translation moved by the two origins (in double), and the scale of the terms that
 /// went into it, for the slack: t' rounds in double within a few DBL_EPSILON of that scale, far below
 /// 1e-8 of it, which times the tests' slack factors (16 FLT_EPSILON and more) covers that rounding.

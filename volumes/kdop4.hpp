@@ -90,8 +90,7 @@ struct alignas(16) KDop4 {
     for (std::size_t m = 0; m < kPlanes; ++m) {
       const double along = normals[m].dot(origin);
       const double d = double(dop.offsets[m]) - along;
-      const double rounding = 8 * std::numeric_limits<double>::epsilon() *
-                              (std::abs(double(dop.offsets[m])) + origin.cwiseAbs().sum());
+      const double rounding = origin_shift_rounding(std::abs(double(dop.offsets[m])), origin);
       offsets[m][lane] = float_up(d + rounding);
       largest = std::max(largest, std::abs(double(offsets[m][lane])));
     }

@@ -95,8 +95,7 @@ struct alignas(16) Obb4 {
       moved += std::abs(exact[k] - center[k][lane]);
       largest = std::max(largest, std::abs(double(center[k][lane])));
     }
-    const double rounding = 8 * std::numeric_limits<double>::epsilon() *
-                            (to_vec(box.center).cwiseAbs().sum() + origin.cwiseAbs().sum());
+    const double rounding = origin_shift_rounding(to_vec(box.center).cwiseAbs().sum(), origin);
     for (int k = 0; k < 3; ++k) {
       half[k][lane] = float_up(double(box.half[k]) + moved + rounding);
       sum += half[k][lane];

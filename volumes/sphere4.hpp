@@ -55,8 +55,7 @@ struct alignas(16) Sphere4 {
       c[k] = rounded_to_float(exact[k]);
       moved += (exact[k] - c[k]) * (exact[k] - c[k]);
     }
-    const double rounding = 8 * std::numeric_limits<double>::epsilon() *
-                            (to_vec(sphere.center).cwiseAbs().sum() + origin.cwiseAbs().sum());
+    const double rounding = origin_shift_rounding(to_vec(sphere.center).cwiseAbs().sum(), origin);
     cx[lane] = c[0], cy[lane] = c[1], cz[lane] = c[2];
     radius[lane] = float_up(double(sphere.radius) + std::sqrt(moved) + rounding);
     mag[lane] = float_up(std::max({std::abs(double(c[0])), std::abs(double(c[1])), std::abs(double(c[2]))}) +
