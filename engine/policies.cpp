@@ -1,5 +1,6 @@
 #include "engine/policies.hpp"
 
+#include "bvh/wide_bvh.hpp"
 #include "engine/registry.hpp"
 
 #include <nlohmann/json.hpp>
@@ -27,6 +28,9 @@ StrategyInfo strategy_row() {
   info.needs_polygons = S::needs_polygons;
   info.needs_density = !S::template accepts<NoDensity>;
   info.coherent = kRunsCoherent<S>;
+  info.wide = kRunsWide<S>;
+  static_assert(!kRunsWide<S> || kDensityFree<S>,
+                "a wide strategy is compiled once per volume: density_free");
   with_each_density([&]<class D>(std::type_identity<D>) {
     if constexpr (S::template accepts<D>) info.densities.emplace_back(D::name());
   });
@@ -97,6 +101,28 @@ std::string StrategyInfo::coherent_refusal() const {
   for (const StrategyInfo& s : strategy_table())
     if (s.coherent) those += (those.empty() ? "" : ", ") + s.name;
   return "strategy " + name + " does not run coherent (the strategies that do: " + those + ")";
+}
+
+std::string StrategyInfo::wide_refusal() const {
+  if (wide) return "";
+  std::string those;
+  for (const StrategyInfo& s : strategy_table())
+    if (s.wide) those += (those.empty() ? "" : ", ") + s.name;
+  return "strategy " + name + " does not run on wide trees (the strategies that do: " + those + ")";
+}
+
+std::string wide_layout_refusal(std::string_view bv) {
+  check_volume_name(bv);
+  bool has = false;
+  std::string those;
+  with_each_volume([&]<class BV>(std::type_identity<BV>) {
+    if constexpr (HasWideLayout<BV>) {
+      those += (those.empty() ? "" : ", ") + std::string(BV::name());
+      has = has || BV::name() == bv;
+    }
+  });
+  if (has) return "";
+  return "bounding volume '" + std::string(bv) + "' has no wide layout (the volumes that do: " + those + ")";
 }
 
 std::string StrategyInfo::contact_geometry_refusal() const {
@@ -172,6 +198,7 @@ nlohmann::json policies_json() {
                           {"needs_polygons", s.needs_polygons},
                           {"needs_density", s.needs_density},
                           {"coherent", s.coherent},
+                          {"wide", s.wide},
                           {"densities", s.densities},
                           {"volumes", s.volumes},
                           {"parameters", parameters_json(s.parameters)}});

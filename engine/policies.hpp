@@ -28,6 +28,7 @@ struct StrategyInfo {
   bool needs_polygons = false;         ///< cannot run on trees saved without polygons
   bool needs_density = false;          ///< does not run on trees without a density
   bool coherent = false;               ///< runs coherent over a sequence of poses (traversal/coherent.hpp)
+  bool wide = false;                   ///< runs on the trees' wide layout (traversal/wide_exact.hpp)
   std::vector<std::string> densities;  ///< the registered densities it runs on
   std::vector<std::string> volumes;    ///< the registered volumes it runs on
   std::vector<ParamSpec> parameters;
@@ -42,10 +43,17 @@ struct StrategyInfo {
   /// Empty when it runs coherent; else the one message every caller gives: "strategy adb does not run
   /// coherent (the strategies that do: exact, all_contacts)".
   [[nodiscard]] std::string coherent_refusal() const;
+  /// Empty when it runs on the trees' wide layout; else the one message every caller gives: "strategy adb
+  /// does not run on wide trees (the strategies that do: exact, all_contacts)".
+  [[nodiscard]] std::string wide_refusal() const;
   /// Empty when its answers name intersecting triangle pairs (needs_polygons); else the one message every
   /// caller gives for contact geometry asked of it.
   [[nodiscard]] std::string contact_geometry_refusal() const;
 };
+
+/// Empty when volume `bv` has a wide layout (bvh/wide_bvh.hpp); else the one message every caller gives:
+/// "bounding volume 'rbox' has no wide layout (the volumes that do: aabb, ...)".
+std::string wide_layout_refusal(std::string_view bv);
 
 /// In registration order.
 const std::vector<DensityInfo>& density_table();

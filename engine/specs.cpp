@@ -6,6 +6,22 @@
 
 namespace bvhlab {
 
+namespace {
+
+/// The strategy's refusals of a coherent or a wide walk; the two together are refused too.
+void check_walk(const StrategyInfo& info, bool coherent, bool wide) {
+  if (coherent)
+    if (std::string refusal = info.coherent_refusal(); !refusal.empty()) throw std::invalid_argument(refusal);
+  if (wide)
+    if (std::string refusal = info.wide_refusal(); !refusal.empty()) throw std::invalid_argument(refusal);
+  if (coherent && wide)
+    throw std::invalid_argument(
+        "strategy " + info.name +
+        ": a coherent query walks the binary trees; ask for coherent or wide, not both");
+}
+
+}  // namespace
+
 std::vector<std::string> volume_names() {
   return type_names(RegisteredVolumes{});
 }
@@ -33,7 +49,7 @@ std::string StrategyVariant::budget_label() const {
 }
 
 std::string StrategyVariant::label() const {
-  return strategy_label(strategy, values, budget) + (coherent ? " coherent" : "");
+  return strategy_label(strategy, values, budget) + (coherent ? " coherent" : "") + (wide ? " wide" : "");
 }
 
 double StrategyVariant::value_or(std::string_view name, double fallback) const {
@@ -43,8 +59,7 @@ double StrategyVariant::value_or(std::string_view name, double fallback) const {
 
 std::vector<StrategyVariant> expand(const StrategySpec& spec) {
   const StrategyInfo& info = strategy_info(spec.name);
-  if (spec.coherent)
-    if (std::string refusal = info.coherent_refusal(); !refusal.empty()) throw std::invalid_argument(refusal);
+  check_walk(info, spec.coherent, spec.wide);
   // Cross product of the given values (a sweep may hold several), in the order of the parameter table.
   std::vector<ParamValues> combos{{}};
   for (const ParamSpec& p : info.parameters) {
@@ -63,8 +78,11 @@ std::vector<StrategyVariant> expand(const StrategySpec& spec) {
   std::vector<StrategyVariant> out;
   for (const ParamValues& combo : combos)
     for (const Budget& budget : budgets)
-      out.push_back(
-          {spec.name, resolve_parameters(info.parameters, combo, spec.name), budget, spec.coherent});
+      out.push_back({.strategy = spec.name,
+                     .values = resolve_parameters(info.parameters, combo, spec.name),
+                     .budget = budget,
+                     .coherent = spec.coherent,
+                     .wide = spec.wide});
   return out;
 }
 
@@ -99,9 +117,7 @@ StrategyVariant strategy_variant(const std::string& name, const ParamValues& giv
 }
 
 void check_strategy_options(const StrategyVariant& variant) {
-  if (variant.coherent)
-    if (std::string refusal = strategy_info(variant.strategy).coherent_refusal(); !refusal.empty())
-      throw std::invalid_argument(refusal);
+  check_walk(strategy_info(variant.strategy), variant.coherent, variant.wide);
   if (variant.contact_geometry)
     if (std::string refusal = strategy_info(variant.strategy).contact_geometry_refusal(); !refusal.empty())
       throw std::invalid_argument(refusal);

@@ -47,6 +47,7 @@ struct StrategySpec {
   std::vector<Budget> budgets;                                     ///< strategies that take a budget
   std::vector<std::string> hierarchies;  ///< restricts the strategy to these; empty: all it applies to
   bool coherent = false;                 ///< each variant runs coherent (StrategyVariant::coherent)
+  bool wide = false;                     ///< each variant walks the wide layout (StrategyVariant::wide)
 };
 
 /// One concrete way to answer a query: the unit of a results row.
@@ -60,8 +61,12 @@ struct StrategyVariant {
   /// Each named contact also gets its geometry (Result::contact_geometry): only strategies that test
   /// triangles take it, on trees with polygons.
   bool contact_geometry = false;
+  /// The query walks the trees' wide layout (four children a node tested at once, bvh/wide_bvh.hpp), built
+  /// from each tree on first use and kept with it: only strategies that run wide take it
+  /// (StrategyInfo::wide), on volumes with a wide layout, not coherent. Same answers, less time.
+  bool wide = false;
   [[nodiscard]] std::string budget_label() const;  ///< "" or "bv_tests=200" or "deadline_us=20"
-  [[nodiscard]] std::string label() const;         ///< e.g. "adb p_min=0.9", "exact coherent"
+  [[nodiscard]] std::string label() const;         ///< e.g. "adb p_min=0.9", "exact coherent", "exact wide"
   /// The value of parameter `name`, or `fallback` when the strategy has none.
   [[nodiscard]] double value_or(std::string_view name, double fallback) const;
 };
@@ -86,7 +91,8 @@ DensitySpec density_spec(const std::string& name, const ParamValues& given);
 /// A strategy variant from its name, given parameters and budget, checked as `bvhlab query` checks them.
 /// Throws std::invalid_argument.
 StrategyVariant strategy_variant(const std::string& name, const ParamValues& given, const Budget& budget);
-/// Throws std::invalid_argument when the strategy refuses the variant's values, budget or coherence.
+/// Throws std::invalid_argument when the strategy refuses the variant's values, budget, coherence or wide
+/// layout (or is asked for both).
 void check_strategy_options(const StrategyVariant& variant);
 
 }  // namespace bvhlab

@@ -5,6 +5,7 @@
 
 #include "adb/saved_tree.hpp"
 #include "adb/update.hpp"
+#include "bvh/wide_bvh.hpp"
 #include "engine/cloud_trees.hpp"
 #include "engine/policies.hpp"
 #include "engine/refusals.hpp"
@@ -17,6 +18,7 @@
 #include <algorithm>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -78,11 +80,26 @@ Tree<BV, D> attach_polygons(const Tree<BV, D>& saved, const Mesh& mesh) {
 template <class D>
 inline constexpr bool kCloudDensity = std::is_same_v<D, NoDensity> || std::is_same_v<D, AdbDensity>;
 
+/// The wide layout of a tree of volume BV (bvh/wide_bvh.hpp), or NoWideLayout for a volume without one.
+struct NoWideLayout {};
+template <class BV>
+struct WideFormOf {
+  using type = NoWideLayout;
+};
+template <HasWideLayout BV>
+struct WideFormOf<BV> {
+  using type = WideTreeOf<BV>;
+};
+template <class BV>
+using WideForm = typename WideFormOf<BV>::type;
+
 /// What a density-free strategy (kDensityFree) reads of a tree: its hierarchy alone, so that one compiled
-/// query serves the trees of every density.
+/// query serves the trees of every density; and its wide layout when the query walks that (owned by the
+/// tree's model, which the query keeps alive).
 template <class BV>
 struct HierarchyOnly {
   const Bvh<BV>& bvh;
+  const WideForm<BV>* wide = nullptr;
 };
 
 /// A tree as strategy S reads it: `Held` is std::reference_wrapper<const Tree<BV, D>> or HierarchyOnly<BV>.
@@ -157,9 +174,16 @@ class TypedQuery final : public PreparedQuery {
       const SurfaceLeaves<BV> leaves(a().bvh, trees_.side_a, b().bvh, trees_.side_b, pose);
       return S::query(a(), b(), pose, options_, leaves);
     } else {
+      if constexpr (kWalksWide)
+        if (trees_.a.wide)
+          return with_geometry(pose, S::query_wide(a(), *a().wide, b(), *b().wide, pose, options_));
       return with_geometry(pose, S::query(a(), b(), pose, options_));
     }
   }
+  /// Whether a prepared query of this type may walk the wide layouts (prepare sets them only for a wide
+  /// variant).
+  static constexpr bool kWalksWide =
+      kRunsWide<S> && HasWideLayout<BV> && std::is_same_v<Held, HierarchyOnly<BV>>;
   Result with_geometry(const RigidTransform& pose, Result r) const {
     if (geometry_) (*geometry_)(pose, r);
     return r;
@@ -303,6 +327,13 @@ struct TypedBase : TreeModel {
   }
 
   double refit(const Mesh& deformed, RefitMethod method) override;
+  /// Drops what was derived from the volumes before they changed in place (a refit, or a follower's copy of
+  /// refitted volumes): the root's bounds and the wide layout. Only while no query holds the tree.
+  void volumes_changed() {
+    bounds.reset();
+    const std::lock_guard lock(wide_mutex_);
+    wide_.reset();
+  }
   [[nodiscard]] std::unique_ptr<FollowerModel> follow(const DensityUpdateSpec& spec) const override;
 
   Tree<BV, D> tree;
@@ -322,6 +353,7 @@ struct TypedBase : TreeModel {
       throw std::invalid_argument(strategy_info(variant.strategy).coherent_refusal());
     if (variant.contact_geometry && !S::needs_polygons)
       throw std::invalid_argument(strategy_info(variant.strategy).contact_geometry_refusal());
+    if (variant.wide) check_wide<S>(variant, side().is_cloud() || b->side().is_cloud());
     if (side().is_cloud() || b->side().is_cloud()) {
       if (variant.contact_geometry)
         throw std::invalid_argument("contact geometry needs triangles; a point cloud's tree has none");
@@ -340,6 +372,11 @@ struct TypedBase : TreeModel {
     const Bvh<BV>& bvh_b = b->tree.bvh;
     if constexpr (kDensityFree<S>) {
       QueryTrees<HierarchyOnly<BV>> trees{std::move(a), std::move(b), {bvh_a}, {bvh_b}, side_a, side_b};
+      if constexpr (HasWideLayout<BV>)
+        if (variant.wide) {
+          trees.a.wide = &wide_of(*trees.owner_a);
+          trees.b.wide = &wide_of(*trees.owner_b);
+        }
       return DensityFreeQueries<type_index<BV>(RegisteredVolumes{})>::prepare(std::move(trees), variant);
     } else {
       const Tree<BV, D>& tree_a = a->tree;
@@ -349,6 +386,33 @@ struct TypedBase : TreeModel {
       return make_query<S, BV, kCloudDensity<D>>(std::move(trees), std::move(options), variant);
     }
   }
+
+  /// The refusals of a wide variant: a strategy without a wide walk, a volume without a wide layout, point
+  /// leaves, a coherent walk.
+  template <class S>
+  static void check_wide(const StrategyVariant& variant, bool cloud) {
+    if (!kRunsWide<S>) throw std::invalid_argument(strategy_info(variant.strategy).wide_refusal());
+    if (!HasWideLayout<BV>) throw std::invalid_argument(wide_layout_refusal(BV::name()));
+    if (variant.coherent)
+      throw std::invalid_argument(
+          "a coherent query walks the binary trees; ask for coherent or wide, not both");
+    if (cloud)
+      throw std::invalid_argument(
+          "a wide query tests triangles at the leaves; a point cloud's tree has none");
+  }
+
+  /// The wide layout of `model` (a TypedBase of this volume and density: the caller checked), built on the
+  /// first wide query and kept with the tree for the next ones.
+  static const WideForm<BV>& wide_of(const TreeModel& model) {
+    const auto& typed = static_cast<const TypedBase&>(model);
+    const std::lock_guard lock(typed.wide_mutex_);
+    if (!typed.wide_) typed.wide_ = std::make_unique<const WideForm<BV>>(WideForm<BV>::build(typed.tree.bvh));
+    return *typed.wide_;
+  }
+
+  /// The wide layout (wide_of); a refit drops it. Built under the lock: threads may prepare queries at once.
+  mutable std::mutex wide_mutex_;
+  mutable std::unique_ptr<const WideForm<BV>> wide_;
 
   /// SurfaceLeaves' checks of the two sides and the strategy's (so running cannot fail).
   template <class S>
@@ -408,7 +472,7 @@ class TypedFollower final : public FollowerModel {
       throw std::invalid_argument("take_volumes: a plain " + std::string(BV::name()) +
                                   " tree is needed, not " + plain.info.bv + ", " + plain.info.annotation);
     model_->tree.bvh = typed->tree.bvh;
-    model_->bounds.reset();
+    model_->volumes_changed();
   }
   DensityUpdateStats update() override {
     DensityUpdateStats stats;
@@ -439,7 +503,7 @@ template <class BV, class D>
 double TypedBase<BV, D>::refit(const Mesh& deformed, RefitMethod method) {
   if constexpr (std::is_same_v<D, NoDensity>) {
     tree.bvh.refit(deformed, method);
-    bounds.reset();
+    volumes_changed();
     return tree.bvh.degradation();
   } else {
     throw std::invalid_argument("refit: a tree with density " + info.density +

@@ -151,9 +151,10 @@ struct QueryResult {
 
 QueryResult query(const AnyTree& a, const AnyTree& b, const py::object& pose, const py::object& rotation,
                   const py::object& translation, const std::string& strategy, long long bv_tests,
-                  double deadline_us, bool contact_geometry, const py::kwargs& parameters) {
+                  double deadline_us, bool contact_geometry, bool wide, const py::kwargs& parameters) {
   StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
   variant.contact_geometry = contact_geometry;
+  variant.wide = wide;
   check_strategy_options(variant);
   const RigidTransform checked = pose_from(pose, rotation, translation);
   check_same_kind_of_units(a.info(), b.info());
@@ -287,11 +288,12 @@ void run_interruptibly(const PreparedQuery& prepared, std::span<const RigidTrans
 py::dict query_batch(const AnyTree& a, const AnyTree& b, const py::object& poses, const py::object& rotations,
                      const py::object& translations, const std::string& strategy, long long bv_tests,
                      double deadline_us, bool coherent, CoherentState* state, bool contact_geometry,
-                     const py::kwargs& parameters) {
+                     bool wide, const py::kwargs& parameters) {
   StrategyVariant variant = variant_from(strategy, bv_tests, deadline_us, parameters);
   if (state && !coherent) throw py::value_error("a state is kept by coherent queries: give coherent=True");
   variant.coherent = coherent;
   variant.contact_geometry = contact_geometry;
+  variant.wide = wide;
   check_strategy_options(variant);
   const std::vector<RigidTransform> checked = poses_from(poses, rotations, translations);
   check_same_kind_of_units(a.info(), b.info());
@@ -403,6 +405,10 @@ void bind_queries(py::module_& m) {
                " exact=" + (q.result.exact ? "True" : "False") + ">";
       });
 
+  const char* wide_help =
+      " wide=True walks the trees' wide layout, four children a node tested at once (strategies exact and "
+      "all_contacts on aabb, the k-DOPs, obb and sphere; not with coherent): the same answers in less time; "
+      "each tree builds it on first use and keeps it.";
   const char* strategy_help =
       " strategy: a name of bvhlab.strategies(), its parameters as keyword arguments (p_min=0.9); bv_tests "
       "and "
@@ -411,17 +417,19 @@ void bind_queries(py::module_& m) {
   m.def("query", &query, py::arg("a"), py::arg("b"), py::arg("pose") = py::none(), py::kw_only(),
         py::arg("rotation") = py::none(), py::arg("translation") = py::none(), py::arg("strategy") = "exact",
         py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0, py::arg("contact_geometry") = false,
+        py::arg("wide") = false,
         (std::string(
              "One query between trees a and b at one pose: a 4 x 4 rigid matrix, or translation (3) and "
              "rotation (3 x 3, default identity); a query without either is refused. contact_geometry=True "
              "adds Result.contact_geometry (strategies that test triangles).") +
-         strategy_help)
+         wide_help + strategy_help)
             .c_str());
   m.def(
       "query_batch", &query_batch, py::arg("a"), py::arg("b"), py::arg("poses") = py::none(), py::kw_only(),
       py::arg("rotations") = py::none(), py::arg("translations") = py::none(), py::arg("strategy") = "exact",
       py::arg("bv_tests") = 0, py::arg("deadline_us") = 0.0, py::arg("coherent") = false,
       py::arg("state") = static_cast<CoherentState*>(nullptr), py::arg("contact_geometry") = false,
+      py::arg("wide") = false,
       (std::string(
            "Queries every pose of poses (K, 4, 4), or of rotations (K, 3, 3; default identities) and "
            "translations (K, 3), without holding the GIL; Ctrl-C interrupts it (KeyboardInterrupt) within a "
@@ -435,7 +443,7 @@ void bind_queries(py::module_& m) {
            "Result.contact_geometry has them, in arrays of one row per contact: pose i's are rows "
            "contact_offsets[i] to contact_offsets[i + 1] of contact_triangles, contact_segments, "
            "contact_points, contact_normals and contact_coplanar.") +
-       strategy_help)
+       wide_help + strategy_help)
           .c_str());
   m.def(
       "protocol_poses",

@@ -10,6 +10,7 @@
 #include "exact.hpp"
 #include "strategy.hpp"
 #include "strategy_names.hpp"
+#include "wide_exact.hpp"
 
 #include <span>
 
@@ -76,6 +77,12 @@ struct ExactStrategy {
   static Result query_coherent(const TreeA& a, const TreeB& b, const RigidTransform& b_to_a, Options mode,
                                CoherentState& state, const Leaves& leaves = kTriangleLeaves) {
     return query_exact_coherent(a.bvh, b.bvh, b_to_a, state, mode, leaves);
+  }
+  static constexpr bool wide = true;
+  template <class TreeA, class TreeB, class Lanes>
+  static Result query_wide(const TreeA& a, const WideBvh<Lanes>& wide_a, const TreeB& b,
+                           const WideBvh<Lanes>& wide_b, const RigidTransform& b_to_a, Options mode) {
+    return query_exact_wide(a.bvh, wide_a, b.bvh, wide_b, b_to_a, mode);
   }
 };
 

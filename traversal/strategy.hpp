@@ -37,6 +37,11 @@
 //                          Result of S::query, starting from `state` (a CoherentState the caller keeps for
 //                          this pair of trees) and leaving its own front there. Its answers are those of
 //                          S::query: a state makes a query faster, never other.
+// Optional: running on the trees' wide layout (bvh/wide_bvh.hpp, traversal/wide_exact.hpp)
+//   S::wide                constexpr bool true: the strategy offers (it must be density_free too)
+//   S::query_wide(a, wide_a, b, wide_b, b_to_a, options)
+//                          Result of S::query, walking the wide trees built from a.bvh and b.bvh (four
+//                          children a node tested at once). The same answers as S::query.
 #pragma once
 
 #include "../adb/parameters.hpp"
@@ -69,6 +74,12 @@ concept Strategy = requires(const ParamValues& values, const Budget& budget) {
 template <class S>
 inline constexpr bool kRunsCoherent = requires {
   requires S::coherent;
+};
+
+/// Whether S runs on the trees' wide layout (S::wide and S::query_wide, above).
+template <class S>
+inline constexpr bool kRunsWide = requires {
+  requires S::wide;
 };
 
 /// Whether S reads only the trees' hierarchies (S::density_free, above).

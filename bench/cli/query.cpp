@@ -27,7 +27,8 @@ struct QueryArgs {
   std::string a, b, pose, protocol, poses_file, bv = "aabb", strategy = "exact", cache, density, cloud;
   double deadline = 0, bv_tests = 0;
   int repeat = 0;
-  bool all = false, json = false, normalize = false, no_cache = false, coherent = false, geometry = false;
+  bool all = false, json = false, normalize = false, no_cache = false, coherent = false, geometry = false,
+       wide = false;
   ParameterOptions parameters;
   const CLI::Option* bv_option = nullptr;
   const CLI::Option* strategy_option = nullptr;
@@ -202,6 +203,18 @@ QueryRequest query_request(const QueryArgs& args, bool trees) {
       throw CLI::ValidationError("--coherent", refusal);
     if (args.bv.rfind("fcl_", 0) == 0)
       throw CLI::ValidationError("--coherent", "FCL hierarchies do not run coherent; give a bvhlab volume");
+  }
+  request.strategy.wide = args.wide;
+  if (args.wide) {
+    if (args.bv.rfind("fcl_", 0) == 0)
+      throw CLI::ValidationError("--wide", "FCL hierarchies have no wide layout here; give a bvhlab volume");
+    if (std::string refusal = strategy.wide_refusal(); !refusal.empty())
+      throw CLI::ValidationError("--wide", refusal);
+    if (std::string refusal = trees ? "" : wide_layout_refusal(args.bv); !refusal.empty())
+      throw CLI::ValidationError("--wide", refusal);
+    if (args.coherent)
+      throw CLI::ValidationError("--wide",
+                                 "a coherent query walks the binary trees; give --coherent or --wide");
   }
   request.strategy.contact_geometry = args.geometry;
   if (args.geometry) {
@@ -521,6 +534,9 @@ Command add_query_command(CLI::App& app) {
                   "Start each pose where the previous one ended (less work on poses close to each other; "
                   "traversal/README.md, \"Coherent queries\"): the poses of --poses or a --protocol turn in "
                   "order, and each --repeat pass");
+  query->add_flag("--wide", args->wide,
+                  "Walk the trees' wide layout: four children a node tested at once (exact and all_contacts; "
+                  "aabb, the k-DOPs, obb and sphere). The same answers, in less time");
   query->add_flag("--contact-geometry", args->geometry,
                   "Also give each contact's geometry: the segment where its two triangles meet, its midpoint "
                   "and a normal from A into B (in A's frame; no penetration depth)");
@@ -549,6 +565,7 @@ Command add_query_command(CLI::App& app) {
       "--strategy time_critical --bv-tests 200 --repeat 100\n"
       "  bvhlab query pinion.off pinion.off --normalize --poses bench/scenes/example_poses.txt --json\n"
       "  bvhlab query jeep1.ms3d jeep1.ms3d --normalize --protocol 0.8,2000 --coherent --repeat 5\n"
+      "  bvhlab query bunny.obj bunny.obj --normalize --protocol 1.0,200 --bv obb --wide --repeat 20\n"
       "  bvhlab query scan.xyz pinion.off --cloud a --pose 0.5,0,0 --strategy adb --p-min 0.99");
   return {query, [args] { return query_command(*args); }};
 }

@@ -62,6 +62,8 @@ bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec&
       if (std::string refusal = fcl_refusal(spec, h.bv); !refusal.empty()) hs.child(k).fail(refusal);
     } else if (std::string refusal = strategy_info(spec.name).volume_refusal(h.bv); !refusal.empty()) {
       hs.child(k).fail(refusal);
+    } else if (std::string no_layout = spec.wide ? wide_layout_refusal(h.bv) : ""; !no_layout.empty()) {
+      hs.child(k).fail(no_layout);
     }
     spec.hierarchies.push_back(name);
   }
@@ -92,6 +94,7 @@ std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Sk
   for (const ParamSpec& p : info.parameters) fields.emplace_back(p.name);
   if (info.budget != BudgetUse::None) fields.emplace_back("budgets");
   fields.emplace_back("coherent");  // refused below, by name, for a strategy that does not run coherent
+  fields.emplace_back("wide");      // likewise for a strategy without a wide walk
   s.expect_object(fields);
   for (const ParamSpec& p : info.parameters)
     if (s.has(std::string(p.name)))
@@ -102,13 +105,20 @@ std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Sk
     spec.coherent = s.child("coherent").boolean();
     if (spec.coherent && !info.coherent) s.child("coherent").fail(info.coherent_refusal());
   }
+  if (s.has("wide")) {
+    spec.wide = s.child("wide").boolean();
+    if (spec.wide && !info.wide) s.child("wide").fail(info.wide_refusal());
+    if (spec.wide && spec.coherent)
+      s.child("wide").fail(
+          "a coherent query walks the binary trees; give \"coherent\" or \"wide\", not both");
+  }
   if (!parse_strategy_hierarchies(s, scene, spec, skipped)) return std::nullopt;
   if (info.needs_density) check_densities(s, scene, spec, info);
   if (std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),
                    [&](const HierarchySpec& h) { return scene.applies(spec, h); }))
     s.fail("\"" + spec.name +
            "\" applies to no hierarchy of the scene (FCL hierarchies run \"exact\", and fcl_obbrss "
-           "\"distance\", not coherent)");
+           "\"distance\", not coherent or wide; a wide strategy runs on the volumes with a wide layout)");
   checked(s, [&] {
     for (const StrategyVariant& v : expand(spec)) check_strategy_options(v);
     return 0;
@@ -235,11 +245,13 @@ const HierarchySpec* Scene::hierarchy(std::string_view name) const {
 }
 
 std::string fcl_refusal(const StrategySpec& s, std::string_view fcl_bv) {
-  const bool runs = !s.coherent && (s.name == kExactStrategyName ||
-                                    (s.name == kDistanceStrategyName && fcl_bv == "fcl_obbrss"));
+  const bool runs =
+      !s.coherent && !s.wide &&
+      (s.name == kExactStrategyName || (s.name == kDistanceStrategyName && fcl_bv == "fcl_obbrss"));
   if (runs) return "";
-  return "\"" + s.name + "\"" + (s.coherent ? " coherent" : "") + " does not run on " + std::string(fcl_bv) +
-         ": FCL hierarchies run \"exact\", and fcl_obbrss \"distance\", not coherent";
+  return "\"" + s.name + "\"" + (s.coherent ? " coherent" : "") + (s.wide ? " wide" : "") +
+         " does not run on " + std::string(fcl_bv) +
+         ": FCL hierarchies run \"exact\", and fcl_obbrss \"distance\", not coherent or wide";
 }
 
 bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
@@ -247,6 +259,7 @@ bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
   if (h.is_fcl()) return fcl_refusal(s, h.bv).empty();
+  if (s.wide && !wide_layout_refusal(h.bv).empty()) return false;  // e.g. rbox
   return strategy_info(s.name).volume_refusal(h.bv).empty();  // e.g. distance on a volume without a bound
 }
 

@@ -88,6 +88,8 @@ class FclHierarchy final : public PreparedHierarchy {
 
   void run(const StrategyVariant& variant, std::span<const RigidTransform> poses, int warmup,
            std::vector<QueryRecord>& out) const override {
+    if (variant.wide)  // the scene parser refuses it (fcl_refusal)
+      throw std::logic_error("runner: FCL hierarchies have no wide layout (" + variant.label() + ")");
     if (variant.strategy == kDistanceStrategyName)
       timed_series(poses, warmup, out, [&](const RigidTransform& p) { return distance(p); });
     else if (variant.strategy == kExactStrategyName)

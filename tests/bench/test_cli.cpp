@@ -451,6 +451,41 @@ TEST_F(Cli, CoherentQueriesAnswerAsColdOverAProtocolTurn) {
                  "expected DISTANCE,STEP,STEPS or DISTANCE,STEPS");
 }
 
+// --wide over a protocol turn: the binary walk's answers on fewer node pairs; refused by name where it does
+// not run (a strategy without a wide walk, a volume without a layout, coherent, FCL).
+TEST_F(Cli, WideQueriesAnswerAsTheBinaryWalk) {
+  testing::write_obj(testing::make_torus(0.7, 0.25, 24, 12), dir / "torus.obj");
+  const std::string turn = "query torus.obj torus.obj --protocol 1.2,120 --json --bv obb";
+  const nlohmann::json binary = nlohmann::json::parse(ok(turn).out)["results"];
+  const nlohmann::json walked = nlohmann::json::parse(ok(turn + " --wide").out)["results"];
+  ASSERT_EQ(binary.size(), 120u);
+  ASSERT_EQ(walked.size(), 120u);
+  std::size_t colliding = 0;
+  std::uint64_t binary_pairs = 0, wide_pairs = 0;
+  for (std::size_t k = 0; k < binary.size(); ++k) {
+    EXPECT_EQ(walked[k]["collides"], binary[k]["collides"]) << k;
+    EXPECT_EQ(walked[k]["exact"], true) << k;
+    colliding += binary[k]["collides"].get<bool>();
+    binary_pairs += binary[k]["nodes_visited"].get<std::uint64_t>();
+    wide_pairs += walked[k]["nodes_visited"].get<std::uint64_t>();
+  }
+  EXPECT_GT(colliding, 0u);
+  EXPECT_LT(colliding, binary.size());
+  EXPECT_LT(wide_pairs, binary_pairs);  // four children settled a step
+  const std::string text =
+      ok("query torus.obj torus.obj --protocol 1.2,12 --bv dop24 --wide --all-contacts").out;
+  EXPECT_NE(text.find("torus vs torus, all_contacts wide on dop24, 12 poses\n"), std::string::npos) << text;
+  expect_refused("query torus.obj torus.obj --pose 1,0,0 --wide --strategy adb --density adb",
+                 "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts)");
+  expect_refused("query torus.obj torus.obj --pose 1,0,0 --wide --bv rbox",
+                 "bounding volume 'rbox' has no wide layout (the volumes that do: aabb, ");
+  expect_refused("query torus.obj torus.obj --pose 1,0,0 --wide --coherent", "give --coherent or --wide");
+#ifdef BVHLAB_HAVE_FCL
+  expect_refused("query torus.obj torus.obj --pose 1,0,0 --wide --bv fcl_obb",
+                 "FCL hierarchies have no wide");
+#endif
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Per-pose output
 

@@ -103,6 +103,32 @@ TEST_F(SceneTest, DefaultsFollowTheProtocol) {
   EXPECT_TRUE(scene.needs_density(scene.hierarchies[1]));
 }
 
+// "wide": a strategy's variants walk the wide layout, on the hierarchies whose volume has one (others are
+// left out, or refused when named); strategies without a wide walk, and coherent with wide, are refused.
+TEST_F(SceneTest, WideStrategiesRunWhereTheVolumeHasALayout) {
+  const Scene scene = parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "obb"}, {"bv": "rbox"}])",
+                                       R"([{"type": "exact"}, {"type": "exact", "wide": true}])", ""));
+  ASSERT_EQ(scene.strategies.size(), 2u);
+  EXPECT_FALSE(scene.strategies[0].wide);
+  EXPECT_TRUE(scene.strategies[1].wide);
+  EXPECT_EQ(expand(scene.strategies[1]).at(0).label(), "exact wide");
+  EXPECT_TRUE(scene.applies(scene.strategies[1], scene.hierarchies[0]));
+  EXPECT_FALSE(scene.applies(scene.strategies[1], scene.hierarchies[1]));  // rbox: no wide layout
+  EXPECT_TRUE(scene.applies(scene.strategies[0], scene.hierarchies[1]));
+  const auto refused = [&](const std::string& strategies, const std::string& expected) {
+    const std::string message = error_of(
+        scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "obb"}, {"bv": "rbox"}])", strategies, ""));
+    EXPECT_NE(message.find(expected), std::string::npos) << message;
+  };
+  refused(R"([{"type": "exact", "wide": true, "hierarchies": ["rbox"]}])",
+          "/strategies/0/hierarchies/0: bounding volume 'rbox' has no wide layout");
+  refused(R"([{"type": "guided_exact", "wide": true}])",
+          "/strategies/0/wide: strategy guided_exact does not run on wide trees");
+  refused(R"([{"type": "exact", "wide": true, "coherent": true}])",
+          "/strategies/0/wide: a coherent query walks the binary trees");
+  refused(R"([{"type": "exact", "wide": "yes"}])", "/strategies/0/wide: expected true or false");
+}
+
 TEST_F(SceneTest, CoherentStrategiesAndProtocolStrides) {
   const Scene scene =
       parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",

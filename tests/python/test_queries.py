@@ -337,6 +337,29 @@ def test_coherent_batches_answer_as_cold_ones_with_less_work(gear_trees, strateg
     np.testing.assert_array_equal(np.concatenate([first["bv_tests"], second["bv_tests"]]), coherent["bv_tests"])
 
 
+@pytest.mark.parametrize("strategy", ["exact", "all_contacts"])
+def test_wide_batches_answer_as_binary_ones(gear, strategy):
+    """wide=True walks the trees' wide layout: the binary walk's answers (and contacts) on fewer node pairs,
+    the single query too; refused by name where it does not run."""
+    trees = {bv: bvhlab.Tree(gear, bv, "none") for bv in ("obb", "rbox")}
+    tree = trees["obb"]
+    poses = np.concatenate([bvhlab.protocol_poses(d, 60) for d in (0.9, 1.4, 2.0)])
+    binary = bvhlab.query_batch(tree, tree, poses, strategy=strategy)
+    walked = bvhlab.query_batch(tree, tree, poses, strategy=strategy, wide=True)
+    for key in ("collides", "exact", "contact_count"):
+        np.testing.assert_array_equal(walked[key], binary[key], err_msg=key)
+    assert 0 < binary["collides"].sum() < len(poses)
+    assert walked["nodes_visited"].sum() < binary["nodes_visited"].sum()
+    single = bvhlab.query(tree, tree, poses[0], strategy=strategy, wide=True)
+    assert single.collides == bool(binary["collides"][0])
+    with pytest.raises(ValueError, match="strategy adb does not run on wide trees"):
+        bvhlab.query_batch(tree, tree, poses, strategy="adb", wide=True)
+    with pytest.raises(ValueError, match="bounding volume 'rbox' has no wide layout"):
+        bvhlab.query_batch(trees["rbox"], trees["rbox"], poses, strategy=strategy, wide=True)
+    with pytest.raises(ValueError, match="coherent or wide, not both"):
+        bvhlab.query_batch(tree, tree, poses, strategy=strategy, wide=True, coherent=True)
+
+
 def test_coherent_states_take_their_bounds(gear_trees):
     """CoherentState's keywords are its bounds: with max_jump 0 every pose that is not answered by the
     remembered contact or the root pair alone jumps, and jumps in a row cost the cold query's work (and at

@@ -1,0 +1,189 @@
+// Wide queries through the run-time layer (StrategyVariant::wide): the walk over the trees' wide layout
+// answers as the binary walk on every volume that has a layout, for trees of any density; it is refused by
+// name where it does not run; and a refit never leaves it reading the volumes from before.
+#include "engine/deforming.hpp"
+#include "engine/policies.hpp"
+#include "support/errors.hpp"
+#include "support/generated_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace bvhlab {
+namespace {
+
+using testing::error_of;
+
+/// Tilted about x while B slides across A: contact, then apart.
+std::vector<RigidTransform> sliding_poses() {
+  std::vector<RigidTransform> poses;
+  for (int i = 0; i < 40; ++i)
+    poses.push_back(RigidTransform{Eigen::AngleAxisd(0.9, Vec3::UnitX()).toRotationMatrix(),
+                                   Vec3(0.04 * i, 0.2, 0.01 * i)});
+  return poses;
+}
+
+std::vector<Result> results_of(const AnyTree& a, const AnyTree& b, const StrategyVariant& variant,
+                               const std::vector<RigidTransform>& poses) {
+  std::vector<Result> out(poses.size());
+  a.prepare(b, variant)->run(poses, [&](std::size_t i, const Result& r) { out[i] = r; });
+  return out;
+}
+
+StrategyVariant wide(StrategyVariant variant) {
+  variant.wide = true;
+  return variant;
+}
+
+std::vector<TrianglePair> sorted_contacts(std::vector<TrianglePair> contacts) {
+  std::sort(contacts.begin(), contacts.end(), [](const TrianglePair& x, const TrianglePair& y) {
+    return std::pair(x.a, x.b) < std::pair(y.a, y.b);
+  });
+  return contacts;
+}
+
+TEST(WideQuery, AnswersAsTheBinaryWalkOnEveryVolumeWithALayout) {
+  const Mesh torus_a = testing::make_torus(0.7, 0.25, 16, 8), torus_b = testing::make_torus(0.5, 0.2, 12, 8);
+  const auto poses = sliding_poses();
+  const StrategyVariant exact = strategy_variant("exact", {}, Budget{});
+  const StrategyVariant all = strategy_variant("all_contacts", {}, Budget{});
+  std::size_t volumes = 0, colliding = 0;
+  for (const std::string& bv : volume_names()) {
+    if (!wide_layout_refusal(bv).empty()) continue;
+    SCOPED_TRACE(bv);
+    ++volumes;
+    // An adb tree serves too: exact reads the hierarchy alone.
+    for (const char* density : {"none", "adb"}) {
+      const AnyTree a = AnyTree::build(torus_a, MeshUnits{}, bv, density_spec(density, {}), BuildOptions{});
+      const AnyTree b = AnyTree::build(torus_b, MeshUnits{}, bv, density_spec(density, {}), BuildOptions{});
+      const auto binary = results_of(a, b, exact, poses), walked = results_of(a, b, wide(exact), poses);
+      const auto contacts = results_of(a, b, all, poses), wide_contacts = results_of(a, b, wide(all), poses);
+      bool other_walk = false;  // the wide walk visits other node pairs: it is not the binary one again
+      for (std::size_t i = 0; i < poses.size(); ++i) {
+        EXPECT_EQ(walked[i].collides, binary[i].collides) << density << ", pose " << i;
+        EXPECT_TRUE(walked[i].exact);
+        const auto expected = sorted_contacts(contacts[i].contacts);
+        EXPECT_EQ(sorted_contacts(wide_contacts[i].contacts), expected) << density << ", pose " << i;
+        if (walked[i].witness)
+          EXPECT_TRUE(std::binary_search(expected.begin(), expected.end(), *walked[i].witness,
+                                         [](const TrianglePair& x, const TrianglePair& y) {
+                                           return std::pair(x.a, x.b) < std::pair(y.a, y.b);
+                                         }))
+              << density << ", pose " << i << ": the witness is not an intersecting pair";
+        other_walk = other_walk || walked[i].counters.nodes_visited != binary[i].counters.nodes_visited;
+        colliding += binary[i].collides;
+      }
+      EXPECT_TRUE(other_walk) << density;
+    }
+  }
+  EXPECT_GE(volumes, 4u);  // aabb, the k-DOPs, obb, sphere
+  EXPECT_GT(colliding, 0u);
+  EXPECT_LT(colliding, volumes * 2 * poses.size());
+}
+
+TEST(WideQuery, IsRefusedByNameWhereItDoesNotRun) {
+  const auto tree = [](const std::string& bv, const char* density) {
+    return AnyTree::build(testing::make_torus(0.7, 0.25, 12, 6), MeshUnits{}, bv, density_spec(density, {}),
+                          BuildOptions{});
+  };
+  StrategyVariant adb = wide(strategy_variant("adb", {}, Budget{}));
+  EXPECT_EQ(error_of([&] { check_strategy_options(adb); }),
+            "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts)");
+  const AnyTree adb_tree = tree("aabb", "adb");
+  EXPECT_EQ(error_of([&] { (void)adb_tree.prepare(adb_tree, adb); }),
+            "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts)");
+
+  const AnyTree rbox = tree("rbox", "none");
+  const std::string no_layout = error_of([&] { (void)rbox.prepare(rbox, wide(StrategyVariant{})); });
+  EXPECT_EQ(no_layout.rfind("bounding volume 'rbox' has no wide layout (the volumes that do: aabb, ", 0), 0u)
+      << no_layout;
+  EXPECT_EQ(wide_layout_refusal("rbox"), no_layout);
+  EXPECT_EQ(wide_layout_refusal("obb"), "");
+  EXPECT_NE(error_of([] { (void)wide_layout_refusal("octagon"); }).find("unknown bounding volume"),
+            std::string::npos);
+
+  StrategyVariant both = wide(StrategyVariant{});
+  both.coherent = true;
+  EXPECT_NE(error_of([&] { check_strategy_options(both); }).find("coherent or wide, not both"),
+            std::string::npos);
+  const AnyTree obb = tree("obb", "none");
+  EXPECT_NE(error_of([&] { (void)obb.prepare(obb, both); }).find("coherent or wide, not both"),
+            std::string::npos);
+  EXPECT_EQ(wide(StrategyVariant{}).label(), "exact wide");
+}
+
+TEST(WideQuery, APointCloudsTreeIsRefused) {
+  UnitCloud cloud;  // points on a ball (star-shaped: the normals are estimated from its centre)
+  for (int i = 0; i < 300; ++i) {
+    const double z = 1 - (2 * i + 1) / 300.0, r = std::sqrt(1 - z * z), phi = 2.399963 * i;
+    cloud.positions.push_back(0.5 * Vec3(r * std::cos(phi), r * std::sin(phi), z));
+  }
+  const AnyTree points = AnyTree::build_points(cloud, "aabb", density_spec("none", {}), BuildOptions{});
+  const AnyTree mesh = AnyTree::build(testing::make_torus(0.7, 0.25, 12, 6), MeshUnits{}, "aabb",
+                                      density_spec("none", {}), BuildOptions{});
+  for (const auto& sides : {std::pair{&points, &mesh}, std::pair{&mesh, &points}})
+    EXPECT_EQ(error_of([&] { (void)sides.first->prepare(*sides.second, wide(StrategyVariant{})); }),
+              "a wide query tests triangles at the leaves; a point cloud's tree has none");
+}
+
+// Each tree builds its wide layout on the first wide query, under its lock: threads preparing at once on
+// fresh trees, from either side, all get the binary walk's answers. (The ThreadSanitizer stage builds no
+// engine; tests/robustness/test_threads.cpp covers the typed queries there.)
+TEST(WideQuery, ThreadsPreparingAtOnceAnswerAsTheBinaryWalk) {
+  const AnyTree a = AnyTree::build(testing::make_torus(0.7, 0.25, 24, 12), MeshUnits{}, "obb",
+                                   density_spec("none", {}), BuildOptions{});
+  const AnyTree b = AnyTree::build(testing::make_torus(0.5, 0.2, 16, 8), MeshUnits{}, "obb",
+                                   density_spec("none", {}), BuildOptions{});
+  const auto poses = sliding_poses();
+  const StrategyVariant all = strategy_variant("all_contacts", {}, Budget{});
+  const std::vector<Result> ab = results_of(a, b, all, poses), ba = results_of(b, a, all, poses);
+  constexpr int kThreads = 4;
+  std::vector<std::vector<Result>> got(kThreads);
+  std::vector<std::thread> threads;
+  std::atomic<bool> go{false};
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      while (!go.load()) std::this_thread::yield();
+      got[t] = t % 2 ? results_of(b, a, wide(all), poses) : results_of(a, b, wide(all), poses);
+    });
+  go = true;
+  for (std::thread& thread : threads) thread.join();
+  for (int t = 0; t < kThreads; ++t)
+    for (std::size_t i = 0; i < poses.size(); ++i)
+      EXPECT_EQ(sorted_contacts(got[t][i].contacts), sorted_contacts((t % 2 ? ba : ab)[i].contacts))
+          << "thread " << t << ", pose " << i;
+}
+
+TEST(WideQuery, ARefitDropsTheLayoutOfTheVolumesBefore) {
+  const Mesh rest = testing::make_torus(0.7, 0.25, 24, 12);
+  Mesh moved = rest;  // the same triangles, half of the tube pulled outward
+  for (Vec3& v : moved.vertices)
+    if (v.x() > 0) v.x() += 0.6;
+  const AnyTree other = AnyTree::build(rest, MeshUnits{}, "obb", density_spec("none", {}), BuildOptions{});
+  DeformingTree tree(rest, "obb", BuildOptions{});
+  const StrategyVariant exact = wide(strategy_variant("exact", {}, Budget{}));
+  (void)tree.tree().prepare(other, exact);  // the wide layout of the rest shape is built and kept
+  tree.refit(moved, RefitMethod::Fit);
+  const AnyTree truth = AnyTree::build(moved, MeshUnits{}, "obb", density_spec("none", {}), BuildOptions{});
+  std::vector<RigidTransform> poses;  // B slides off A's pulled side: apart at 1.9 at rest, 2.5 refitted
+  for (int i = 0; i < 40; ++i) poses.push_back(RigidTransform::translate(Vec3(0.1 * i, 0.05, 0)));
+  const auto walked = results_of(tree.tree(), other, exact, poses);
+  const auto expected = results_of(truth, other, strategy_variant("exact", {}, Budget{}), poses);
+  std::size_t differ_from_rest = 0;
+  const auto at_rest = results_of(other, other, strategy_variant("exact", {}, Budget{}), poses);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    EXPECT_EQ(walked[i].collides, expected[i].collides) << "pose " << i;
+    differ_from_rest += expected[i].collides != at_rest[i].collides;
+  }
+  EXPECT_GT(differ_from_rest, 0u);  // the refit changed answers: a stale layout would show
+}
+
+}  // namespace
+}  // namespace bvhlab
