@@ -185,8 +185,14 @@ LINES = ["-", "--", ":", "-.", (0, (5, 1, 1, 1))]
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
 
 
+def walk_of(row):
+    """The strategy with how it walks the trees ("exact", "exact wide", "exact coherent"): what line and
+    marker tell apart."""
+    return " ".join([row["strategy"]] + [w for w in row.get("label", "").split() if w in ("wide", "coherent")])
+
+
 def style_for(hierarchy, strategy, hierarchies, strategies):
-    """Colour by hierarchy, line and marker by strategy (in the order the strategies first appear)."""
+    """Colour by hierarchy, line and marker by strategy and walk (walk_of, in the order they first appear)."""
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     colour = colours[hierarchies.index(hierarchy) % len(colours)]
     index = strategies.index(strategy) if strategy in strategies else 0
@@ -213,13 +219,13 @@ def exact_and_operating_panels(rows, args):
     its axes and [(panel, mesh, [(series rows, (colour, line, marker), label)])]."""
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
-    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
+    strategies = list(dict.fromkeys(walk_of(r) for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
     panels = []
     for (ax,), mesh in zip(per_mesh, meshes):
         shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
                  if is_exact(s[0]) or is_operating(s[0], args)]
-        panels.append((ax, mesh, [(s, style_for(s[0]["hierarchy"], s[0]["strategy"], hierarchies, strategies),
+        panels.append((ax, mesh, [(s, style_for(s[0]["hierarchy"], walk_of(s[0]), hierarchies, strategies),
                                    f"{s[0]['hierarchy']}: {series_label(s[0])}") for s in shown]))
     return fig, axes, panels
 
@@ -228,13 +234,13 @@ def figure_time_vs_distance(rows, args, out):
     """Time per query against distance, and below each panel the work that explains it: BV tests per query."""
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
-    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
+    strategies = list(dict.fromkeys(walk_of(r) for r in rows))
     fig, per_mesh, axes = subplots(len(meshes), rows_per_mesh=2, height=3.4)
     for (time_ax, work_ax), mesh in zip(per_mesh, meshes):
         shown = [s for s in grouped([r for r in rows if r["mesh"] == mesh]).values()
                  if is_exact(s[0]) or is_operating(s[0], args)]
         for i, series in enumerate(shown):
-            colour, line, marker = style_for(series[0]["hierarchy"], series[0]["strategy"], hierarchies, strategies)
+            colour, line, marker = style_for(series[0]["hierarchy"], walk_of(series[0]), hierarchies, strategies)
             style = dict(marker=marker, color=colour, label=f"{series[0]['hierarchy']}: {series_label(series[0])}",
                          **layered(i))
             d = [num(r["distance"]) for r in series]
@@ -301,7 +307,7 @@ def annotate_work(ax, x, y, bv_tests, colour):
 def figure_error_vs_time(rows, args, out):
     meshes = meshes_of(rows)
     hierarchies = list(dict.fromkeys(r["hierarchy"] for r in rows))
-    strategies = list(dict.fromkeys(r["strategy"] for r in rows))
+    strategies = list(dict.fromkeys(walk_of(r) for r in rows))
     fig, per_mesh, axes = subplots(len(meshes))
     for (ax,), mesh in zip(per_mesh, meshes):
         groups = grouped([r for r in rows if r["mesh"] == mesh])
@@ -315,7 +321,7 @@ def figure_error_vs_time(rows, args, out):
             if is_sweep(first, args):
                 curves.setdefault((first["hierarchy"], curve_name(first)), []).append((float(first["p_min"]), agg))
                 continue
-            colour, _, marker = style_for(first["hierarchy"], first["strategy"], hierarchies, strategies)
+            colour, _, marker = style_for(first["hierarchy"], walk_of(first), hierarchies, strategies)
             if first["budget"]:
                 marker = next(budget_markers, "D")
             ax.plot([agg["time"]], [100 * (agg["fp"] + agg["fn"])], marker, color=colour, linestyle="none",

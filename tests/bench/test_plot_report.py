@@ -144,6 +144,16 @@ class PminCurves(unittest.TestCase):
         self.assertEqual(plot_report.curve_name(confirming), "adb confirm_levels=1")
 
 
+class Walks(unittest.TestCase):
+    def test_a_wide_or_coherent_series_is_drawn_apart_from_its_strategy(self):
+        plain, wide, coherent = (result_row("", strategy="exact", exact="1") for _ in range(3))
+        wide["label"], coherent["label"] = "exact wide", "exact coherent"
+        walks = [plot_report.walk_of(r) for r in (plain, wide, coherent)]
+        self.assertEqual(walks, ["exact", "exact wide", "exact coherent"])
+        styles = {plot_report.style_for("aabb", w, ["aabb"], walks)[1:] for w in walks}
+        self.assertEqual(len(styles), 3)  # line and marker differ: one colour per hierarchy
+
+
 class Script(ReportScriptChecks, unittest.TestCase):
     """The command line; `bvhlab report`'s tests (test_bench_run) draw the five figures from a real run."""
 
