@@ -135,6 +135,7 @@ struct ModelInfo {
   std::size_t triangles = 0, nodes = 0, depth = 0;
   double model_bytes = 0, bytes_per_triangle = 0;
   double density_bytes = 0;  ///< what the density adds to model_bytes (a strategy without one reads less)
+  double wide_bytes = 0;     ///< the wide layout's, when a series walks it (not in model_bytes)
   double build_seconds = 0,
          annotate_seconds = 0;  ///< as measured when it was built (cached trees keep theirs)
   bool from_cache = false;

@@ -135,6 +135,10 @@ const TreeInfo& AnyTree::info() const {
   return model_->info;
 }
 
+double AnyTree::wide_layout_bytes() const {
+  return model_->wide_layout_bytes();
+}
+
 Box AnyTree::world_box(const RigidTransform& pose) const {
   return model_->world_box(pose);
 }

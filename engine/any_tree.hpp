@@ -152,6 +152,10 @@ class AnyTree {
   /// The saved-tree bytes save() writes (`source` names the tree in errors).
   [[nodiscard]] std::vector<std::byte> save_bytes(const std::string& source) const;
   [[nodiscard]] const TreeInfo& info() const;
+  /// The bytes of the tree's wide layout (what a wide query walks beside the binary tree's leaves), built
+  /// now if no wide query has built it yet. Throws std::invalid_argument for a volume without a layout or a
+  /// point cloud's tree.
+  [[nodiscard]] double wide_layout_bytes() const;
   /// The tree's world box when it is placed by `pose` (traversal/broad_phase/world_box.hpp).
   [[nodiscard]] Box world_box(const RigidTransform& pose) const;
 

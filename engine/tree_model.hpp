@@ -25,6 +25,8 @@ struct TreeModel {
                                                                std::shared_ptr<const TreeModel> b,
                                                                const StrategyVariant& variant) const = 0;
   [[nodiscard]] virtual Box world_box(const RigidTransform& pose) const = 0;
+  /// AnyTree::wide_layout_bytes.
+  [[nodiscard]] virtual double wide_layout_bytes() const = 0;
   /// schedule_frame on `pairs`, whose first A is this model.
   [[nodiscard]] virtual std::vector<PairOutcome> schedule(std::span<const FramePairRef> pairs,
                                                           const FrameOptions& options,

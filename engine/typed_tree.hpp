@@ -299,6 +299,15 @@ struct TypedBase : TreeModel {
     return out;
   }
 
+  [[nodiscard]] double wide_layout_bytes() const override {
+    if (side().is_cloud())
+      throw std::invalid_argument("a point cloud's tree has no wide layout (a wide query tests triangles)");
+    if constexpr (HasWideLayout<BV>)
+      return double(wide_of(*this).bytes());
+    else
+      throw std::invalid_argument(wide_layout_refusal(BV::name()));
+  }
+
   [[nodiscard]] Box world_box(const RigidTransform& pose) const override {
     // A refitted tree's bounds are not derived again: that would add a pass over its vertices to a refit.
     return bounds ? bvhlab::world_box(tree.bvh, pose, *bounds)

@@ -27,8 +27,10 @@ ResultRow series_row(const std::string& label, const HierarchySpec& h, const Mod
   row.p_min = variant.value_or("p_min", -1);
   row.budget = variant.budget_label();
   row.distance = distance;
-  // The bytes the strategy reads: a strategy that needs no density does not read the annotation.
+  // The bytes the strategy reads: a strategy that needs no density does not read the annotation; a wide walk
+  // reads the wide layout and the binary tree's leaves (both forms counted, as bench_wide counts them).
   row.model_bytes = strategy.needs_density ? model.model_bytes : model.model_bytes - model.density_bytes;
+  if (variant.wide) row.model_bytes += model.wide_bytes;
   row.bytes_per_triangle = model.triangles ? row.model_bytes / double(model.triangles) : 0;
   return row;
 }

@@ -396,6 +396,9 @@ std::unique_ptr<PreparedHierarchy> Preparation::hierarchy(const PlannedHierarchy
     const DensitySpec& density = planned.density;  // the plan decided whether the trees are annotated
     AnyTree ta = store_->tree(a, h, density, &info);
     AnyTree tb = &a == &b ? ta : store_->tree(b, h, density);
+    if (std::any_of(planned.variants.begin(), planned.variants.end(),
+                    [](const StrategyVariant& v) { return v.wide; }))
+      info.wide_bytes = ta.wide_layout_bytes();
     out = std::make_unique<BvhlabHierarchy>(std::move(ta), std::move(tb));
   }
   out->model = info;

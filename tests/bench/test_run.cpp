@@ -94,6 +94,29 @@ TEST_F(RunTest, ExactAabbSceneNeverAnnotatesNorBuildsFcl) {
   }
 }
 
+// A wide series answers as the binary one (0 errors against the ground truth), and its rows count the
+// bytes of both forms: the wide layout and the binary tree whose leaves it reads.
+TEST_F(RunTest, WideSeriesAnswerExactlyAndCountTheLayoutsBytes) {
+  const RunOutput run = run_scene(
+      scene(R"([{"bv": "obb"}, {"bv": "rbox"}])", R"([{"type": "exact"}, {"type": "exact", "wide": true}])"),
+      options);
+  std::size_t wide_rows = 0;
+  for (const ResultRow& r : run.rows) {
+    EXPECT_EQ(r.fp_rate, 0.0) << r.label;
+    EXPECT_EQ(r.fn_rate, 0.0) << r.label;
+    if (r.label != "exact wide") continue;
+    ++wide_rows;
+    EXPECT_EQ(r.hierarchy, "obb");  // rbox has no wide layout: left out
+    const auto binary = std::find_if(run.rows.begin(), run.rows.end(), [&](const ResultRow& b) {
+      return b.label == "exact" && b.hierarchy == r.hierarchy && b.distance == r.distance;
+    });
+    ASSERT_NE(binary, run.rows.end());
+    EXPECT_GT(r.bytes_per_triangle, binary->bytes_per_triangle);
+    EXPECT_LT(r.bytes_per_triangle, 2 * binary->bytes_per_triangle);  // a wide node per four binary ones
+  }
+  EXPECT_GT(wide_rows, 0u);
+}
+
 TEST_F(RunTest, AnnotationRunsOnlyWhereAStrategyNeedsIt) {
   const RunOutput run =
       run_scene(scene(R"([{"bv": "aabb"}, {"bv": "dop24"}])",
