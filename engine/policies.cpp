@@ -95,20 +95,28 @@ std::string StrategyInfo::volume_refusal(std::string_view bv) const {
          "', which has no distance bound (it runs on: " + joined_names(volumes) + ")";
 }
 
-std::string StrategyInfo::coherent_refusal() const {
-  if (coherent) return "";
+namespace {
+
+/// The registered strategies that have `flag`, comma-separated: what a refusal offers instead.
+std::string strategies_with(bool StrategyInfo::*flag) {
   std::string those;
   for (const StrategyInfo& s : strategy_table())
-    if (s.coherent) those += (those.empty() ? "" : ", ") + s.name;
-  return "strategy " + name + " does not run coherent (the strategies that do: " + those + ")";
+    if (s.*flag) those += (those.empty() ? "" : ", ") + s.name;
+  return those;
+}
+
+}  // namespace
+
+std::string StrategyInfo::coherent_refusal() const {
+  if (coherent) return "";
+  return "strategy " + name +
+         " does not run coherent (the strategies that do: " + strategies_with(&StrategyInfo::coherent) + ")";
 }
 
 std::string StrategyInfo::wide_refusal() const {
   if (wide) return "";
-  std::string those;
-  for (const StrategyInfo& s : strategy_table())
-    if (s.wide) those += (those.empty() ? "" : ", ") + s.name;
-  return "strategy " + name + " does not run on wide trees (the strategies that do: " + those + ")";
+  return "strategy " + name +
+         " does not run on wide trees (the strategies that do: " + strategies_with(&StrategyInfo::wide) + ")";
 }
 
 std::string wide_layout_refusal(std::string_view bv) {
@@ -127,11 +135,8 @@ std::string wide_layout_refusal(std::string_view bv) {
 
 std::string StrategyInfo::contact_geometry_refusal() const {
   if (needs_polygons) return "";
-  std::string those;
-  for (const StrategyInfo& s : strategy_table())
-    if (s.needs_polygons) those += (those.empty() ? "" : ", ") + s.name;
   return "strategy " + name + " tests no triangles, so it names no contacts to give the geometry of (the " +
-         "strategies that do: " + those + ")";
+         "strategies that do: " + strategies_with(&StrategyInfo::needs_polygons) + ")";
 }
 
 const ParamSpec* StrategyInfo::parameter(std::string_view name) const {

@@ -88,6 +88,36 @@ TEST(WideQuery, AnswersAsTheBinaryWalkOnEveryVolumeWithALayout) {
   EXPECT_LT(colliding, volumes * 2 * poses.size());
 }
 
+// A saved tree loaded with its mesh walks wide as the tree it was saved from (the layout is derived from
+// the binary tree, which is what the file keeps), and the contacts' geometry is the binary walk's.
+TEST(WideQuery, ALoadedTreeAndContactGeometryWalkWideToo) {
+  const Mesh torus = testing::make_torus(0.7, 0.25, 16, 8);
+  const AnyTree built = AnyTree::build(torus, MeshUnits{}, "dop24", density_spec("none", {}), BuildOptions{});
+  const AnyTree loaded = AnyTree::from_bytes(built.save_bytes("torus"), "torus", &torus);
+  StrategyVariant all = strategy_variant("all_contacts", {}, Budget{});
+  all.contact_geometry = true;
+  const auto poses = sliding_poses();
+  const auto binary = results_of(built, built, all, poses),
+             walked = results_of(loaded, loaded, wide(all), poses);
+  std::size_t contacts = 0;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    ASSERT_EQ(walked[i].contact_geometry.size(), binary[i].contact_geometry.size()) << "pose " << i;
+    const auto by_pair = [](const ContactGeometry& x, const ContactGeometry& y) {
+      return std::pair(x.triangles.a, x.triangles.b) < std::pair(y.triangles.a, y.triangles.b);
+    };
+    auto expected = binary[i].contact_geometry, got = walked[i].contact_geometry;
+    std::sort(expected.begin(), expected.end(), by_pair);
+    std::sort(got.begin(), got.end(), by_pair);
+    for (std::size_t k = 0; k < got.size(); ++k) {
+      EXPECT_EQ(got[k].triangles, expected[k].triangles);
+      EXPECT_EQ(got[k].point, expected[k].point);
+      EXPECT_EQ(got[k].normal, expected[k].normal);
+    }
+    contacts += got.size();
+  }
+  EXPECT_GT(contacts, 0u);
+}
+
 TEST(WideQuery, IsRefusedByNameWhereItDoesNotRun) {
   const auto tree = [](const std::string& bv, const char* density) {
     return AnyTree::build(testing::make_torus(0.7, 0.25, 12, 6), MeshUnits{}, bv, density_spec(density, {}),
