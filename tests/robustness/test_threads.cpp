@@ -1,14 +1,16 @@
 // Threads: queries from several threads on shared trees give exactly the single-threaded answers, for every
 // registered BV and every strategy (exact first and all contacts, ADB with p_min, ADB under a BV-test budget,
-// guided exact; no deadlines, whose answers depend on timing). Loading, building and annotating concurrently
-// give the same meshes and trees as doing it alone. Run under ThreadSanitizer by the tsan preset (label
-// threads), which also catches races that happen not to change an answer.
+// guided exact; no deadlines, whose answers depend on timing), and the wide walk on shared wide trees.
+// Loading, building and annotating concurrently give the same meshes and trees as doing it alone. Run under
+// ThreadSanitizer by the tsan preset (label threads), which also catches races that happen not to change an
+// answer.
 #include "bvh/mesh_io.hpp"
 #include "engine/mesh_catalog.hpp"
 #include "engine/protocol.hpp"
 #include "engine/registry.hpp"
 #include "robust_support.hpp"
 #include "support/meshes.hpp"
+#include "traversal/wide_exact.hpp"
 
 #include <gtest/gtest.h>
 
@@ -50,6 +52,27 @@ std::vector<RigidTransform> poses() {
   return out;
 }
 
+// query(i) for i < n from kThreads threads at once, each starting at another i: per thread its answers.
+// Each thread keeps its own results; the caller compares after the join (gtest is not asked to be
+// thread-safe on failures).
+template <class Query>
+std::vector<std::vector<Result>> answers_from_threads(std::size_t n, const Query& query) {
+  std::vector<std::vector<Result>> got(kThreads, std::vector<Result>(n));
+  std::vector<std::thread> threads;
+  std::atomic<bool> go{false};
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      while (!go.load()) std::this_thread::yield();
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t i = (k + t * n / kThreads) % n;
+        got[t][i] = query(i);
+      }
+    });
+  go = true;
+  for (auto& thread : threads) thread.join();
+  return got;
+}
+
 TEST(Threads, SharedTreesAnswerAsSingleThreadedForEveryVolumeAndStrategy) {
   const Mesh jeep = load_protocol_mesh("jeep1.ms3d");
   const auto queries = poses();
@@ -67,21 +90,7 @@ TEST(Threads, SharedTreesAnswerAsSingleThreadedForEveryVolumeAndStrategy) {
     };
     std::vector<Result> reference(n);
     for (std::size_t i = 0; i < n; ++i) reference[i] = query(i);
-    // Each thread keeps its own results; comparisons happen after the join (gtest is not asked to be
-    // thread-safe on failures).
-    std::vector<std::vector<Result>> got(kThreads, std::vector<Result>(n));
-    std::vector<std::thread> threads;
-    std::atomic<bool> go{false};
-    for (int t = 0; t < kThreads; ++t)
-      threads.emplace_back([&, t] {
-        while (!go.load()) std::this_thread::yield();
-        for (std::size_t k = 0; k < n; ++k) {
-          const std::size_t i = (k + t * n / kThreads) % n;
-          got[t][i] = query(i);
-        }
-      });
-    go = true;
-    for (auto& thread : threads) thread.join();
+    const auto got = answers_from_threads(n, query);
     for (int t = 0; t < kThreads; ++t)
       for (std::size_t i = 0; i < n; ++i)
         ASSERT_TRUE(same(reference[i], got[t][i]))
@@ -90,6 +99,37 @@ TEST(Threads, SharedTreesAnswerAsSingleThreadedForEveryVolumeAndStrategy) {
     ++volumes;
   });
   EXPECT_GT(volumes, 0);
+}
+
+// The wide walk on shared wide trees (bvh/wide_bvh.hpp): every volume with a four-lane layout, first and
+// all contacts, from several threads at once, gives the single-threaded answers and work counters.
+TEST(Threads, SharedWideTreesAnswerAsSingleThreaded) {
+  const Mesh jeep = load_protocol_mesh("jeep1.ms3d");
+  const auto queries = poses();
+  int volumes = 0;
+  with_each_volume([&](auto id) {
+    using BV = typename decltype(id)::type;
+    if constexpr (HasWideLayout<BV>) {
+      SCOPED_TRACE(std::string(BV::name()));
+      const auto tree = Bvh<BV>::build(jeep);
+      const auto wide = WideTreeOf<BV>::build(tree);
+      const std::size_t n = queries.size() * 2;
+      auto query = [&](std::size_t i) {
+        const ContactMode mode = i % 2 == 0 ? ContactMode::First : ContactMode::All;
+        Result r = query_exact_wide(tree, wide, tree, wide, queries[i / 2], mode);
+        std::sort(r.contacts.begin(), r.contacts.end());
+        return r;
+      };
+      std::vector<Result> reference(n);
+      for (std::size_t i = 0; i < n; ++i) reference[i] = query(i);
+      const auto got = answers_from_threads(n, query);
+      for (int t = 0; t < kThreads; ++t)
+        for (std::size_t i = 0; i < n; ++i)
+          ASSERT_TRUE(same(reference[i], got[t][i])) << "thread " << t << ", query " << i;
+      ++volumes;
+    }
+  });
+  EXPECT_GE(volumes, 4);  // boxes, the k-DOPs, spheres, OBBs
 }
 
 // The loader installs one process-wide assimp logger and captures messages per thread; concurrent loads must
