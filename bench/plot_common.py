@@ -51,6 +51,25 @@ def report_main(script, doc, required, draw, optional=(), add_options=None, refu
     draw(args, *tables)
 
 
+def draw_each(jobs, workers=None):
+    """Runs each job, a tuple (function, *arguments) that draws and saves one figure: on a machine of several
+    cores in forked processes, one figure a process (matplotlib is not thread-safe), started in the order
+    given (list the longest first), else one after another. A job's exception is raised here. Each job must
+    only write its own file: nothing comes back from a process."""
+    import concurrent.futures
+    import multiprocessing
+
+    workers = min(len(jobs), workers or os.cpu_count() or 1)
+    if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+        for function, *arguments in jobs:
+            function(*arguments)
+        return
+    context = multiprocessing.get_context("fork")
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
+        for future in [pool.submit(function, *arguments) for function, *arguments in jobs]:
+            future.result()
+
+
 def save(fig, out, dpi, rect=(0, 0, 1, 1)):
     """Lays the figure out within `rect` (figure fractions: room left for a legend beside it), writes it to
     `out` and frees it (a report draws several in one process)."""

@@ -4,6 +4,7 @@ labels apart, numbers on short log axes, series side by side rather than on top 
 Run by ctest with BVHLAB_SOURCE_DIR set; plain unittest, so it needs nothing beyond matplotlib.
 """
 import math
+import os
 import unittest
 
 from plot_script_checks import ReportScriptChecks  # first: it puts bench/ on sys.path
@@ -162,6 +163,40 @@ class Script(ReportScriptChecks, unittest.TestCase):
 
     def test_refuses_without_results(self):
         self.assertRefusesWithoutEachRequiredTable({"results.csv": [result_row("0.9")]})
+
+
+def write_text(path, text):
+    with open(path, "w") as f:
+        f.write(text)
+
+
+def fail_drawing(path):
+    raise ValueError(f"cannot draw {path}")
+
+
+class DrawEach(unittest.TestCase):
+    """The figures are drawn side by side in processes: every job runs, in one process or several, and a
+    job's failure reaches the caller."""
+
+    def test_every_job_runs_whatever_the_workers(self):
+        import tempfile
+
+        import plot_common
+
+        for workers in (1, 2):
+            with tempfile.TemporaryDirectory() as folder:
+                paths = [os.path.join(folder, f"{k}.txt") for k in range(5)]
+                plot_common.draw_each([(write_text, p, p) for p in paths], workers=workers)
+                for p in paths:
+                    with open(p) as f:
+                        self.assertEqual(f.read(), p)
+
+    def test_a_failing_job_is_raised(self):
+        import plot_common
+
+        for workers in (1, 2):
+            with self.assertRaisesRegex(ValueError, "cannot draw fig4"):
+                plot_common.draw_each([(write_text, os.devnull, ""), (fail_drawing, "fig4")], workers=workers)
 
 
 class Dodge(unittest.TestCase):
