@@ -414,28 +414,35 @@ TEST_F(Cli, PoseListsAreQueriedInOrder) {
                  "one of --pose, --protocol, --poses");
 }
 
+// Two --json runs of the same poses: the same exact answers, in order, some colliding and some not, and
+// the second with less of `work` in all.
+void expect_same_answers_with_less_work(const std::string& reference_out, const std::string& other_out,
+                                        const char* work, std::size_t poses) {
+  const nlohmann::json reference = nlohmann::json::parse(reference_out)["results"];
+  const nlohmann::json other = nlohmann::json::parse(other_out)["results"];
+  ASSERT_EQ(reference.size(), poses);
+  ASSERT_EQ(other.size(), poses);
+  std::size_t colliding = 0;
+  std::uint64_t reference_work = 0, other_work = 0;
+  for (std::size_t k = 0; k < poses; ++k) {
+    EXPECT_EQ(other[k]["step"], k);
+    EXPECT_EQ(other[k]["collides"], reference[k]["collides"]) << k;
+    EXPECT_EQ(other[k]["exact"], true) << k;
+    colliding += reference[k]["collides"].get<bool>();
+    reference_work += reference[k][work].get<std::uint64_t>();
+    other_work += other[k][work].get<std::uint64_t>();
+  }
+  EXPECT_GT(colliding, 0u);
+  EXPECT_LT(colliding, poses);
+  EXPECT_LT(other_work, reference_work) << work;
+}
+
 // --coherent over a protocol turn (--protocol DISTANCE,STEPS: every step in order): the cold answers, with
 // fewer BV tests in all; strategies that do not run coherent and FCL hierarchies are refused by name.
 TEST_F(Cli, CoherentQueriesAnswerAsColdOverAProtocolTurn) {
   testing::write_obj(testing::make_torus(0.7, 0.25, 24, 12), dir / "torus.obj");
   const std::string turn = "query torus.obj torus.obj --protocol 1.2,120 --json";
-  const nlohmann::json cold = nlohmann::json::parse(ok(turn).out)["results"];
-  const nlohmann::json coherent = nlohmann::json::parse(ok(turn + " --coherent").out)["results"];
-  ASSERT_EQ(cold.size(), 120u);
-  ASSERT_EQ(coherent.size(), 120u);
-  std::size_t colliding = 0;
-  std::uint64_t cold_tests = 0, coherent_tests = 0;
-  for (std::size_t k = 0; k < cold.size(); ++k) {
-    EXPECT_EQ(coherent[k]["step"], k);
-    EXPECT_EQ(coherent[k]["collides"], cold[k]["collides"]) << k;
-    EXPECT_EQ(coherent[k]["exact"], true) << k;
-    colliding += cold[k]["collides"].get<bool>();
-    cold_tests += cold[k]["bv_tests"].get<std::uint64_t>();
-    coherent_tests += coherent[k]["bv_tests"].get<std::uint64_t>();
-  }
-  EXPECT_GT(colliding, 0u);
-  EXPECT_LT(colliding, cold.size());
-  EXPECT_LT(coherent_tests, cold_tests);
+  expect_same_answers_with_less_work(ok(turn).out, ok(turn + " --coherent").out, "bv_tests", 120);
   const std::string text = ok("query torus.obj torus.obj --protocol 1.2,120 --coherent --all-contacts").out;
   EXPECT_NE(text.find("torus vs torus, all_contacts coherent on aabb, 120 poses\n"), std::string::npos)
       << text;
@@ -456,22 +463,8 @@ TEST_F(Cli, CoherentQueriesAnswerAsColdOverAProtocolTurn) {
 TEST_F(Cli, WideQueriesAnswerAsTheBinaryWalk) {
   testing::write_obj(testing::make_torus(0.7, 0.25, 24, 12), dir / "torus.obj");
   const std::string turn = "query torus.obj torus.obj --protocol 1.2,120 --json --bv obb";
-  const nlohmann::json binary = nlohmann::json::parse(ok(turn).out)["results"];
-  const nlohmann::json walked = nlohmann::json::parse(ok(turn + " --wide").out)["results"];
-  ASSERT_EQ(binary.size(), 120u);
-  ASSERT_EQ(walked.size(), 120u);
-  std::size_t colliding = 0;
-  std::uint64_t binary_pairs = 0, wide_pairs = 0;
-  for (std::size_t k = 0; k < binary.size(); ++k) {
-    EXPECT_EQ(walked[k]["collides"], binary[k]["collides"]) << k;
-    EXPECT_EQ(walked[k]["exact"], true) << k;
-    colliding += binary[k]["collides"].get<bool>();
-    binary_pairs += binary[k]["nodes_visited"].get<std::uint64_t>();
-    wide_pairs += walked[k]["nodes_visited"].get<std::uint64_t>();
-  }
-  EXPECT_GT(colliding, 0u);
-  EXPECT_LT(colliding, binary.size());
-  EXPECT_LT(wide_pairs, binary_pairs);  // four children settled a step
+  // Fewer node pairs: four children settled a step.
+  expect_same_answers_with_less_work(ok(turn).out, ok(turn + " --wide").out, "nodes_visited", 120);
   const std::string text =
       ok("query torus.obj torus.obj --protocol 1.2,12 --bv dop24 --wide --all-contacts").out;
   EXPECT_NE(text.find("torus vs torus, all_contacts wide on dop24, 12 poses\n"), std::string::npos) << text;

@@ -73,6 +73,17 @@ std::vector<std::vector<Result>> answers_from_threads(std::size_t n, const Query
   return got;
 }
 
+// query(i) for every i < n from kThreads threads gives what it gives on one thread; describe(i) names i.
+template <class Query, class Describe>
+void expect_threads_answer_alone(std::size_t n, const Query& query, const Describe& describe) {
+  std::vector<Result> reference(n);
+  for (std::size_t i = 0; i < n; ++i) reference[i] = query(i);
+  const auto got = answers_from_threads(n, query);
+  for (int t = 0; t < kThreads; ++t)
+    for (std::size_t i = 0; i < n; ++i)
+      ASSERT_TRUE(same(reference[i], got[t][i])) << "thread " << t << ", " << describe(i);
+}
+
 TEST(Threads, SharedTreesAnswerAsSingleThreadedForEveryVolumeAndStrategy) {
   const Mesh jeep = load_protocol_mesh("jeep1.ms3d");
   const auto queries = poses();
@@ -88,14 +99,10 @@ TEST(Threads, SharedTreesAnswerAsSingleThreadedForEveryVolumeAndStrategy) {
       std::sort(r.contacts.begin(), r.contacts.end());
       return r;
     };
-    std::vector<Result> reference(n);
-    for (std::size_t i = 0; i < n; ++i) reference[i] = query(i);
-    const auto got = answers_from_threads(n, query);
-    for (int t = 0; t < kThreads; ++t)
-      for (std::size_t i = 0; i < n; ++i)
-        ASSERT_TRUE(same(reference[i], got[t][i]))
-            << "thread " << t << ", " << to_string(kAllStrategies[i % kAllStrategies.size()]) << ", pose "
-            << i / kAllStrategies.size();
+    expect_threads_answer_alone(n, query, [](std::size_t i) {
+      return to_string(kAllStrategies[i % kAllStrategies.size()]) + ", pose " +
+             std::to_string(i / kAllStrategies.size());
+    });
     ++volumes;
   });
   EXPECT_GT(volumes, 0);
@@ -120,12 +127,7 @@ TEST(Threads, SharedWideTreesAnswerAsSingleThreaded) {
         std::sort(r.contacts.begin(), r.contacts.end());
         return r;
       };
-      std::vector<Result> reference(n);
-      for (std::size_t i = 0; i < n; ++i) reference[i] = query(i);
-      const auto got = answers_from_threads(n, query);
-      for (int t = 0; t < kThreads; ++t)
-        for (std::size_t i = 0; i < n; ++i)
-          ASSERT_TRUE(same(reference[i], got[t][i])) << "thread " << t << ", query " << i;
+      expect_threads_answer_alone(n, query, [](std::size_t i) { return "query " + std::to_string(i); });
       ++volumes;
     }
   });
