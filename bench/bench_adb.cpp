@@ -3,16 +3,16 @@
 // false-positive and false-negative rates against exact ground truth, BV tests per query. At the end, a
 // summary per mesh: for every p_min the mean time, the total error, and the speed-up over each exact tree;
 // and the operating point: the fastest p_min whose total error is at most 4%.
+// The trees and queries are the run-time layer's (engine/any_tree.hpp), compiled once in the engine: a pass
+// over a distance's poses is one PreparedQuery::run, each answer handed back through one indirect call.
 //
 //   bench_adb [--meshes=a,b] [--steps=200] [--p-min=0.5,0.7,...] [--exact=aabb,dop24] [--grid=2]
 //             [--tau=0.5] [--distances=1.2,1.4,...] [benchmark flags]
-#include "adb/adb_density.hpp"
 #include "bench/core/bench_flags.hpp"
+#include "engine/any_tree.hpp"
 #include "engine/mesh_catalog.hpp"
 #include "engine/protocol.hpp"
-#include "engine/registry.hpp"
-#include "traversal/adb.hpp"
-#include "traversal/exact.hpp"
+#include "engine/specs.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -41,23 +41,23 @@ struct Measured {
 // (mesh, strategy label) -> per distance. Filled by the benchmark bodies; read by the summary.
 std::map<std::pair<std::string, std::string>, std::map<double, Measured>> g_measured;
 
-template <class Query>
-void run_poses(benchmark::State& state, const Workload& w, std::size_t d, Query&& query, Measured& out) {
+void run_poses(benchmark::State& state, const Workload& w, std::size_t d, const PreparedQuery& query,
+               Measured& out) {
   const auto& poses = w.poses[d];
   const auto& truth = w.truth[d];
   std::size_t fp = 0, fn = 0;
   double bv_tests = 0;
+  const ResultSink count = [&](std::size_t k, const Result& r) {
+    fp += r.collides && !truth[k];
+    fn += !r.collides && truth[k];
+    bv_tests += static_cast<double>(r.counters.bv_tests);
+  };
   std::size_t passes = 0;
   const auto start = std::chrono::steady_clock::now();
   for (auto _ : state) {
     fp = fn = 0;
     bv_tests = 0;
-    for (std::size_t k = 0; k < poses.size(); ++k) {
-      const Result r = query(poses[k]);
-      fp += r.collides && !truth[k];
-      fn += !r.collides && truth[k];
-      bv_tests += static_cast<double>(r.counters.bv_tests);
-    }
+    query.run(poses, count);
     ++passes;
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -70,43 +70,39 @@ void run_poses(benchmark::State& state, const Workload& w, std::size_t d, Query&
   state.counters["bv_tests"] = bv_tests / n;
 }
 
-template <int G>
-void register_adb(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w,
-                  const std::vector<double>& p_mins, double tau) {
-  AnnotateStats stats;
-  auto tree = std::make_shared<const Tree<Aabb, AdbDensity>>(
-      annotate_adb(Bvh<Aabb>::build(mesh), G, tau, {}, &stats));
-  std::fprintf(stderr, "bench_adb: %s annotated (g = %d) in %.2f s\n", label.c_str(), G, stats.seconds);
-  for (double p_min : p_mins) {
-    char strategy[64];
-    std::snprintf(strategy, sizeof strategy, "adb_aabb_g%d/p:%.2f", G, p_min);
-    for (std::size_t d = 0; d < w->distances.size(); ++d) {
-      char name[160];
-      std::snprintf(name, sizeof name, "%s/%s/d:%.1f", label.c_str(), strategy, w->distances[d]);
-      benchmark::RegisterBenchmark(name, [=](benchmark::State& state) {
-        AdbOptions options;
-        options.p_min = p_min;
-        run_poses(
-            state, *w, d, [&](const RigidTransform& pose) { return query_adb(*tree, *tree, pose, options); },
-            g_measured[{label, strategy}][w->distances[d]]);
-      })->Unit(benchmark::kMillisecond);
-    }
-  }
-}
-
-template <class BV>
-void register_exact(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w) {
-  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(mesh));
-  const std::string strategy = "exact_" + std::string(BV::name());
+/// One benchmark per distance of `variant` on `tree` against itself, named label/strategy/d:….
+void register_series(const std::string& label, const std::string& strategy,
+                     const std::shared_ptr<const AnyTree>& tree, const StrategyVariant& variant,
+                     const std::shared_ptr<const Workload>& w) {
+  const std::shared_ptr<const PreparedQuery> query = tree->prepare(*tree, variant);
   for (std::size_t d = 0; d < w->distances.size(); ++d) {
     char name[160];
     std::snprintf(name, sizeof name, "%s/%s/d:%.1f", label.c_str(), strategy.c_str(), w->distances[d]);
     benchmark::RegisterBenchmark(name, [=](benchmark::State& state) {
-      run_poses(
-          state, *w, d, [&](const RigidTransform& pose) { return query_exact(*tree, *tree, pose); },
-          g_measured[{label, strategy}][w->distances[d]]);
+      run_poses(state, *w, d, *query, g_measured[{label, strategy}][w->distances[d]]);
     })->Unit(benchmark::kMillisecond);
   }
+}
+
+void register_adb(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w,
+                  const std::vector<double>& p_mins, int grid, double tau) {
+  const AnyTree plain = AnyTree::build(mesh, MeshUnits{}, "aabb", density_spec("none", {}), BuildOptions{});
+  AnnotateStats stats;
+  const DensitySpec adb = density_spec("adb", {{"grid", grid}, {"tau", tau}});
+  const auto tree = std::make_shared<const AnyTree>(plain.annotated(adb, AnnotationContext{}, &stats));
+  std::fprintf(stderr, "bench_adb: %s annotated (g = %d) in %.2f s\n", label.c_str(), grid, stats.seconds);
+  for (double p_min : p_mins) {
+    char strategy[64];
+    std::snprintf(strategy, sizeof strategy, "adb_aabb_g%d/p:%.2f", grid, p_min);
+    register_series(label, strategy, tree, strategy_variant("adb", {{"p_min", p_min}}, Budget{}), w);
+  }
+}
+
+void register_exact(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w,
+                    const std::string& bv) {
+  const auto tree = std::make_shared<const AnyTree>(
+      AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{}));
+  register_series(label, "exact_" + bv, tree, strategy_variant("exact", {}, Budget{}), w);
 }
 
 void print_summary(const std::vector<std::string>& exact_names) {
@@ -173,7 +169,7 @@ int main(int argc, char** argv) {
   std::vector<double> p_mins{0.5, 0.7, 0.8, 0.9, 0.95, 0.99};
   std::vector<double> distances = ProtocolOptions{}.distances;
   int steps = 200, grid = 2;
-  double tau = kDefaultAdbTau;
+  double tau = density_spec("adb", {}).values.at("tau");  // the density's default
   if (auto exit = initialize_benchmark("bench_adb",
                                        {{"meshes", &meshes, "meshes to run"},
                                         {"exact", &exact, "exact hierarchies to compare with"},
@@ -196,18 +192,17 @@ int main(int argc, char** argv) {
       const std::string label = std::filesystem::path(file).stem().string();
       auto workload = std::make_shared<Workload>();
       workload->distances = distances;
-      const auto truth_tree = Bvh<Aabb>::build(mesh);  // exact, and equal to CGAL (tests/traversal)
+      // The truth: the exact AABB tree's answers, equal to CGAL's (tests/traversal).
+      const AnyTree truth_tree = AnyTree::build(mesh, MeshUnits{}, "aabb", density_spec("none", {}), {});
+      const auto truth_query = truth_tree.prepare(truth_tree, strategy_variant("exact", {}, Budget{}));
       for (double d : distances) {
         workload->poses.push_back(protocol_poses(d, steps));
-        auto& truth = workload->truth.emplace_back();
-        for (const auto& pose : workload->poses.back())
-          truth.push_back(query_exact(truth_tree, truth_tree, pose).collides);
+        auto& truth = workload->truth.emplace_back(workload->poses.back().size());
+        truth_query->run(workload->poses.back(),
+                         [&](std::size_t k, const Result& r) { truth[k] = r.collides; });
       }
-      for (const auto& e : exact)
-        with_volume(e, [&]<class BV>(std::type_identity<BV>) { register_exact<BV>(label, mesh, workload); });
-      if (grid == 2) register_adb<2>(label, mesh, workload, p_mins, tau);
-      if (grid == 3) register_adb<3>(label, mesh, workload, p_mins, tau);
-      if (grid == 4) register_adb<4>(label, mesh, workload, p_mins, tau);
+      for (const auto& e : exact) register_exact(label, mesh, workload, e);
+      register_adb(label, mesh, workload, p_mins, grid, tau);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_adb: %s\n", e.what());
