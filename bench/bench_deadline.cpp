@@ -8,16 +8,17 @@
 // least 1 us (gaps between back-to-back clock reads) without a context switch: time the machine takes
 // (timer interrupts, the hypervisor). A stall that begins before a deadline and ends after it delays the
 // answer past it, whatever the query does, so it shows in p99_us once stalls take about 1% of the time.
+// The trees and queries are the run-time layer's (engine/any_tree.hpp): a timed query is one
+// PreparedQuery::run of one pose: its call and the answer handed back add about 30 ns to the times.
 //
 //   bench_deadline [--meshes=injector_pipes.stl,occt_tr12j_housing.stl] [--bv=aabb,obb]
 //                  [--deadlines=2,5,10,20] [--distances=1.2,1.4,1.6,1.8] [--steps=500] [--min-pops=40]
 //                  [benchmark flags]
-#include "adb/adb_density.hpp"
 #include "bench/core/bench_flags.hpp"
+#include "engine/any_tree.hpp"
 #include "engine/mesh_catalog.hpp"
 #include "engine/protocol.hpp"
-#include "engine/registry.hpp"
-#include "traversal/adb.hpp"
+#include "engine/specs.hpp"
 
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -68,24 +69,28 @@ double stall_share(std::chrono::milliseconds span) {
 }
 
 /// Times every pose warm (one untimed query, then one timed), once per benchmark iteration.
-template <class BV>
-void run_deadline(benchmark::State& state, const Tree<BV, AdbDensity>& tree,
-                  const std::vector<RigidTransform>& poses, const AdbOptions& options) {
+void run_deadline(benchmark::State& state, const PreparedQuery& query,
+                  const std::vector<RigidTransform>& poses, double deadline_us) {
   std::vector<double> micros, undisturbed;
   std::size_t flagged = 0;
-  bool sink = false;
+  bool collides = false, exhausted = false, sink = false;
+  const ResultSink keep = [&](std::size_t, const Result& r) {
+    collides = r.collides;
+    exhausted = r.budget_exhausted;
+  };
   for (auto _ : state) {
     for (const RigidTransform& pose : poses) {
-      sink ^= query_adb(tree, tree, pose, options).collides;  // warms the caches for this pose
+      query.run({&pose, 1}, keep);  // warms the caches for this pose
+      sink ^= collides;
       const long switches = context_switches();
       const auto start = Clock::now();
-      const Result r = query_adb(tree, tree, pose, options);
+      query.run({&pose, 1}, keep);
       const auto stop = Clock::now();
       const double us = std::chrono::duration<double, std::micro>(stop - start).count();
       micros.push_back(us);
       if (context_switches() == switches) undisturbed.push_back(us);
-      flagged += r.budget_exhausted;
-      sink ^= r.collides;
+      flagged += exhausted;
+      sink ^= collides;
     }
   }
   benchmark::DoNotOptimize(sink);
@@ -105,8 +110,8 @@ void run_deadline(benchmark::State& state, const Tree<BV, AdbDensity>& tree,
   state.counters["flagged"] = static_cast<double>(flagged) / static_cast<double>(micros.size());
   state.counters["poses"] = static_cast<double>(poses.size());
   state.counters["stall_share"] = stall_share(std::chrono::milliseconds(100));
-  if (options.budget.deadline_us > 0 && options.budget.deadline_us < 1e9)
-    state.counters["p99_over_us"] = quantile(micros, 0.99) - options.budget.deadline_us;
+  if (deadline_us > 0 && deadline_us < 1e9)
+    state.counters["p99_over_us"] = quantile(micros, 0.99) - deadline_us;
 }
 
 struct Setup {
@@ -116,35 +121,39 @@ struct Setup {
   std::uint64_t min_pops = 40;
 };
 
-template <class BV>
-void register_mesh(const std::string& label, const Mesh& mesh, const Setup& setup) {
-  auto tree = std::make_shared<const Tree<BV, AdbDensity>>(annotate_adb(Bvh<BV>::build(mesh), 2));
+/// ADB at p_min 0.9 without a budget, or time-critical with a deadline of `deadline_us`.
+StrategyVariant adb_variant(double deadline_us) {
+  if (deadline_us == 0) return strategy_variant("adb", {{"p_min", 0.9}}, Budget{});
+  return strategy_variant("time_critical", {{"p_min", 0.9}}, Budget{.deadline_us = deadline_us});
+}
+
+void register_mesh(const std::string& label, const std::string& bv, const Mesh& mesh, const Setup& setup) {
+  const auto tree = std::make_shared<const AnyTree>(
+      AnyTree::build(mesh, MeshUnits{}, bv, density_spec("adb", {{"grid", 2}}), BuildOptions{}));
   auto poses = std::make_shared<std::vector<RigidTransform>>();
-  AdbOptions unbudgeted;
-  unbudgeted.p_min = 0.9;
-  for (double d : setup.distances)
-    for (const RigidTransform& pose : protocol_poses(d, setup.steps))
-      if (query_adb(*tree, *tree, pose, unbudgeted).counters.nodes_visited >= setup.min_pops)
-        poses->push_back(pose);
+  const auto unbudgeted = tree->prepare(*tree, adb_variant(0));
+  for (double d : setup.distances) {
+    const std::vector<RigidTransform> all = protocol_poses(d, setup.steps);
+    unbudgeted->run(all, [&](std::size_t k, const Result& r) {
+      if (r.counters.nodes_visited >= setup.min_pops) poses->push_back(all[k]);
+    });
+  }
   std::fprintf(stderr, "bench_deadline: %s on %s: %zu long poses (>= %ju node pairs)\n", label.c_str(),
-               std::string(BV::name()).c_str(), poses->size(), std::uintmax_t(setup.min_pops));
+               bv.c_str(), poses->size(), std::uintmax_t(setup.min_pops));
   if (poses->empty()) return;
-  auto add = [&](const std::string& series, const AdbOptions& options) {
-    const std::string name = label + "/" + std::string(BV::name()) + "/" + series;
+  auto add = [&](const std::string& series, double deadline_us) {
+    const std::shared_ptr<const PreparedQuery> query = tree->prepare(*tree, adb_variant(deadline_us));
+    const std::string name = label + "/" + bv + "/" + series;
     benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& state) {
-      run_deadline(state, *tree, *poses, options);
+      run_deadline(state, *query, *poses, deadline_us);
     })->Unit(benchmark::kMillisecond);
   };
-  add("no_budget", unbudgeted);
-  AdbOptions never = unbudgeted;
-  never.budget.deadline_us = 1e9;
-  add("deadline_never_reached", never);
+  add("no_budget", 0);
+  add("deadline_never_reached", 1e9);
   for (double deadline : setup.deadlines) {
-    AdbOptions options = unbudgeted;
-    options.budget.deadline_us = deadline;
     char series[64];
     std::snprintf(series, sizeof series, "deadline_us:%g", deadline);
-    add(series, options);
+    add(series, deadline);
   }
 }
 
@@ -177,8 +186,7 @@ int main(int argc, char** argv) {
       }
       const Mesh mesh = load_protocol_mesh(file);
       const std::string label = std::filesystem::path(file).stem().string();
-      for (const auto& v : volumes)
-        with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_mesh<BV>(label, mesh, setup); });
+      for (const auto& v : volumes) register_mesh(label, v, mesh, setup);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_deadline: %s\n", e.what());
