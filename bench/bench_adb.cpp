@@ -84,9 +84,15 @@ void register_series(const std::string& label, const std::string& strategy,
   }
 }
 
-void register_adb(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w,
+/// `mesh`'s tree of volume `bv` without a density.
+std::shared_ptr<const AnyTree> plain_tree(const Mesh& mesh, const std::string& bv) {
+  return std::make_shared<const AnyTree>(
+      AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{}));
+}
+
+/// The ADB series: `plain` (the AABB tree) annotated, one series per p_min.
+void register_adb(const std::string& label, const AnyTree& plain, const std::shared_ptr<const Workload>& w,
                   const std::vector<double>& p_mins, int grid, double tau) {
-  const AnyTree plain = AnyTree::build(mesh, MeshUnits{}, "aabb", density_spec("none", {}), BuildOptions{});
   AnnotateStats stats;
   const DensitySpec adb = density_spec("adb", {{"grid", grid}, {"tau", tau}});
   const auto tree = std::make_shared<const AnyTree>(plain.annotated(adb, AnnotationContext{}, &stats));
@@ -96,13 +102,6 @@ void register_adb(const std::string& label, const Mesh& mesh, const std::shared_
     std::snprintf(strategy, sizeof strategy, "adb_aabb_g%d/p:%.2f", grid, p_min);
     register_series(label, strategy, tree, strategy_variant("adb", {{"p_min", p_min}}, Budget{}), w);
   }
-}
-
-void register_exact(const std::string& label, const Mesh& mesh, const std::shared_ptr<const Workload>& w,
-                    const std::string& bv) {
-  const auto tree = std::make_shared<const AnyTree>(
-      AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{}));
-  register_series(label, "exact_" + bv, tree, strategy_variant("exact", {}, Budget{}), w);
 }
 
 void print_summary(const std::vector<std::string>& exact_names) {
@@ -192,17 +191,21 @@ int main(int argc, char** argv) {
       const std::string label = std::filesystem::path(file).stem().string();
       auto workload = std::make_shared<Workload>();
       workload->distances = distances;
-      // The truth: the exact AABB tree's answers, equal to CGAL's (tests/traversal).
-      const AnyTree truth_tree = AnyTree::build(mesh, MeshUnits{}, "aabb", density_spec("none", {}), {});
-      const auto truth_query = truth_tree.prepare(truth_tree, strategy_variant("exact", {}, Budget{}));
+      // One AABB tree: the truth (its exact answers, equal to CGAL's: tests/traversal), the exact AABB
+      // series and the tree ADB annotates.
+      const auto aabb = plain_tree(mesh, "aabb");
+      const StrategyVariant exact_variant = strategy_variant("exact", {}, Budget{});
+      const auto truth_query = aabb->prepare(*aabb, exact_variant);
       for (double d : distances) {
         workload->poses.push_back(protocol_poses(d, steps));
         auto& truth = workload->truth.emplace_back(workload->poses.back().size());
         truth_query->run(workload->poses.back(),
                          [&](std::size_t k, const Result& r) { truth[k] = r.collides; });
       }
-      for (const auto& e : exact) register_exact(label, mesh, workload, e);
-      register_adb(label, mesh, workload, p_mins, grid, tau);
+      for (const auto& e : exact)
+        register_series(label, "exact_" + e, e == "aabb" ? aabb : plain_tree(mesh, e), exact_variant,
+                        workload);
+      register_adb(label, *aabb, workload, p_mins, grid, tau);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_adb: %s\n", e.what());
