@@ -52,6 +52,12 @@ std::vector<RigidTransform> poses() {
   return out;
 }
 
+// `r` with its contacts in order, so that two answers compare whatever order a walk found them in.
+Result with_sorted_contacts(Result r) {
+  std::sort(r.contacts.begin(), r.contacts.end());
+  return r;
+}
+
 // query(i) for i < n from kThreads threads at once, each starting at another i: per thread its answers.
 // Each thread keeps its own results; the caller compares after the join (gtest is not asked to be
 // thread-safe on failures).
@@ -94,10 +100,8 @@ TEST(Threads, SharedTreesAnswerAsSingleThreadedForEveryVolumeAndStrategy) {
     const auto tree = annotated<BV>(jeep);
     const std::size_t n = queries.size() * kAllStrategies.size();
     auto query = [&](std::size_t i) {
-      Result r =
-          run<BV>(kAllStrategies[i % kAllStrategies.size()], tree, tree, queries[i / kAllStrategies.size()]);
-      std::sort(r.contacts.begin(), r.contacts.end());
-      return r;
+      return with_sorted_contacts(
+          run<BV>(kAllStrategies[i % kAllStrategies.size()], tree, tree, queries[i / kAllStrategies.size()]));
     };
     expect_threads_answer_alone(n, query, [](std::size_t i) {
       return to_string(kAllStrategies[i % kAllStrategies.size()]) + ", pose " +
@@ -123,9 +127,7 @@ TEST(Threads, SharedWideTreesAnswerAsSingleThreaded) {
       const std::size_t n = queries.size() * 2;
       auto query = [&](std::size_t i) {
         const ContactMode mode = i % 2 == 0 ? ContactMode::First : ContactMode::All;
-        Result r = query_exact_wide(tree, wide, tree, wide, queries[i / 2], mode);
-        std::sort(r.contacts.begin(), r.contacts.end());
-        return r;
+        return with_sorted_contacts(query_exact_wide(tree, wide, tree, wide, queries[i / 2], mode));
       };
       expect_threads_answer_alone(n, query, [](std::size_t i) { return "query " + std::to_string(i); });
       ++volumes;
