@@ -15,9 +15,9 @@
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
 #include "bench/report_tables.hpp"
+#include "engine/any_tree.hpp"
 #include "engine/protocol.hpp"
-#include "engine/registry.hpp"
-#include "traversal/coherent.hpp"
+#include "traversal/coherent_state.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -59,16 +59,20 @@ struct Pass {
   std::vector<bool> answers;
 };
 
-template <class Query>
-Pass timed_pass(const std::vector<RigidTransform>& poses, Query&& query) {
+/// One pass of `query` over `poses`, continuing `state` when given (a coherent query).
+Pass timed_pass(const PreparedQuery& query, const std::vector<RigidTransform>& poses,
+                CoherentState* state = nullptr) {
   Pass pass;
-  pass.answers.reserve(poses.size());
-  const auto start = std::chrono::steady_clock::now();
-  for (const RigidTransform& pose : poses) {
-    const Result r = query(pose);
+  pass.answers.resize(poses.size());
+  const ResultSink record = [&](std::size_t k, const Result& r) {
     pass.work += r.counters;
-    pass.answers.push_back(r.collides);
-  }
+    pass.answers[k] = r.collides;
+  };
+  const auto start = std::chrono::steady_clock::now();
+  if (state)
+    query.run(poses, record, *state);
+  else
+    query.run(poses, record);
   pass.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return pass;
 }
@@ -118,21 +122,21 @@ void record(Series& s, const Pass& cold, const Pass& coherent, const CoherentSta
 /// The states' options, from --judge, --max_cold_run and --max_jump.
 CoherenceOptions coherence_options;
 
-template <class BV>
-void run_series(benchmark::State& state, const Bvh<BV>& tree, const std::vector<RigidTransform>& poses) {
+/// The exact query of one tree against itself, cold and coherent (the run-time layer's, engine/any_tree.hpp).
+struct Queries {
+  std::unique_ptr<PreparedQuery> cold, coherent;
+};
+
+void run_series(benchmark::State& state, const Queries& q, const std::vector<RigidTransform>& poses) {
   Series s;
   bool cold_first = true;
   for (auto _ : state) {
     CoherentState coherence(coherence_options);
-    auto cold = [&] { return timed_pass(poses, [&](const auto& p) { return query_exact(tree, tree, p); }); };
-    auto coherent = [&] {
-      return timed_pass(poses, [&](const auto& p) { return query_exact_coherent(tree, tree, p, coherence); });
-    };
     Pass c, h;
     if (cold_first)
-      c = cold(), h = coherent();
+      c = timed_pass(*q.cold, poses), h = timed_pass(*q.coherent, poses, &coherence);
     else
-      h = coherent(), c = cold();
+      h = timed_pass(*q.coherent, poses, &coherence), c = timed_pass(*q.cold, poses);
     cold_first = !cold_first;
     record(s, c, h, coherence, 1e6 / static_cast<double>(poses.size()));
   }
@@ -140,14 +144,17 @@ void run_series(benchmark::State& state, const Bvh<BV>& tree, const std::vector<
   if (s.disagreements) state.SkipWithError("coherent answers differ from the cold ones");
 }
 
-template <class BV>
-void register_volume(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
+void register_volume(const std::string& mesh_name, const Mesh& mesh, const std::string& bv,
                      const std::vector<PoseSet>& sets) {
-  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
+  const AnyTree tree = AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{});
+  StrategyVariant cold = strategy_variant("exact", {}, Budget{}), coherent = cold;
+  coherent.coherent = true;
+  auto queries =
+      std::make_shared<const Queries>(Queries{tree.prepare(tree, cold), tree.prepare(tree, coherent)});
   for (const auto& set : sets) {
-    const std::string name = mesh_name + "/" + std::string(BV::name()) + "/" + set.label;
-    benchmark::RegisterBenchmark(name.c_str(), [tree, &set](benchmark::State& state) {
-      run_series(state, *tree, set.poses);
+    const std::string name = mesh_name + "/" + bv + "/" + set.label;
+    benchmark::RegisterBenchmark(name.c_str(), [queries, &set](benchmark::State& state) {
+      run_series(state, *queries, set.poses);
     })->Unit(benchmark::kMillisecond);
   }
 }
@@ -200,9 +207,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   static const std::vector<PoseSet> sets = make_pose_sets(distances, steps, strides);
+  try {
+    for (const auto& v : volumes) check_volume_name(v);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "bench_coherence: --volumes: %s\n", e.what());
+    return 2;
+  }
   for_each_protocol_mesh("bench_coherence", meshes, [&](const std::string& label, const auto& mesh) {
-    for (const auto& v : volumes)
-      with_volume(v, [&]<class BV>(std::type_identity<BV>) { register_volume<BV>(label, mesh, sets); });
+    for (const auto& v : volumes) register_volume(label, *mesh, v, sets);
   });
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -10,12 +10,14 @@
 // anytime distance's goal: the share of apart poses (distance > 0) whose interval, with a tenth of the full
 // query's BV tests, is at most a tenth of the distance wide (`anytime_tenth`; -1 when no pose is apart),
 // and the same with three tenths of the tests (`anytime_3tenths`).
-// Each bvhlab series has a `/coherent` twin: the poses in order through query_distance_coherent.
+// Each bvhlab series has a `/coherent` twin: the poses in order, each starting where the last one ended.
+// bvhlab's queries are the run-time layer's prepared queries (engine/any_tree.hpp), compiled once there.
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
+#include "engine/any_tree.hpp"
+#include "engine/policies.hpp"
 #include "engine/protocol.hpp"
-#include "engine/registry.hpp"
-#include "traversal/distance.hpp"
+#include "traversal/coherent_state.hpp"
 
 #include <benchmark/benchmark.h>
 #ifdef BVHLAB_HAVE_FCL
@@ -29,6 +31,8 @@
 #include <cstdio>
 #include <deque>
 #include <memory>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -70,29 +74,51 @@ std::size_t disagreements(const std::vector<double>& distances, const std::vecto
   return out;
 }
 
-/// Share of the poses apart where query_distance_anytime, capped at `tenths` tenths of the full query's BV
+/// A tree's distance queries (the run-time layer's, engine/any_tree.hpp): full, and full coherent.
+struct Queries {
+  const AnyTree* tree = nullptr;
+  std::unique_ptr<PreparedQuery> full, coherent;
+};
+
+/// Each pose's proximity under `query`; its work added to `work`.
+std::vector<Proximity> proximities(const PreparedQuery& query, std::span<const RigidTransform> poses,
+                                   Counters& work, CoherentState* state = nullptr) {
+  std::vector<Proximity> out(poses.size());
+  const ResultSink record = [&](std::size_t k, const Result& r) {
+    out[k] = *r.proximity;
+    work += r.counters;
+  };
+  if (state)
+    query.run(poses, record, *state);
+  else
+    query.run(poses, record);
+  return out;
+}
+
+/// Share of the poses apart where the anytime distance, capped at `tenths` tenths of the full query's BV
 /// tests, answers an interval at most a tenth of the distance wide; -1 when no pose is apart.
-/// `full` holds each pose's full query.
-template <class BV>
-double anytime_share(const Bvh<BV>& tree, const std::vector<RigidTransform>& poses,
-                     const std::vector<DistanceResult>& full, std::uint64_t tenths) {
+/// `full` and `full_work` hold each pose's full query.
+double anytime_share(const AnyTree& tree, const std::vector<RigidTransform>& poses,
+                     const std::vector<Proximity>& full, const std::vector<Counters>& full_work,
+                     std::uint64_t tenths) {
   int apart = 0, narrow = 0;
   for (std::size_t i = 0; i < poses.size(); ++i) {
     if (!(full[i].distance > 0)) continue;
     ++apart;
-    const Budget cap{std::max<std::uint64_t>(1, full[i].counters.bv_tests * tenths / 10), 0};
-    const DistanceResult r = query_distance_anytime(tree, tree, poses[i], cap);
+    const Budget cap{std::max<std::uint64_t>(1, full_work[i].bv_tests * tenths / 10), 0};
+    Counters work;
+    const auto query = tree.prepare(tree, strategy_variant("distance_anytime", {}, cap));
+    const Proximity r = proximities(*query, std::span(poses).subspan(i, 1), work).front();
     narrow += r.distance - r.lower_bound <= 0.1 * full[i].distance;
   }
   return apart ? double(narrow) / apart : -1;
 }
 
-/// The same poses in order through query_distance_coherent, a fresh state each pass (its first pose is
+/// The same poses in order through the coherent distance query, a fresh state each pass (its first pose is
 /// cold); `coherent_disagree` counts poses whose distance is not the cold query's (it must be 0).
-template <class BV>
-void register_coherent(const std::string& name, const std::shared_ptr<const Bvh<BV>>& tree,
-                       const PoseSet& set, const std::vector<double>& cold) {
-  benchmark::RegisterBenchmark(name.c_str(), [tree, &set, cold](benchmark::State& state) {
+void register_coherent(const std::string& name, const std::shared_ptr<const Queries>& q, const PoseSet& set,
+                       const std::vector<double>& cold) {
+  benchmark::RegisterBenchmark(name.c_str(), [q, &set, cold](benchmark::State& state) {
     Counters pass;
     double sum = 0;
     std::size_t disagree = 0;
@@ -101,11 +127,10 @@ void register_coherent(const std::string& name, const std::shared_ptr<const Bvh<
       sum = 0;
       disagree = 0;
       CoherentState coherent;
-      for (std::size_t i = 0; i < set.poses.size(); ++i) {
-        const DistanceResult r = query_distance_coherent(*tree, *tree, set.poses[i], coherent);
-        pass += r.counters;
-        sum += r.distance;
-        disagree += r.distance != cold[i];
+      const std::vector<Proximity> got = proximities(*q->coherent, set.poses, pass, &coherent);
+      for (std::size_t i = 0; i < got.size(); ++i) {
+        sum += got[i].distance;
+        disagree += got[i].distance != cold[i];
       }
       benchmark::DoNotOptimize(sum);
     }
@@ -114,33 +139,35 @@ void register_coherent(const std::string& name, const std::shared_ptr<const Bvh<
   })->Unit(benchmark::kMillisecond);
 }
 
-template <class BV>
-void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
+void register_bvhlab(const std::string& mesh_name, const Mesh& mesh, const std::string& bv,
                      const std::vector<PoseSet>& sets) {
-  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
+  static std::deque<AnyTree> trees;  // kept to the end of main: the queries hold references into them
+  const AnyTree& tree =
+      trees.emplace_back(AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{}));
+  StrategyVariant full = strategy_variant("distance", {}, Budget{}), coherent = full;
+  coherent.coherent = true;
+  const auto q =
+      std::make_shared<const Queries>(Queries{&tree, tree.prepare(tree, full), tree.prepare(tree, coherent)});
   for (const auto& set : sets) {
-    std::vector<DistanceResult> full;
+    std::vector<Proximity> first;
+    std::vector<Counters> first_work;
+    for (std::size_t i = 0; i < set.poses.size(); ++i)
+      first.push_back(
+          proximities(*q->full, std::span(set.poses).subspan(i, 1), first_work.emplace_back()).front());
     std::vector<double> distances;
-    for (const auto& pose : set.poses) {
-      full.push_back(query_distance(*tree, *tree, pose));
-      distances.push_back(full.back().distance);
-    }
+    for (const Proximity& p : first) distances.push_back(p.distance);
     const double disagree = static_cast<double>(disagreements(distances, set.reference));
-    const double anytime_tenth = anytime_share(*tree, set.poses, full, 1);
-    const double anytime_3tenths = anytime_share(*tree, set.poses, full, 3);
-    const std::string name = "distance/" + mesh_name + "/" + std::string(BV::name()) + "/d:" + set.label;
-    benchmark::RegisterBenchmark(name.c_str(), [tree, &set, disagree, anytime_tenth,
+    const double anytime_tenth = anytime_share(tree, set.poses, first, first_work, 1);
+    const double anytime_3tenths = anytime_share(tree, set.poses, first, first_work, 3);
+    const std::string name = "distance/" + mesh_name + "/" + bv + "/d:" + set.label;
+    benchmark::RegisterBenchmark(name.c_str(), [q, &set, disagree, anytime_tenth,
                                                 anytime_3tenths](benchmark::State& state) {
       Counters pass;
       double sum = 0;
       for (auto _ : state) {
         pass = {};
         sum = 0;
-        for (const auto& pose : set.poses) {
-          const DistanceResult r = query_distance(*tree, *tree, pose);
-          pass += r.counters;
-          sum += r.distance;
-        }
+        for (const Proximity& p : proximities(*q->full, set.poses, pass)) sum += p.distance;
         benchmark::DoNotOptimize(sum);
       }
       set_counters(state, set.poses.size(), pass, sum);
@@ -148,7 +175,7 @@ void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const M
       state.counters["anytime_tenth"] = anytime_tenth;
       state.counters["anytime_3tenths"] = anytime_3tenths;
     })->Unit(benchmark::kMillisecond);
-    register_coherent(name + "/coherent", tree, set, distances);
+    register_coherent(name + "/coherent", q, set, distances);
   }
 }
 
@@ -191,6 +218,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_distance: --steps must be at least 1\n");
     return 2;
   }
+  try {
+    for (const auto& v : volumes) check_volume_name(v);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "bench_distance: --volumes: %s\n", e.what());
+    return 2;
+  }
   for_each_protocol_mesh("bench_distance", meshes, [&](const std::string& label, const auto& mesh) {
     // One pose list per mesh, kept to the end of main: the benchmarks hold references into it.
     static std::deque<std::vector<PoseSet>> per_mesh;
@@ -202,12 +235,11 @@ int main(int argc, char** argv) {
         set.reference.push_back(fcl_distance(*reference, *reference, pose).distance);
 #endif
     for (const auto& v : volumes) {
-      with_volume(v, [&]<class BV>(std::type_identity<BV>) {
-        if constexpr (DistanceVolume<BV>)
-          register_bvhlab<BV>(label, mesh, sets);
-        else
-          std::fprintf(stderr, "bench_distance: skipping %s (no distance bound)\n", v.c_str());
-      });
+      const std::string refusal = strategy_info("distance").volume_refusal(v);
+      if (refusal.empty())
+        register_bvhlab(label, *mesh, v, sets);
+      else
+        std::fprintf(stderr, "bench_distance: skipping %s (%s)\n", v.c_str(), refusal.c_str());
     }
 #ifdef BVHLAB_HAVE_FCL
     register_fcl<fcl::RSSd>(label, "fcl_rss", mesh, sets);

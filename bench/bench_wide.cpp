@@ -1,6 +1,6 @@
-// Wide against binary trees: the exact first-contact query on a binary tree (query_exact) and on its wide
-// form (query_exact_wide: four children a node, tested at once), side by side, for every volume that has a
-// wide layout (AABB and the k-DOPs).
+// Wide against binary trees: the exact first-contact query on a binary tree and on its wide layout (four
+// children a node, tested at once: traversal/wide_exact.hpp), side by side, for every volume that has a wide
+// layout. Both are the run-time layer's prepared queries (engine/any_tree.hpp), compiled once in the engine.
 //
 //   bench_wide [--meshes=jeep1.ms3d,bunny.obj] [--volumes=aabb,dop18,dop24] [--distances=0.4,0.8,1.2,1.6,2.0]
 //              [--steps=200] [benchmark flags]
@@ -13,9 +13,9 @@
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
 #include "bench/report_tables.hpp"
+#include "engine/any_tree.hpp"
+#include "engine/policies.hpp"
 #include "engine/protocol.hpp"
-#include "engine/registry.hpp"
-#include "traversal/wide_exact.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -31,14 +31,24 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-template <class BV>
-struct Trees {
-  Bvh<BV> binary;
-  WideTreeOf<BV> wide;
+/// The exact query of one tree against itself, on the binary tree and on its wide layout.
+struct Queries {
+  std::unique_ptr<PreparedQuery> binary, wide;
 };
 
-template <class BV>
-void run_series(benchmark::State& state, const Trees<BV>& t, const std::vector<RigidTransform>& poses) {
+/// One pass of `query` over `poses`: its seconds; each answer and the work added to `answers` and `work`.
+double timed_pass(const PreparedQuery& query, const std::vector<RigidTransform>& poses,
+                  std::vector<char>& answers, Counters& work) {
+  const ResultSink record = [&](std::size_t k, const Result& r) {
+    answers[k] = r.collides;
+    work += r.counters;
+  };
+  const auto start = Clock::now();
+  query.run(poses, record);
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void run_series(benchmark::State& state, const Queries& q, const std::vector<RigidTransform>& poses) {
   std::vector<double> binary_us, wide_us, speedup;
   Counters binary_work, wide_work;
   std::vector<char> binary_answers(poses.size()), wide_answers(poses.size());
@@ -47,23 +57,9 @@ void run_series(benchmark::State& state, const Trees<BV>& t, const std::vector<R
   for (auto _ : state) {
     double binary_seconds = 0, wide_seconds = 0;
     const auto binary_pass = [&] {
-      const auto start = Clock::now();
-      for (std::size_t k = 0; k < poses.size(); ++k) {
-        const Result r = query_exact(t.binary, t.binary, poses[k]);
-        binary_answers[k] = r.collides;
-        binary_work += r.counters;
-      }
-      binary_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+      binary_seconds = timed_pass(*q.binary, poses, binary_answers, binary_work);
     };
-    const auto wide_pass = [&] {
-      const auto start = Clock::now();
-      for (std::size_t k = 0; k < poses.size(); ++k) {
-        const Result r = query_exact_wide(t.binary, t.wide, t.binary, t.wide, poses[k]);
-        wide_answers[k] = r.collides;
-        wide_work += r.counters;
-      }
-      wide_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    };
+    const auto wide_pass = [&] { wide_seconds = timed_pass(*q.wide, poses, wide_answers, wide_work); };
     if (binary_first)
       binary_pass(), wide_pass();
     else
@@ -119,32 +115,27 @@ int main(int argc, char** argv) {
   for (double d : distances)
     for (const RigidTransform& pose : protocol_poses(d, steps)) poses.push_back(pose);
   for (const auto& v : volumes) {
-    bool wide = false;
+    std::string refusal;
     try {
-      with_volume(v, [&]<class BV>(std::type_identity<BV>) { wide = HasWideLayout<BV>; });
+      refusal = wide_layout_refusal(v);
     } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "bench_wide: --volumes: %s\n", e.what());
-      return 2;
+      refusal = e.what();
     }
-    if (!wide) {
-      std::fprintf(stderr, "bench_wide: --volumes: %s has no wide layout (aabb and the k-DOPs have)\n",
-                   v.c_str());
+    if (!refusal.empty()) {
+      std::fprintf(stderr, "bench_wide: --volumes: %s\n", refusal.c_str());
       return 2;
     }
   }
+  StrategyVariant exact = strategy_variant("exact", {}, Budget{}), wide = exact;
+  wide.wide = true;
   for_each_protocol_mesh("bench_wide", meshes, [&](const std::string& label, const auto& mesh) {
-    for (const auto& v : volumes)
-      with_volume(v, [&]<class BV>(std::type_identity<BV>) {
-        if constexpr (HasWideLayout<BV>) {
-          auto binary = Bvh<BV>::build(*mesh);
-          auto wide = WideTreeOf<BV>::build(binary);
-          const auto trees = std::make_shared<const Trees<BV>>(Trees<BV>{std::move(binary), std::move(wide)});
-          const std::string name = label + "/" + std::string(BV::name());
-          benchmark::RegisterBenchmark(name.c_str(), [trees](benchmark::State& state) {
-            run_series(state, *trees, poses);
-          })->Unit(benchmark::kMillisecond);
-        }
-      });
+    for (const auto& v : volumes) {
+      const AnyTree tree = AnyTree::build(*mesh, MeshUnits{}, v, density_spec("none", {}), BuildOptions{});
+      auto queries = std::make_shared<Queries>(Queries{tree.prepare(tree, exact), tree.prepare(tree, wide)});
+      benchmark::RegisterBenchmark((label + "/" + v).c_str(), [queries](benchmark::State& state) {
+        run_series(state, *queries, poses);
+      })->Unit(benchmark::kMillisecond);
+    }
   });
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
