@@ -32,6 +32,7 @@ struct CgalGroundTruth::Impl {
   std::vector<bool> b_degenerate;
   bool any_b_degenerate = false;
   Tree tree;
+  Box a_regular_box;  // of a_regular's corners: a moved triangle of B whose box misses it cannot touch them
 
   TrianglePoints moved_b(std::size_t j, const RigidTransform& pose) const {
     const auto t = b.triangle(j);
@@ -79,6 +80,8 @@ CgalGroundTruth::CgalGroundTruth(const Mesh& a, const Mesh& b) : impl_(std::make
     impl_->b_degenerate[j] = degenerate(b.triangle(j));
     impl_->any_b_degenerate = impl_->any_b_degenerate || impl_->b_degenerate[j];
   }
+  for (std::uint32_t i : impl_->a_regular_ids)
+    for (const Vec3& corner : a.triangle(i)) impl_->a_regular_box.extend(corner);
   impl_->tree.insert(impl_->a_regular.begin(), impl_->a_regular.end());
   impl_->tree.build();
 }
@@ -90,8 +93,15 @@ CgalGroundTruth& CgalGroundTruth::operator=(CgalGroundTruth&&) noexcept = defaul
 bool CgalGroundTruth::collides(const RigidTransform& b_to_a) const {
   const Impl& m = *impl_;
   if (m.a_degenerate.empty() && !m.any_b_degenerate) {  // the common case: CGAL's tree answers alone
-    for (std::size_t j = 0; j < m.b.triangles.size(); ++j) {
-      const TrianglePoints q = m.moved_b(j, b_to_a);
+    // B's vertices moved once (the same doubles moved_b gives), and a triangle whose box misses A's box
+    // left out before CGAL is asked: the box holds the exact corners, so this drops no contact.
+    std::vector<Vec3> moved(m.b.vertices.size());
+    for (std::size_t v = 0; v < moved.size(); ++v) moved[v] = b_to_a.apply(m.b.vertices[v]);
+    for (const TriangleIndices& t : m.b.triangles) {
+      const TrianglePoints q{moved[t[0]], moved[t[1]], moved[t[2]]};
+      Box box;
+      for (const Vec3& corner : q) box.extend(corner);
+      if (!box.overlaps(m.a_regular_box)) continue;
       if (m.tree.do_intersect(K::Triangle_3(point(q[0]), point(q[1]), point(q[2])))) return true;
     }
     return false;
