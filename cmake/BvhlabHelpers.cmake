@@ -32,6 +32,15 @@ function(bvhlab_cold)
   endforeach()
 endfunction()
 
+# bvhlab_glue(target ...): code that only reads arguments and calls the libraries (the CLI's commands) is
+# compiled at -O0 in Release: it does no work of its own worth optimising, and compiles in about 60 % of the
+# time it takes at -O1.
+function(bvhlab_glue)
+  foreach(target ${ARGN})
+    target_compile_options(${target} PRIVATE $<$<CONFIG:Release>:-O0>)
+  endforeach()
+endfunction()
+
 # In the build, the source tree's root is the include root: #include "volumes/aabb.hpp". Installed, the
 # headers sit under include/bvhlab and users write #include <bvhlab/volumes/aabb.hpp>, which cannot clash
 # with another project's volumes/ or adb/; the library's headers include each other by relative paths
