@@ -5,8 +5,9 @@
 // `protocol` (built and run by Release; the sanitizer presets leave it out). The ADB strategies and the
 // loader in far frames are in test_far_frames.cpp.
 #include "bench/core/ground_truth.hpp"
+#include "engine/any_tree.hpp"
 #include "engine/mesh_catalog.hpp"
-#include "engine/registry.hpp"
+#include "engine/specs.hpp"
 #include "robust_support.hpp"
 #include "support/generated_meshes.hpp"
 
@@ -75,37 +76,39 @@ TEST_P(FarFrameProtocol, AnswersSurviveTheFrameChange) {
     for (const Query& q : queries) expected.push_back(truth.collides(q.pose));
     const Mesh far = reframe(model, frame.scale, frame.offset);
     const double eps = rounding_in_scene_units(frame);
-    with_each_volume([&](auto id) {
-      using BV = typename decltype(id)::type;
-      const auto tree = Bvh<BV>::build(far);
+    std::vector<RigidTransform> far_poses;
+    for (const Query& q : queries) far_poses.push_back(reframe(q.pose, frame.scale, frame.offset));
+    // Every registered volume's tree and exact query, as the run-time layer builds and runs them.
+    for (const std::string& bv : volume_names()) {
+      const AnyTree tree = AnyTree::build(far, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{});
+      const auto query = tree.prepare(tree, strategy_variant("exact", {}, Budget{}));
       int flagged = 0, wrong = 0, colliding = 0;
       std::uint64_t triangle_tests = 0;
       const auto start = std::chrono::steady_clock::now();
-      for (std::size_t k = 0; k < queries.size(); ++k) {
-        const Result r = query_exact(tree, tree, reframe(queries[k].pose, frame.scale, frame.offset));
+      query->run(far_poses, [&](std::size_t k, const Result& r) {
         colliding += expected[k];
         triangle_tests += r.counters.triangle_tests;
-        if (r.collides == expected[k]) continue;
+        if (r.collides == expected[k]) return;
         if (within_rounding(truth, queries[k].pose, expected[k], eps)) {
           ++flagged;
         } else {
           ++wrong;
-          ADD_FAILURE() << BV::name() << ": d " << queries[k].distance << " query " << k << " answers "
-                        << r.collides << ", the unmoved scene " << expected[k] << ", and no perturbation of "
-                        << 2 * eps << " flips it";
+          ADD_FAILURE() << bv << ": d " << queries[k].distance << " query " << k << " answers " << r.collides
+                        << ", the unmoved scene " << expected[k] << ", and no perturbation of " << 2 * eps
+                        << " flips it";
         }
-      }
+      });
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       std::printf(
           "[far frames] %-20s %-7s queries %zu colliding %d flagged-within-rounding %d wrong %d "
           "triangle tests/query %.0f, %.2f s\n",
-          (c.model + " " + frame.name).c_str(), std::string(BV::name()).c_str(), queries.size(), colliding,
-          flagged, wrong, double(triangle_tests) / double(queries.size()), seconds);
+          (c.model + " " + frame.name).c_str(), bv.c_str(), queries.size(), colliding, flagged, wrong,
+          double(triangle_tests) / double(queries.size()), seconds);
       // Flags are for the rare pose at contact; many of them would mean the frame itself loses the answer.
-      EXPECT_LE(flagged, static_cast<int>(queries.size()) / 100 + 1) << BV::name();
+      EXPECT_LE(flagged, static_cast<int>(queries.size()) / 100 + 1) << bv;
       EXPECT_GT(colliding, 0);
       EXPECT_LT(colliding, static_cast<int>(queries.size()));
-    });
+    }
   }
 }
 
