@@ -1,14 +1,11 @@
 // The benchmark protocol on real meshes: every registered BV gives exactly CGAL's answer on every pose,
 // and the colliding fractions match the reference table measured with FCL (adb/README.md, section 4).
-#include "adb/adb_density.hpp"
 #include "bench/core/ground_truth.hpp"
 #include "bvh/mesh_io.hpp"
+#include "engine/any_tree.hpp"
+#include "engine/policies.hpp"
 #include "engine/protocol.hpp"
-#include "engine/registry.hpp"
 #include "support/meshes.hpp"
-#include "traversal/adb.hpp"
-#include "traversal/exact.hpp"
-#include "traversal/wide_exact.hpp"
 
 #include <gtest/gtest.h>
 
@@ -33,59 +30,49 @@ void check_mesh(const Reference& ref) {
   const CgalGroundTruth truth(mesh, mesh);
   const ProtocolOptions protocol;
 
-  std::vector<std::vector<char>> expected(protocol.distances.size());
-  for (std::size_t d = 0; d < protocol.distances.size(); ++d) {
+  std::vector<RigidTransform> poses;
+  std::vector<double> pose_distance;
+  std::vector<char> expected;
+  for (std::size_t i = 0; i < protocol.distances.size(); ++i) {
+    const double d = protocol.distances[i];
     int colliding = 0;
     for (int k = 0; k < kSteps; ++k) {
-      const bool hit = truth.collides(protocol_pose(protocol.distances[d], k, kSteps));
-      expected[d].push_back(hit);
-      colliding += hit;
+      poses.push_back(protocol_pose(d, k, kSteps));
+      pose_distance.push_back(d);
+      expected.push_back(truth.collides(poses.back()));
+      colliding += expected.back();
     }
     // 500 evenly spaced poses of the same turn: the fraction may differ from the 5000-pose reference by
     // sampling alone; 3 percentage points is far beyond that for these smooth tumbling sequences.
     const double percent = 100.0 * colliding / kSteps;
-    EXPECT_NEAR(percent, ref.colliding_percent[d], 3.0) << ref.file << " at d = " << protocol.distances[d];
+    EXPECT_NEAR(percent, ref.colliding_percent[i], 3.0) << ref.file << " at d = " << d;
+  }
+  // Every answer of `query` against CGAL's, each claimed exact; `label` names the query.
+  const auto check = [&](const PreparedQuery& query, const std::string& label) {
+    std::size_t mismatches = 0;
+    query.run(poses, [&](std::size_t k, const Result& r) {
+      if (r.collides == static_cast<bool>(expected[k]) && r.exact) return;
+      if (++mismatches <= 5)
+        ADD_FAILURE() << ref.file << " " << label << " d = " << pose_distance[k] << " step " << k % kSteps
+                      << ": bvhlab says " << r.collides << (r.exact ? "" : ", not exact");
+    });
+    EXPECT_EQ(mismatches, 0u) << ref.file << " " << label;
+  };
+
+  // Every registered volume's tree, and its wide form (four children a node, tested at once) where the
+  // volume has a wide layout, as the run-time layer builds and runs them.
+  StrategyVariant exact = strategy_variant("exact", {}, Budget{}), wide = exact;
+  wide.wide = true;
+  for (const std::string& bv : volume_names()) {
+    const AnyTree tree = AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{});
+    check(*tree.prepare(tree, exact), bv);
+    if (wide_layout_refusal(bv).empty()) check(*tree.prepare(tree, wide), bv + " wide");
   }
 
-  // Every volume's tree, and its wide form (four children a node, tested at once) where the volume has a
-  // wide layout: the same answer on every pose.
-  with_each_volume([&]<class BV>(std::type_identity<BV>) {
-    const auto tree = Bvh<BV>::build(mesh);
-    std::size_t mismatches = 0;
-    for (std::size_t d = 0; d < protocol.distances.size(); ++d)
-      for (int k = 0; k < kSteps; ++k) {
-        const Result r = query_exact(tree, tree, protocol_pose(protocol.distances[d], k, kSteps));
-        if (r.collides != static_cast<bool>(expected[d][k])) {
-          ++mismatches;
-          ADD_FAILURE() << ref.file << " " << BV::name() << " d = " << protocol.distances[d] << " step " << k
-                        << ": bvhlab says " << r.collides;
-        }
-      }
-    EXPECT_EQ(mismatches, 0u) << BV::name();
-    if constexpr (HasWideLayout<BV>) {
-      const auto wide = WideTreeOf<BV>::build(tree);
-      std::size_t wide_mismatches = 0;
-      for (std::size_t d = 0; d < protocol.distances.size(); ++d)
-        for (int k = 0; k < kSteps; ++k) {
-          const RigidTransform pose = protocol_pose(protocol.distances[d], k, kSteps);
-          wide_mismatches += query_exact_wide(tree, wide, tree, wide, pose).collides != bool(expected[d][k]);
-        }
-      EXPECT_EQ(wide_mismatches, 0u) << ref.file << " wide " << BV::name();
-    }
-  });
-
   // Guided exact (ADB order, exact leaves) on the real annotation: the same answer on every pose.
-  const auto annotated = annotate_adb(Bvh<Aabb>::build(mesh), 2);
-  AdbOptions guided;
-  guided.exact_leaves = true;
-  std::size_t guided_mismatches = 0;
-  for (std::size_t d = 0; d < protocol.distances.size(); ++d)
-    for (int k = 0; k < kSteps; ++k) {
-      const Result r =
-          query_adb(annotated, annotated, protocol_pose(protocol.distances[d], k, kSteps), guided);
-      guided_mismatches += r.collides != static_cast<bool>(expected[d][k]) || !r.exact;
-    }
-  EXPECT_EQ(guided_mismatches, 0u) << ref.file << " guided exact";
+  const AnyTree annotated =
+      AnyTree::build(mesh, MeshUnits{}, "aabb", density_spec("adb", {{"grid", 2}}), BuildOptions{});
+  check(*annotated.prepare(annotated, strategy_variant("guided_exact", {}, Budget{})), "guided exact");
 }
 
 TEST(Protocol, Jeep1AllVolumesMatchCgal) {
