@@ -154,7 +154,13 @@ struct alignas(16) Obb4 {
     const F4 slack =
         F4{_mm_set1_ps(kSlackFactor)} * ((F4{_mm_load_ps(a.mag.data())} + F4{_mm_load_ps(b.mag.data())}) +
                                          F4{_mm_set1_ps(c.translation_magnitude)});
-    const F4 gap = largest_gap(load_vector(a), load_vector(b), F4{_mm_set1_ps(kWidenM)});
+    // A's face axes first: where they separate all four lanes (a gap only grows with more axes), the
+    // other twelve cannot change the answer.
+    const Lane<F4> la = load_vector(a), lb = load_vector(b);
+    Relative<F4> r;
+    F4 gap = face_gap_a(la, lb, F4{_mm_set1_ps(kWidenM)}, r);
+    if (_mm_movemask_ps(_mm_cmpgt_ps(gap.v, slack.v)) == 0xF) return 0;
+    gap = other_gap(la, lb, r, gap);
     return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(gap.v, slack.v))) ^ 0xFu;
   }
 #else
@@ -213,41 +219,61 @@ struct alignas(16) Obb4 {
     }
     return out;
   }
-  /// The largest gap over the 15 axes of A's box `a` and B's placed box `b` (obb.hpp's test; > 0 where an
-  /// axis separates), |m| widened by `widen`.
+  /// B's axes and centre offset in A's box frame, shared by the 15 axes.
+  template <class V>
+  struct Relative {
+    V m[3][3], am[3][3], t[3];  ///< m = A^T B, am = |m| widened, t = A^T (c_b - c_a)
+  };
+  /// The largest gap over A's three face axes (> 0 where one separates), filling `r` for the other twelve.
   template <class V, class W>
-  [[gnu::always_inline]] static V largest_gap(const Lane<V>& a, const Lane<V>& b, W widen_by) {
+  [[gnu::always_inline]] static V face_gap_a(const Lane<V>& a, const Lane<V>& b, W widen_by, Relative<V>& r) {
     using obb4_detail::abs;
     using obb4_detail::max;
     const V widen = V(widen_by);
-    V m[3][3], am[3][3], t[3];
     const V d[3] = {b.center[0] - a.center[0], b.center[1] - a.center[1], b.center[2] - a.center[2]};
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) {
-        m[i][j] = (a.axes[i] * b.axes[j] + a.axes[3 + i] * b.axes[3 + j]) + a.axes[6 + i] * b.axes[6 + j];
-        am[i][j] = abs(m[i][j]) + widen;
+        r.m[i][j] = (a.axes[i] * b.axes[j] + a.axes[3 + i] * b.axes[3 + j]) + a.axes[6 + i] * b.axes[6 + j];
+        r.am[i][j] = abs(r.m[i][j]) + widen;
       }
-      t[i] = (a.axes[i] * d[0] + a.axes[3 + i] * d[1]) + a.axes[6 + i] * d[2];
+      r.t[i] = (a.axes[i] * d[0] + a.axes[3 + i] * d[1]) + a.axes[6 + i] * d[2];
     }
+    const V* hb = b.half;
+    V gap = abs(r.t[0]) - a.half[0] - ((r.am[0][0] * hb[0] + r.am[0][1] * hb[1]) + r.am[0][2] * hb[2]);
+    for (int i = 1; i < 3; ++i)
+      gap = max(gap,
+                abs(r.t[i]) - a.half[i] - ((r.am[i][0] * hb[0] + r.am[i][1] * hb[1]) + r.am[i][2] * hb[2]));
+    return gap;
+  }
+  /// `gap` (A's face axes) with B's three face axes and the nine edge pairs taken in.
+  template <class V>
+  [[gnu::always_inline]] static V other_gap(const Lane<V>& a, const Lane<V>& b, const Relative<V>& r, V gap) {
+    using obb4_detail::abs;
+    using obb4_detail::max;
     const V* ha = a.half;
     const V* hb = b.half;
-    V gap = abs(t[0]) - ha[0] - ((am[0][0] * hb[0] + am[0][1] * hb[1]) + am[0][2] * hb[2]);
-    for (int i = 1; i < 3; ++i)
-      gap = max(gap, abs(t[i]) - ha[i] - ((am[i][0] * hb[0] + am[i][1] * hb[1]) + am[i][2] * hb[2]));
     for (int j = 0; j < 3; ++j)
-      gap = max(gap, abs((t[0] * m[0][j] + t[1] * m[1][j]) + t[2] * m[2][j]) -
-                         ((am[0][j] * ha[0] + am[1][j] * ha[1]) + am[2][j] * ha[2]) - hb[j]);
+      gap = max(gap, abs((r.t[0] * r.m[0][j] + r.t[1] * r.m[1][j]) + r.t[2] * r.m[2][j]) -
+                         ((r.am[0][j] * ha[0] + r.am[1][j] * ha[1]) + r.am[2][j] * ha[2]) - hb[j]);
     for (int i = 0; i < 3; ++i) {
       const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
       for (int j = 0; j < 3; ++j) {
         const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-        const V distance = abs(t[i2] * m[i1][j] - t[i1] * m[i2][j]);
-        const V radius_a = ha[i1] * am[i2][j] + ha[i2] * am[i1][j];
-        const V radius_b = hb[j1] * am[i][j2] + hb[j2] * am[i][j1];
+        const V distance = abs(r.t[i2] * r.m[i1][j] - r.t[i1] * r.m[i2][j]);
+        const V radius_a = ha[i1] * r.am[i2][j] + ha[i2] * r.am[i1][j];
+        const V radius_b = hb[j1] * r.am[i][j2] + hb[j2] * r.am[i][j1];
         gap = max(gap, distance - radius_a - radius_b);
       }
     }
     return gap;
+  }
+  /// The largest gap over the 15 axes of A's box `a` and B's placed box `b` (obb.hpp's test; > 0 where an
+  /// axis separates), |m| widened by `widen`.
+  template <class V, class W>
+  [[gnu::always_inline]] static V largest_gap(const Lane<V>& a, const Lane<V>& b, W widen_by) {
+    Relative<V> r;
+    const V gap = face_gap_a(a, b, widen_by, r);
+    return other_gap(a, b, r, gap);
   }
 };
 
