@@ -76,7 +76,6 @@ std::size_t disagreements(const std::vector<double>& distances, const std::vecto
 
 /// A tree's distance queries (the run-time layer's, engine/any_tree.hpp): full, and full coherent.
 struct Queries {
-  const AnyTree* tree = nullptr;
   std::unique_ptr<PreparedQuery> full, coherent;
 };
 
@@ -141,19 +140,19 @@ void register_coherent(const std::string& name, const std::shared_ptr<const Quer
 
 void register_bvhlab(const std::string& mesh_name, const Mesh& mesh, const std::string& bv,
                      const std::vector<PoseSet>& sets) {
-  static std::deque<AnyTree> trees;  // kept to the end of main: the queries hold references into them
-  const AnyTree& tree =
-      trees.emplace_back(AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{}));
+  // The prepared queries keep the tree alive.
+  const AnyTree tree = AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{});
   StrategyVariant full = strategy_variant("distance", {}, Budget{}), coherent = full;
   coherent.coherent = true;
   const auto q =
-      std::make_shared<const Queries>(Queries{&tree, tree.prepare(tree, full), tree.prepare(tree, coherent)});
+      std::make_shared<const Queries>(Queries{tree.prepare(tree, full), tree.prepare(tree, coherent)});
   for (const auto& set : sets) {
-    std::vector<Proximity> first;
-    std::vector<Counters> first_work;
-    for (std::size_t i = 0; i < set.poses.size(); ++i)
-      first.push_back(
-          proximities(*q->full, std::span(set.poses).subspan(i, 1), first_work.emplace_back()).front());
+    std::vector<Proximity> first(set.poses.size());
+    std::vector<Counters> first_work(set.poses.size());
+    q->full->run(set.poses, [&](std::size_t k, const Result& r) {
+      first[k] = *r.proximity;
+      first_work[k] = r.counters;
+    });
     std::vector<double> distances;
     for (const Proximity& p : first) distances.push_back(p.distance);
     const double disagree = static_cast<double>(disagreements(distances, set.reference));
