@@ -5,15 +5,15 @@
 //   flags]
 //
 // Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
-// protocol's mean time per query. Each volume with a wide layout (AABB, k-DOPs) also runs its wide form
-// (four children a node, traversal/wide_exact.hpp) as the series <volume>_wide, unless --wide=false.
+// protocol's mean time per query. Each volume with a wide layout (all but rbox) also runs its wide form
+// (four children a node, traversal/wide_exact.hpp) as the series <volume>_wide, unless --wide=false. The
+// queries are the run-time layer's (engine/any_tree.hpp), compiled once in the engine.
 // Counters: BV tests and triangle tests per query, bytes per triangle.
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
+#include "engine/any_tree.hpp"
+#include "engine/policies.hpp"
 #include "engine/protocol.hpp"
-#include "engine/registry.hpp"
-#include "traversal/exact.hpp"
-#include "traversal/wide_exact.hpp"
 
 #include <benchmark/benchmark.h>
 #ifdef BVHLAB_HAVE_FCL
@@ -23,7 +23,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
-#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -59,23 +59,22 @@ void set_per_query_counters(benchmark::State& state, std::size_t queries, const 
   if (bytes_per_triangle > 0) state.counters["bytes_per_tri"] = bytes_per_triangle;
 }
 
-/// One series per pose set: `query(pose)` answers a Result, timed over the set's poses per iteration.
-template <class Query>
-void register_series(const std::string& prefix, const std::vector<PoseSet>& sets, Query query,
-                     double bytes_per_triangle) {
+/// One series per pose set: `query` over the set's poses per iteration.
+void register_series(const std::string& prefix, const std::vector<PoseSet>& sets,
+                     std::shared_ptr<const PreparedQuery> query, double bytes_per_triangle) {
   for (const auto& set : sets) {
     const std::string name = prefix + "/d:" + set.label;
     benchmark::RegisterBenchmark(name.c_str(), [query, bytes_per_triangle, &set](benchmark::State& state) {
       Counters pass;
       std::size_t colliding = 0;
+      const ResultSink record = [&](std::size_t, const Result& r) {
+        pass += r.counters;
+        colliding += r.collides;
+      };
       for (auto _ : state) {
         pass = {};
         colliding = 0;
-        for (const auto& pose : set.poses) {
-          const Result r = query(pose);
-          pass += r.counters;
-          colliding += r.collides;
-        }
+        query->run(set.poses, record);
         benchmark::DoNotOptimize(colliding);
       }
       set_per_query_counters(state, set.poses.size(), pass, colliding, bytes_per_triangle);
@@ -83,28 +82,20 @@ void register_series(const std::string& prefix, const std::vector<PoseSet>& sets
   }
 }
 
-template <class BV>
-void register_bvhlab(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
-                     const std::vector<PoseSet>& sets) {
-  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
-  register_series(
-      "exact/" + mesh_name + "/" + std::string(BV::name()), sets,
-      [tree](const RigidTransform& pose) { return query_exact(*tree, *tree, pose); },
-      tree->stats().bytes_per_triangle);
-}
-
-/// A tree's wide form (traversal/wide_exact.hpp) as the series "<volume>_wide"; its bytes per triangle
-/// count both forms (the wide walk reads the binary leaves).
-template <HasWideLayout BV>
-void register_wide(const std::string& mesh_name, const std::shared_ptr<const Mesh>& mesh,
-                   const std::vector<PoseSet>& sets) {
-  auto tree = std::make_shared<const Bvh<BV>>(Bvh<BV>::build(*mesh));
-  auto wide = std::make_shared<const WideTreeOf<BV>>(WideTreeOf<BV>::build(*tree));
-  const BvhStats stats = tree->stats();
-  register_series(
-      "exact/" + mesh_name + "/" + std::string(BV::name()) + "_wide", sets,
-      [tree, wide](const RigidTransform& pose) { return query_exact_wide(*tree, *wide, *tree, *wide, pose); },
-      double(stats.nodes * stats.bytes_per_node + wide->bytes()) / double(stats.triangles));
+/// The exact query of volume `bv`'s tree of the mesh against itself, and of its wide form as the series
+/// "<volume>_wide" (whose bytes per triangle count both forms: the wide walk reads the binary leaves).
+void register_bvhlab(const std::string& mesh_name, const Mesh& mesh, const std::string& bv,
+                     const std::vector<PoseSet>& sets, bool wide) {
+  const AnyTree tree = AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{});
+  StrategyVariant exact = strategy_variant("exact", {}, Budget{});
+  const double triangles = double(tree.info().triangles);
+  const std::string prefix = "exact/" + mesh_name + "/" + bv;
+  register_series(prefix, sets, tree.prepare(tree, exact), tree.info().model_bytes / triangles);
+  if (!wide || !wide_layout_refusal(bv).empty()) return;
+  exact.wide = true;
+  std::shared_ptr<const PreparedQuery> query = tree.prepare(tree, exact);
+  register_series(prefix + "_wide", sets, std::move(query),
+                  (tree.info().model_bytes + tree.wide_layout_bytes()) / triangles);
 }
 
 #ifdef BVHLAB_HAVE_FCL
@@ -153,14 +144,17 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_protocol: --steps must be at least 1\n");
     return 2;
   }
+  for (const auto& v : volumes) {
+    try {
+      (void)wide_layout_refusal(v);  // throws for a name the registry does not know
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "bench_protocol: --volumes: %s\n", e.what());
+      return 2;
+    }
+  }
   static const std::vector<PoseSet> sets = make_pose_sets(steps);
   for_each_protocol_mesh("bench_protocol", meshes, [&](const std::string& label, const auto& mesh) {
-    for (const auto& v : volumes)
-      with_volume(v, [&]<class BV>(std::type_identity<BV>) {
-        register_bvhlab<BV>(label, mesh, sets);
-        if constexpr (HasWideLayout<BV>)
-          if (wide) register_wide<BV>(label, mesh, sets);
-      });
+    for (const auto& v : volumes) register_bvhlab(label, *mesh, v, sets, wide);
 #ifdef BVHLAB_HAVE_FCL
     register_fcl<fcl::OBBd>(label, "fcl_obb", mesh, sets);
     register_fcl<fcl::OBBRSSd>(label, "fcl_obbrss", mesh, sets);
