@@ -56,16 +56,38 @@ inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rota
   return (hi - lo).cwiseMax(thinnest).prod();
 }
 
-/// An upper bound of Vol(A ∩ B) for boxes a and b whose frames b_to_a relates (abs_rotation = |R|):
-/// re-boxing either box in the other's frame bounds the overlap from above, so the smaller bound is used.
+/// A pose as re-boxing reads it in both directions: B into A's frame (R, |R|, t) and A into B's (R^T, |R|^T,
+/// -R^T t). A traversal makes it once per pose: the inverse is the same for every node pair.
+struct ReboxPose {
+  ReboxPose(const RigidTransform& b_to_a, const Mat3& abs_rotation)
+      : rotation(b_to_a.rotation),
+        abs_rotation(abs_rotation),
+        translation(b_to_a.translation),
+        inverse_rotation(rotation.transpose()),
+        inverse_abs_rotation(abs_rotation.transpose()),
+        inverse_translation(-(inverse_rotation * translation)) {}
+  explicit ReboxPose(const RigidTransform& b_to_a) : ReboxPose(b_to_a, b_to_a.rotation.cwiseAbs()) {}
+
+  Mat3 rotation, abs_rotation;
+  Vec3 translation;
+  Mat3 inverse_rotation, inverse_abs_rotation;
+  Vec3 inverse_translation;
+};
+
+/// An upper bound of Vol(A ∩ B) for boxes a and b whose frames `pose` relates: re-boxing either box in the
+/// other's frame bounds the overlap from above, so the smaller bound is used.
+inline double overlap_volume(const Box& a, const Box& b, const ReboxPose& pose) {
+  if (a.empty() || b.empty()) return 0;
+  const double in_a = reboxed_overlap(a, b, pose.rotation, pose.abs_rotation, pose.translation);
+  if (!(in_a > 0)) return 0;
+  const double in_b =
+      reboxed_overlap(b, a, pose.inverse_rotation, pose.inverse_abs_rotation, pose.inverse_translation);
+  return std::min(in_a, in_b);
+}
+/// The same for one pair (abs_rotation = |R|).
 inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b_to_a,
                              const Mat3& abs_rotation) {
-  if (a.empty() || b.empty()) return 0;
-  const double in_a = reboxed_overlap(a, b, b_to_a.rotation, abs_rotation, b_to_a.translation);
-  if (!(in_a > 0)) return 0;
-  const Mat3 r_t = b_to_a.rotation.transpose();
-  const double in_b = reboxed_overlap(b, a, r_t, abs_rotation.transpose(), -(r_t * b_to_a.translation));
-  return std::min(in_a, in_b);
+  return overlap_volume(a, b, ReboxPose(b_to_a, abs_rotation));
 }
 
 /// The estimate's inputs for one node pair.
@@ -77,10 +99,9 @@ struct PairGeometry {
 
 /// The inputs from axis-aligned boxes in the trees' frames (b_to_a maps B's tree frame into A's).
 [[gnu::always_inline]] inline PairGeometry tree_frame_geometry(const Box& a, const Box& b,
-                                                               const RigidTransform& b_to_a,
-                                                               const Mat3& abs_rotation) {
+                                                               const ReboxPose& pose) {
   PairGeometry g{with_min_thickness(a), with_min_thickness(b), 0};
-  g.overlap = overlap_volume(g.a, g.b, b_to_a, abs_rotation);
+  g.overlap = overlap_volume(g.a, g.b, pose);
   return g;
 }
 
