@@ -59,14 +59,13 @@ inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rota
 /// A pose as re-boxing reads it in both directions: B into A's frame (R, |R|, t) and A into B's (R^T, |R|^T,
 /// -R^T t). A traversal makes it once per pose: the inverse is the same for every node pair.
 struct ReboxPose {
-  ReboxPose(const RigidTransform& b_to_a, const Mat3& abs_rotation)
+  explicit ReboxPose(const RigidTransform& b_to_a)
       : rotation(b_to_a.rotation),
-        abs_rotation(abs_rotation),
+        abs_rotation(rotation.cwiseAbs()),
         translation(b_to_a.translation),
         inverse_rotation(rotation.transpose()),
         inverse_abs_rotation(abs_rotation.transpose()),
         inverse_translation(-(inverse_rotation * translation)) {}
-  explicit ReboxPose(const RigidTransform& b_to_a) : ReboxPose(b_to_a, b_to_a.rotation.cwiseAbs()) {}
 
   Mat3 rotation, abs_rotation;
   Vec3 translation;
@@ -74,20 +73,32 @@ struct ReboxPose {
   Vec3 inverse_translation;
 };
 
-/// An upper bound of Vol(A ∩ B) for boxes a and b whose frames `pose` relates: re-boxing either box in the
-/// other's frame bounds the overlap from above, so the smaller bound is used.
-inline double overlap_volume(const Box& a, const Box& b, const ReboxPose& pose) {
+/// An upper bound of Vol(A ∩ B): re-boxing either box in the other's frame bounds the overlap from above,
+/// so the smaller bound is used. B re-boxed in A's frame by (rotation, abs_rotation, translation) first;
+/// `a_in_b()`, A re-boxed in B's frame, only where that is positive.
+template <class AInB>
+[[gnu::always_inline]] inline double smaller_reboxed_overlap(const Box& a, const Box& b, const Mat3& rotation,
+                                                             const Mat3& abs_rotation,
+                                                             const Vec3& translation, AInB&& a_in_b) {
   if (a.empty() || b.empty()) return 0;
-  const double in_a = reboxed_overlap(a, b, pose.rotation, pose.abs_rotation, pose.translation);
+  const double in_a = reboxed_overlap(a, b, rotation, abs_rotation, translation);
   if (!(in_a > 0)) return 0;
-  const double in_b =
-      reboxed_overlap(b, a, pose.inverse_rotation, pose.inverse_abs_rotation, pose.inverse_translation);
-  return std::min(in_a, in_b);
+  return std::min(in_a, a_in_b());
 }
-/// The same for one pair (abs_rotation = |R|).
+
+/// The bound for boxes a and b whose frames `pose` relates, the inverse made beforehand.
+inline double overlap_volume(const Box& a, const Box& b, const ReboxPose& pose) {
+  return smaller_reboxed_overlap(a, b, pose.rotation, pose.abs_rotation, pose.translation, [&] {
+    return reboxed_overlap(b, a, pose.inverse_rotation, pose.inverse_abs_rotation, pose.inverse_translation);
+  });
+}
+/// The same for one pair (abs_rotation = |R|): the inverse made only where it is needed.
 inline double overlap_volume(const Box& a, const Box& b, const RigidTransform& b_to_a,
                              const Mat3& abs_rotation) {
-  return overlap_volume(a, b, ReboxPose(b_to_a, abs_rotation));
+  return smaller_reboxed_overlap(a, b, b_to_a.rotation, abs_rotation, b_to_a.translation, [&] {
+    const Mat3 r_t = b_to_a.rotation.transpose();
+    return reboxed_overlap(b, a, r_t, abs_rotation.transpose(), -(r_t * b_to_a.translation));
+  });
 }
 
 /// The estimate's inputs for one node pair.
