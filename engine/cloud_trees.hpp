@@ -1,11 +1,11 @@
-// Trees over point clouds as the run-time layer builds and queries them: the tree of a cloud, and which
-// strategies take the clouds' surface test at the leaves (traversal/point_leaves.hpp). Internal to engine/.
+// Trees over point clouds as the run-time layer builds them: the tree of a cloud and the densities it takes.
+// Which strategies query them is in engine/typed_query.hpp. Internal to engine/.
 #pragma once
 
 #include "adb/point_density.hpp"
 #include "engine/specs.hpp"
 #include "engine/timing.hpp"
-#include "traversal/point_leaves.hpp"
+#include "traversal/surface_side.hpp"
 
 #include <stdexcept>
 #include <string>
@@ -32,32 +32,6 @@ Tree<BV, D> cloud_tree(const PointCloud& cloud, const ParamValues& density, cons
     annotate_seconds = seconds_since(start);
     return tree;
   }
-}
-
-/// Strategy S, given two trees of type TreeT (a Tree<BV, D>, or what else it reads a tree as), runs on point
-/// clouds: it takes the leaf test as a last argument (S::query(a, b, pose, options, leaves)).
-template <class S, class BV, class TreeT>
-inline constexpr bool takes_leaf_test_on = requires(const TreeT& tree, const RigidTransform& pose,
-                                                    const typename S::Options& options,
-                                                    const SurfaceLeaves<BV>& leaves) {
-  S::query(tree, tree, pose, options, leaves);
-};
-/// Strategy S runs on point clouds of BV and D.
-template <class S, class BV, class D>
-inline constexpr bool takes_leaf_test = takes_leaf_test_on<S, BV, Tree<BV, D>>;
-
-/// Why strategy S, configured with `options`, cannot query point clouds on trees of BV and D; empty when it
-/// can: it takes a leaf test (takes_leaf_test) and answers something other than triangle pairs
-/// (all_contacts).
-template <class S, TreeVolume BV, class D>
-std::string cloud_query_refusal(const typename S::Options& options, std::string_view name) {
-  if constexpr (std::is_same_v<typename S::Options, ContactMode>)
-    if (options == ContactMode::All)
-      return "strategy " + std::string(name) +
-             " lists intersecting triangle pairs, and a point cloud has none";
-  if constexpr (!takes_leaf_test<S, BV, D>)
-    return "strategy " + std::string(name) + " takes no leaf test, so it cannot query point clouds";
-  return {};
 }
 
 /// Calls f.template operator()<D>() with the density a tree over points of BV takes under `density`:

@@ -9,7 +9,7 @@
 #include "adb/adb_paper_density.hpp"
 #include "adb/tree.hpp"
 #include "engine/specs.hpp"
-#include "traversal/strategies.hpp"
+#include "traversal/strategy_types.hpp"
 #include "volumes/shipped.hpp"
 
 #include <string>

@@ -1,6 +1,8 @@
-// The typed trees behind AnyTree and their operations: included only by the generated translation units
-// (engine/volume_slot.cpp.in), each of which instantiates pair_ops<BV, D> for one registered volume and
-// density, with every strategy on them. Internal to engine/.
+// The typed trees behind AnyTree and their own operations (build, load, annotate, refit, save): included by
+// the generated model files (engine/volume_slot.cpp.in), each of which instantiates pair_ops<BV, D> for one
+// registered volume and density. Their queries are compiled apart, in the query files
+// (engine/typed_query.hpp, engine/volume_queries.cpp.in): this header does not include the traversal loops,
+// so a change to a strategy recompiles the query files only. Internal to engine/.
 #pragma once
 
 #include "adb/saved_tree.hpp"
@@ -11,9 +13,7 @@
 #include "engine/refusals.hpp"
 #include "engine/registry.hpp"
 #include "engine/tree_model.hpp"
-#include "traversal/contact_geometry.hpp"
-#include "traversal/frame_schedule.hpp"
-#include "traversal/strategies.hpp"
+#include "traversal/frame_budget.hpp"
 
 #include <algorithm>
 #include <functional>
@@ -93,167 +93,21 @@ struct WideFormOf<BV> {
 template <class BV>
 using WideForm = typename WideFormOf<BV>::type;
 
-/// What a density-free strategy (kDensityFree) reads of a tree: its hierarchy alone, so that one compiled
-/// query serves the trees of every density; and its wide layout when the query walks that (owned by the
-/// tree's model, which the query keeps alive).
-template <class BV>
-struct HierarchyOnly {
-  const Bvh<BV>& bvh;
-  const WideForm<BV>* wide = nullptr;
+/// A tree's queries: prepared queries and the frame budget's schedule, compiled in the query files.
+struct QueryOps {
+  std::unique_ptr<PreparedQuery> (*prepare)(ModelPtr a, ModelPtr b, const StrategyVariant& variant);
+  std::vector<PairOutcome> (*schedule)(const TreeModel& a, std::span<const FramePairRef> pairs,
+                                       const FrameOptions& options, FrameMemory* memory);
 };
 
-/// A tree as strategy S reads it: `Held` is std::reference_wrapper<const Tree<BV, D>> or HierarchyOnly<BV>.
-template <class T>
-const T& tree_of(const std::reference_wrapper<const T>& held) {
-  return held.get();
-}
-template <class BV>
-const HierarchyOnly<BV>& tree_of(const HierarchyOnly<BV>& held) {
-  return held;
-}
-template <class Held>
-using HeldTree = std::remove_cvref_t<decltype(tree_of(std::declval<const Held&>()))>;
+/// The queries of volume V and density D of the registry: defined in engine/typed_query.hpp, instantiated
+/// once, in the query file of their slot.
+template <std::size_t V, std::size_t D>
+const QueryOps& slot_query_ops();
 
-/// The two trees of a prepared query as its strategy reads them, their sides of a point query, and their
-/// models, kept alive while the query lives.
-template <class Held>
-struct QueryTrees {
-  ModelPtr owner_a, owner_b;
-  Held a, b;
-  SurfaceSide side_a, side_b;
-};
-
-/// Strategy S on two trees of volume BV, configured once; with kSurfaces, with the clouds' surface test at
-/// the leaves (traversal/point_leaves.hpp), made per pose as query_exact_points and query_adb_points make it.
-template <class S, class BV, class Held, bool kSurfaces>
-class TypedQuery final : public PreparedQuery {
- public:
-  TypedQuery(QueryTrees<Held> trees, typename S::Options options, bool coherent,
-             bool contact_geometry = false)
-      : trees_(std::move(trees)), options_(std::move(options)), coherent_(coherent) {
-    if (contact_geometry)
-      geometry_.emplace(a().bvh.triangles(), a().bvh.triangle_ids(), b().bvh.triangles(),
-                        b().bvh.triangle_ids());
-  }
-  void run(std::span<const RigidTransform> poses, const ResultSink& sink) const override {
-    if (coherent_) {
-      CoherentState state;
-      return run(poses, sink, state);
-    }
-    for (std::size_t i = 0; i < poses.size(); ++i) sink(i, query(poses[i]));
-  }
-  void run(std::span<const RigidTransform> poses, const ResultSink& sink,
-           CoherentState& state) const override {
-    if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
-    for (std::size_t i = 0; i < poses.size(); ++i) sink(i, query(poses[i], state));
-  }
-  void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out) const override {
-    if (coherent_) {
-      CoherentState state;
-      return timed_series(poses, warmup, out, [&](const RigidTransform& pose) { return query(pose, state); });
-    }
-    timed_series(poses, warmup, out, [this](const RigidTransform& pose) { return query(pose); });
-  }
-  void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
-            CoherentState& state) const override {
-    if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
-    timed_coherent_series(poses, warmup, out, coherent_query(), state);
-  }
-  void time_per_pose(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
-                     std::span<CoherentState> states) const override {
-    if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
-    timed_per_pose_series(poses, warmup, out, coherent_query(), states);
-  }
-  [[nodiscard]] bool coherent() const override { return coherent_; }
-
- private:
-  /// Not inlined: both loops call one copy of the traversal (a direct call per query, not a virtual one),
-  /// which halves what each combination costs to compile.
-  [[gnu::noinline]] Result query(const RigidTransform& pose) const {
-    if constexpr (kSurfaces) {
-      const SurfaceLeaves<BV> leaves(a().bvh, trees_.side_a, b().bvh, trees_.side_b, pose);
-      return S::query(a(), b(), pose, options_, leaves);
-    } else {
-      if constexpr (kWalksWide)
-        if (trees_.a.wide)
-          return with_geometry(pose, S::query_wide(a(), *a().wide, b(), *b().wide, pose, options_));
-      return with_geometry(pose, S::query(a(), b(), pose, options_));
-    }
-  }
-  /// Whether a prepared query of this type may walk the wide layouts (prepare sets them only for a wide
-  /// variant).
-  static constexpr bool kWalksWide =
-      kRunsWide<S> && HasWideLayout<BV> && std::is_same_v<Held, HierarchyOnly<BV>>;
-  Result with_geometry(const RigidTransform& pose, Result r) const {
-    if (geometry_) (*geometry_)(pose, r);
-    return r;
-  }
-  /// The coherent query (prepare lets coherent_ be set only for a strategy that has one).
-  [[gnu::noinline]] Result query(const RigidTransform& pose, CoherentState& state) const {
-    if constexpr (!kRunsCoherent<S>) {
-      throw std::logic_error("strategy " + std::string(S::name()) + " prepared coherent");
-    } else if constexpr (kSurfaces) {
-      const SurfaceLeaves<BV> leaves(a().bvh, trees_.side_a, b().bvh, trees_.side_b, pose);
-      return S::query_coherent(a(), b(), pose, options_, state, leaves);
-    } else {
-      return with_geometry(pose, S::query_coherent(a(), b(), pose, options_, state));
-    }
-  }
-  /// The coherent query as the timing loops call it.
-  auto coherent_query() const {
-    return [this](const RigidTransform& pose, CoherentState& state) { return query(pose, state); };
-  }
-  const auto& a() const { return tree_of(trees_.a); }
-  const auto& b() const { return tree_of(trees_.b); }
-
-  QueryTrees<Held> trees_;
-  typename S::Options options_;
-  bool coherent_ = false;
-  std::optional<ContactGeometryMaker> geometry_;  ///< when the variant asks for the contacts' geometry
-};
-
-/// The prepared query of strategy S (configured as `options`) on `trees`, with the surface test when a side
-/// is a cloud (compiled only with kClouds: trees whose density a cloud's tree can carry). The caller checked
-/// the variant against the trees.
-template <class S, class BV, bool kClouds, class Held>
-std::unique_ptr<PreparedQuery> make_query(QueryTrees<Held> trees, typename S::Options options,
-                                          const StrategyVariant& variant) {
-  if (!trees.side_a.is_cloud() && !trees.side_b.is_cloud())
-    return std::make_unique<TypedQuery<S, BV, Held, false>>(std::move(trees), std::move(options),
-                                                            variant.coherent, variant.contact_geometry);
-  if constexpr (kClouds && takes_leaf_test_on<S, BV, HeldTree<Held>>)
-    return std::make_unique<TypedQuery<S, BV, Held, true>>(std::move(trees), std::move(options),
-                                                           variant.coherent);
-  else
-    throw std::logic_error("cloud_query_refusal let strategy " + variant.strategy +
-                           " through without a leaf test");
-}
-
-/// The queries of the density-free strategies on volume slot V, for trees of any density: compiled in the
-/// volume's first slot file only (engine/volume_slot.cpp.in), which every engine with the volume has.
-template <std::size_t V, bool = (V < type_list_size(RegisteredVolumes{}))>
-struct DensityFreeQueries {
-  using BV = TypeAt<V, RegisteredVolumes>;
-  /// Throws std::logic_error for a strategy that is not density-free (the caller dispatches those itself).
-  static std::unique_ptr<PreparedQuery> prepare(QueryTrees<HierarchyOnly<BV>> trees,
-                                                const StrategyVariant& variant);
-};
-template <std::size_t V>
-struct DensityFreeQueries<V, false> {};  ///< a slot beyond the registered volumes
-
-template <std::size_t V, bool kRegistered>
-std::unique_ptr<PreparedQuery> DensityFreeQueries<V, kRegistered>::prepare(
-    QueryTrees<HierarchyOnly<BV>> trees, const StrategyVariant& variant) {
-  // The strategy is looked up by name again and its options made again (the caller checked them): a member
-  // template per strategy would not be covered by the class's extern declaration.
-  return with_strategy(
-      variant.strategy, [&]<class S>(std::type_identity<S>) -> std::unique_ptr<PreparedQuery> {
-        if constexpr (kDensityFree<S> && kAcceptsVolume<S, BV>)
-          return make_query<S, BV, true>(std::move(trees),
-                                         strategy_options<S>(variant.values, variant.budget), variant);
-        else
-          throw std::logic_error("strategy " + variant.strategy + " reached the density-free queries");
-      });
+template <class BV, class D>
+const QueryOps& query_ops() {
+  return slot_query_ops<type_index<BV>(RegisteredVolumes{}), type_index<D>(RegisteredDensities{})>();
 }
 
 /// A typed tree, of a mesh or of a point cloud (then with its surface): what a query needs of either.
@@ -280,30 +134,18 @@ struct TypedBase : TreeModel {
   /// A mesh's side of a point query; a cloud's tree gives its surface.
   [[nodiscard]] virtual SurfaceSide side() const { return mesh_side(); }
 
+  /// Prepared by the volume and density's query file (engine/typed_query.hpp), so that a change to a
+  /// strategy does not recompile the trees' own operations.
   [[nodiscard]] std::unique_ptr<PreparedQuery> prepare(ModelPtr self, ModelPtr b,
                                                        const StrategyVariant& variant) const override {
-    auto other = std::dynamic_pointer_cast<const TypedBase>(b);
-    if (!other)
-      throw std::invalid_argument("the two trees differ in BV or density (" + info.bv + ", " +
-                                  info.annotation + " vs " + b->info.bv + ", " + b->info.annotation + ")");
-    auto a = std::static_pointer_cast<const TypedBase>(std::move(self));
-    std::unique_ptr<PreparedQuery> out;
-    with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
-      if constexpr (!kAcceptsVolume<S, BV>)
-        throw std::invalid_argument(strategy_info(variant.strategy).volume_refusal(BV::name()));
-      else if constexpr (S::template accepts<D>)
-        out = prepare_typed<S>(std::move(a), std::move(other), variant);
-      else
-        throw std::invalid_argument(strategy_info(variant.strategy).refusal(D::name()));
-    });
-    return out;
+    return query_ops<BV, D>().prepare(std::move(self), std::move(b), variant);
   }
 
   [[nodiscard]] double wide_layout_bytes() const override {
     if (side().is_cloud())
       throw std::invalid_argument("a point cloud's tree has no wide layout (a wide query tests triangles)");
     if constexpr (HasWideLayout<BV>)
-      return double(wide_of(*this).bytes());
+      return double(wide_layout().bytes());
     else
       throw std::invalid_argument(wide_layout_refusal(BV::name()));
   }
@@ -314,25 +156,11 @@ struct TypedBase : TreeModel {
                   : bvhlab::world_box(tree.bvh, pose, root_bounds(tree.bvh));
   }
 
+  /// The frame budget's schedule (engine/typed_query.hpp), compiled with the queries.
   [[nodiscard]] std::vector<PairOutcome> schedule(std::span<const FramePairRef> pairs,
                                                   const FrameOptions& options,
                                                   FrameMemory* memory) const override {
-    if constexpr (ProbabilityDensity<D>) {
-      std::vector<FramePair<BV, D>> typed;
-      typed.reserve(pairs.size());
-      for (const FramePairRef& p : pairs) {
-        const auto* a = dynamic_cast<const TypedBase*>(p.a->model().get());
-        const auto* b = dynamic_cast<const TypedBase*>(p.b->model().get());
-        if (!a || !b)
-          throw std::invalid_argument("a frame budget runs on trees of one volume and density; " + info.bv +
-                                      ", " + info.annotation + " met another");
-        typed.push_back({&a->tree, &b->tree, p.b_to_a, p.identity});
-      }
-      return schedule_frame<BV, D>(std::span<const FramePair<BV, D>>(typed), options, memory);
-    } else {
-      throw std::invalid_argument("frame budgets need a density with probabilities; the trees carry " +
-                                  info.density);
-    }
+    return query_ops<BV, D>().schedule(*this, pairs, options, memory);
   }
 
   double refit(const Mesh& deformed, RefitMethod method) override;
@@ -349,89 +177,17 @@ struct TypedBase : TreeModel {
   /// The root's bounding ball and DOP vertices (traversal/broad_phase/world_box.hpp); none after a refit.
   std::optional<RootBounds> bounds;
 
+  /// The wide layout of this tree, built on the first wide query and kept with the tree for the next ones.
+  const WideForm<BV>& wide_layout() const {
+    const std::lock_guard lock(wide_mutex_);
+    if (!wide_) wide_ = std::make_unique<const WideForm<BV>>(WideForm<BV>::build(tree.bvh));
+    return *wide_;
+  }
+
  private:
-  /// S configured, checked against both trees, with the surface test when either is a cloud's.
-  template <class S>
-  std::unique_ptr<PreparedQuery> prepare_typed(std::shared_ptr<const TypedBase> a,
-                                               std::shared_ptr<const TypedBase> b,
-                                               const StrategyVariant& variant) const {
-    if constexpr (ProbabilityDensity<D>)  // refuses trees annotated with other parameters, before any pose
-      (void)D::estimator(tree.density, b->tree.density);
-    auto options = strategy_options<S>(variant.values, variant.budget);
-    if (variant.coherent && !kRunsCoherent<S>)
-      throw std::invalid_argument(strategy_info(variant.strategy).coherent_refusal());
-    if (variant.contact_geometry && !S::needs_polygons)
-      throw std::invalid_argument(strategy_info(variant.strategy).contact_geometry_refusal());
-    if (variant.wide) check_wide<S>(variant, side().is_cloud() || b->side().is_cloud());
-    if (side().is_cloud() || b->side().is_cloud()) {
-      if (variant.contact_geometry)
-        throw std::invalid_argument("contact geometry needs triangles; a point cloud's tree has none");
-      if constexpr (kCloudDensity<D>)
-        check_points<S>(*a, *b, options, variant);
-      else
-        throw std::logic_error("a tree over points with density " + info.density);
-    } else if (S::needs_polygons && !(info.polygons && b->info.polygons)) {
-      throw std::invalid_argument(
-          "strategy " + variant.strategy +
-          " tests triangles, and a tree was loaded without polygons (load it with its "
-          "mesh)");
-    }
-    const SurfaceSide side_a = a->side(), side_b = b->side();
-    const Bvh<BV>& bvh_a = a->tree.bvh;
-    const Bvh<BV>& bvh_b = b->tree.bvh;
-    if constexpr (kDensityFree<S>) {
-      QueryTrees<HierarchyOnly<BV>> trees{std::move(a), std::move(b), {bvh_a}, {bvh_b}, side_a, side_b};
-      if constexpr (HasWideLayout<BV>)
-        if (variant.wide) {
-          trees.a.wide = &wide_of(*trees.owner_a);
-          trees.b.wide = &wide_of(*trees.owner_b);
-        }
-      return DensityFreeQueries<type_index<BV>(RegisteredVolumes{})>::prepare(std::move(trees), variant);
-    } else {
-      const Tree<BV, D>& tree_a = a->tree;
-      const Tree<BV, D>& tree_b = b->tree;
-      QueryTrees<std::reference_wrapper<const Tree<BV, D>>> trees{
-          std::move(a), std::move(b), std::cref(tree_a), std::cref(tree_b), side_a, side_b};
-      return make_query<S, BV, kCloudDensity<D>>(std::move(trees), std::move(options), variant);
-    }
-  }
-
-  /// The refusals of a wide variant: a strategy without a wide walk, a volume without a wide layout, point
-  /// leaves, a coherent walk.
-  template <class S>
-  static void check_wide(const StrategyVariant& variant, bool cloud) {
-    if (!kRunsWide<S>) throw std::invalid_argument(strategy_info(variant.strategy).wide_refusal());
-    if (!HasWideLayout<BV>) throw std::invalid_argument(wide_layout_refusal(BV::name()));
-    if (variant.coherent)
-      throw std::invalid_argument(
-          "a coherent query walks the binary trees; ask for coherent or wide, not both");
-    if (cloud)
-      throw std::invalid_argument(
-          "a wide query tests triangles at the leaves; a point cloud's tree has none");
-  }
-
-  /// The wide layout of `model` (a TypedBase of this volume and density: the caller checked), built on the
-  /// first wide query and kept with the tree for the next ones.
-  static const WideForm<BV>& wide_of(const TreeModel& model) {
-    const auto& typed = static_cast<const TypedBase&>(model);
-    const std::lock_guard lock(typed.wide_mutex_);
-    if (!typed.wide_) typed.wide_ = std::make_unique<const WideForm<BV>>(WideForm<BV>::build(typed.tree.bvh));
-    return *typed.wide_;
-  }
-
-  /// The wide layout (wide_of); a refit drops it. Built under the lock: threads may prepare queries at once.
+  /// The wide layout (wide_layout); a refit drops it. Built under the lock: threads may prepare at once.
   mutable std::mutex wide_mutex_;
   mutable std::unique_ptr<const WideForm<BV>> wide_;
-
-  /// SurfaceLeaves' checks of the two sides and the strategy's (so running cannot fail).
-  template <class S>
-  static void check_points(const TypedBase& a, const TypedBase& b, const typename S::Options& options,
-                           const StrategyVariant& variant) {
-    (void)SurfaceLeaves<BV>(a.tree.bvh, a.side(), b.tree.bvh, b.side(), RigidTransform{});
-    if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, variant.strategy);
-        !refusal.empty())
-      throw std::invalid_argument(refusal);
-  }
 };
 
 /// A mesh's tree.

@@ -19,6 +19,7 @@
 #include "../bvh/triangle_distance.hpp"
 #include "coherent.hpp"
 #include "coherent_state.hpp"
+#include "distance_result.hpp"
 #include "driver.hpp"
 #include "exact.hpp"
 
@@ -161,36 +162,12 @@ class DistanceHooks {
   double unexamined_bound_ = std::numeric_limits<double>::infinity();
 };
 
-/// What a distance query answers. `distance` is the nearest pair found, `lower_bound` what is proven: they
-/// are equal (and `exact`) unless a budget stopped the query, and the exact distance lies between them.
-/// Points are in A's frame (on_b is B's point moved by the pose); `triangles` are source-mesh indices.
-struct DistanceResult {
-  double distance = std::numeric_limits<double>::infinity();
-  double lower_bound = 0;
-  Vec3 on_a = Vec3::Zero(), on_b = Vec3::Zero();
-  std::optional<TrianglePair> triangles;  ///< empty only for an empty tree, or when stopped before a leaf
-  bool exact = true;
-  bool budget_exhausted = false;
-  Counters counters;
-};
-
 namespace distance_detail {
 
 template <DistanceVolume BV>
 void check_query(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, const char* who) {
   b_to_a.validate();
   TriangleLeaves::require(a, b, who);
-}
-
-/// Refuses a deadline that is negative, NaN or infinite, and a budget that allows nothing.
-inline void check_anytime_budget(const Budget& budget) {
-  if (!(budget.deadline_us >= 0) || std::isinf(budget.deadline_us))
-    throw std::invalid_argument(
-        "anytime distance: the deadline must be a finite number of microseconds >= 0");
-  if (budget.unlimited())
-    throw std::invalid_argument(
-        "anytime distance: the budget is 0 (no BV-test cap and no deadline); give one, or ask for the full "
-        "distance query");
 }
 
 /// The distance traversal under `limit` (Unlimited or BudgetLimit). With `seed` (a coherent query's

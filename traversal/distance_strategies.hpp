@@ -1,10 +1,12 @@
 // The proximity strategies (concept: traversal/strategy.hpp): thin configurations of the queries in
-// traversal/distance.hpp. They run on trees of volumes with a distance bound (the DistanceVolume
-// refinement) and refuse the others by name (S::accepts_volume); the density does not matter to them.
+// traversal/distance.hpp, which is not included here (traversal/strategy_types.hpp says why). They run on
+// trees of volumes with a distance bound (the DistanceVolume refinement) and refuse the others by name
+// (S::accepts_volume); the density does not matter to them.
 #pragma once
 
 #include "../adb/parameters.hpp"
-#include "distance.hpp"
+#include "coherent_state.hpp"
+#include "distance_result.hpp"
 #include "strategy.hpp"
 #include "strategy_names.hpp"
 

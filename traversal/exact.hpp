@@ -3,13 +3,12 @@
 #pragma once
 
 #include "driver.hpp"
+#include "exact_options.hpp"
 
 #include <optional>
 #include <stdexcept>
 
 namespace bvhlab {
-
-enum class ContactMode { First, All };
 
 /// The exact strategy's hooks: a pair is queued iff its volumes overlap; leaf pairs run the leaf test (the
 /// triangle tests, or Leaves' own). `Pair` may carry a key for other queue policies (set by a derived
