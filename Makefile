@@ -17,7 +17,7 @@ build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)
 
 # The demo needs its own CLI only (bvhlab-demo: the volumes demo.json uses): no tests, benchmarks or
-# fuzzers, and 4 of the 20 engine slot files, are built first.
+# fuzzers, and 4 of the engine's 22 slots (12 of its 55 files), are built first.
 demo: configure
 	cmake --build --preset $(PRESET) -j $(JOBS) --target bvhlab_demo
 	$(BUILD_DIR)/bench/bvhlab-demo demo --build-dir $(BUILD_DIR)
