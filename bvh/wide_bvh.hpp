@@ -27,8 +27,8 @@ namespace bvhlab {
 /// and lists as children the binary nodes below it that it does not absorb: starting from its two children,
 /// the one with the largest size (bounding-box volume) is replaced by its own two until there are kWidth or
 /// only leaves. Every binary leaf is the child of exactly one wide node (a tree that is one leaf has no wide
-/// node). Children keep the binary order (left before right), so a depth-first walk meets them as the
-/// binary walk would.
+/// node). Children keep the binary order (left before right), so a depth-first walk in lane order meets
+/// them as the binary walk would (the all-contacts walk does; a first-contact walk takes the nearest first).
 struct WideTopology {
   static constexpr int kWidth = 4;
   struct Node {

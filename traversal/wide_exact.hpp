@@ -1,8 +1,9 @@
 // Exact first-contact (or all-contacts) query on wide trees (bvh/wide_bvh.hpp): depth-first, like
 // query_exact on the binary trees, but one step tests a volume of one tree against all four children of a
-// node of the other at once (the Lanes' place and overlap_placed). The same answers as query_exact on the
-// binary trees the wide ones were built from: the triangle tests are the same, the volume tests
-// conservative.
+// node of the other at once (the Lanes' place and overlap_placed), and a first-contact walk takes the
+// overlapping children nearest first (Lanes::center_distances). The same answers as query_exact on the
+// binary trees the wide ones were built from (the witness may be another intersecting pair): the triangle
+// tests are the same, the volume tests conservative.
 //
 // Counters: bv_tests counts four a step (each lane is a volume test, occupied or not: a node of fewer than
 // four children pays for four), nodes_visited the pairs taken off the stack, triangle_tests as usual.
@@ -11,6 +12,7 @@
 #include "../bvh/wide_bvh.hpp"
 #include "exact.hpp"
 
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -74,21 +76,35 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
   if constexpr (keep) placed.reserve(32);
   std::vector<wide_detail::WidePair> stack;
   stack.reserve(64);
-  // Pushes the pairs of the lanes `hits` marks, last to first, so that the first is taken first, as in the
-  // binary walk: `base` with the lane set on the split side.
-  const auto push = [&stack](unsigned hits, const wide_detail::WidePair& base, bool split_b) {
-    for (std::uint32_t k = 4; k-- > 0;)
-      if (hits & (1u << k)) {
-        wide_detail::WidePair child = base;
-        (split_b ? child.b_lane : child.a_lane) = k;
-        stack.push_back(child);
-      }
+  // Pushes the pairs of the lanes `hits` marks (`base` with the lane set on the split side), so that the
+  // one whose centres are nearest is taken first: looking for a first contact, that pair is the likeliest
+  // to hold one (the distances are computed only where two lanes or more overlap). All contacts need every
+  // pair, so that walk keeps the lanes' order (the binary walk's).
+  const bool nearest_first = mode == ContactMode::First;
+  const auto push = [&stack, nearest_first](unsigned hits, const auto& a_volumes, const auto& b_placed,
+                                            const wide_detail::WidePair& base, bool split_b) {
+    std::array<float, 4> distance{};
+    if (nearest_first && (hits & (hits - 1)) != 0) distance = Lanes::center_distances(a_volumes, b_placed);
+    std::array<std::uint32_t, 4> order;  // the lanes hit, in the order they are to be taken
+    int n = 0;
+    for (std::uint32_t k = 0; k < 4; ++k) {
+      if (!(hits & (1u << k))) continue;
+      int i = n++;
+      for (; i > 0 && distance[k] < distance[order[i - 1]]; --i) order[i] = order[i - 1];
+      order[i] = k;
+    }
+    while (n-- > 0) {
+      wide_detail::WidePair child = base;
+      (split_b ? child.b_lane : child.a_lane) = order[n];
+      stack.push_back(child);
+    }
   };
   // The roots, as any pair (B's root placed in block 0 where the walk keeps blocks).
   counters.bv_tests += 1;
   const typename Lanes::Placed root_b = Lanes::place(wide_b.node(0).boxes, lanes);
   if constexpr (keep) placed.push_back(root_b);
-  push(Lanes::overlap_placed(wide_a.node(0).boxes, root_b, lanes) & 1u, {0, 0, 0, 0, 0}, false);
+  push(Lanes::overlap_placed(wide_a.node(0).boxes, root_b, lanes) & 1u, wide_a.node(0).boxes, root_b,
+       {0, 0, 0, 0, 0}, false);
   while (!stack.empty()) {
     const wide_detail::WidePair p = stack.back();
     stack.pop_back();
@@ -114,11 +130,11 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
     counters.bv_tests += 4;
     if (leaf_a || (!leaf_b && node_b.boxes.volume(int(p.b_lane)) > node_a.boxes.volume(int(p.a_lane)))) {
       const typename Lanes::Placed children = Lanes::place(wide_b.node(child_b).boxes, lanes);
-      const unsigned hits =
-          Lanes::overlap_placed(Lanes::broadcast(node_a.boxes, int(p.a_lane)), children, lanes);
+      const Lanes a_volume = Lanes::broadcast(node_a.boxes, int(p.a_lane));
+      const unsigned hits = Lanes::overlap_placed(a_volume, children, lanes);
       const auto block = static_cast<std::uint32_t>(placed.size());
       if constexpr (keep) placed.push_back(children);
-      push(hits, {p.a_node, p.a_lane, child_b, 0, block}, true);
+      push(hits, a_volume, children, {p.a_node, p.a_lane, child_b, 0, block}, true);
     } else {
       const auto placed_b = [&] {
         if constexpr (keep)
@@ -126,8 +142,9 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
         else
           return Lanes::place(Lanes::broadcast(node_b.boxes, int(p.b_lane)), lanes);
       };
-      const unsigned hits = Lanes::overlap_placed(wide_a.node(child_a).boxes, placed_b(), lanes);
-      push(hits, {child_a, 0, p.b_node, p.b_lane, p.placed}, false);
+      const typename Lanes::Placed b_volume = placed_b();
+      const unsigned hits = Lanes::overlap_placed(wide_a.node(child_a).boxes, b_volume, lanes);
+      push(hits, wide_a.node(child_a).boxes, b_volume, {child_a, 0, p.b_node, p.b_lane, p.placed}, false);
     }
   }
   return result;

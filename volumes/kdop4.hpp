@@ -129,6 +129,18 @@ struct alignas(16) KDop4 {
     out.mag.fill(from.mag[lane]);
     return out;
   }
+  /// Per lane, four times the squared distance between the centres of the bounding boxes of `a`'s lane
+  /// and `b`'s (placed on A's axes; the first three are the coordinate axes, as in volume()): the wide walk
+  /// takes the nearest of the overlapping pairs first (traversal/wide_exact.hpp).
+  static Row center_distances(const KDop4& a, const Placed& b) {
+    Row out{};
+    for (int k = 0; k < kLanes; ++k)
+      for (std::size_t m = 0; m < 3; ++m) {
+        const float d = (a.offsets[m][k] - a.offsets[m + kAxes][k]) - (b.upper[m][k] - b.neg_lower[m][k]);
+        out[k] += d * d;
+      }
+    return out;
+  }
 
   /// Bit k set: lane k of `a` (A's frame) and lane k of `b` (B's, placed by the pose) may overlap. Lanes of
   /// an empty DOP never do. place() then overlap_placed(), in the vector unit where there is SSE2: the float

@@ -119,6 +119,17 @@ struct alignas(16) Obb4 {
   using Placed = Obb4;
   static constexpr bool kKeepsPlaced = false;
   static Placed broadcast_placed(const Placed& from, int lane) { return broadcast(from, lane); }
+  /// Per lane, the squared distance between the centres of `a`'s lane and `b`'s (placed in A's frame): the
+  /// wide walk takes the nearest of the overlapping pairs first (traversal/wide_exact.hpp).
+  static Row center_distances(const Obb4& a, const Placed& b) {
+    Row out{};
+    for (int k = 0; k < kLanes; ++k)
+      for (int r = 0; r < 3; ++r) {
+        const float d = a.center[r][k] - b.center[r][k];
+        out[k] += d * d;
+      }
+    return out;
+  }
 
   /// Bit k set: lane k of `a` and lane k of `b` (placed by the pose) may overlap; empty lanes never do.
   static unsigned overlap(const Obb4& a, const Obb4& b, const PairContext& c) {

@@ -6,6 +6,7 @@
 // the lanes stored relative to nearby origins. (Boxes are checked in exact arithmetic: test_aabb4.cpp.)
 #include "support/generated_meshes.hpp"
 #include "support/random_draws.hpp"
+#include "volumes/aabb4.hpp"
 #include "volumes/dop24.hpp"
 #include "volumes/kdop4.hpp"
 #include "volumes/obb4.hpp"
@@ -13,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <random>
 #include <vector>
 
@@ -100,6 +103,43 @@ TYPED_TEST(LaneTest, PairsAtTheDoubleTestsEdgeStayOverlappingFarFromTheOrigin) {
         (TypeParam::overlap(la, lb, TypeParam::make_context(pose, origin_a, origin_b)) & 1u) == 0;
   }
   EXPECT_GT(apart_outside, 280);
+}
+
+// The wide walk takes the overlapping pair of nearest centres first (traversal/wide_exact.hpp): four small
+// volumes of B placed around A's at distances 0.4 to 2.5 in shuffled lanes, after a random pose, come out of
+// center_distances in the order of their true distances, for every layout.
+template <class Lanes>
+class LaneOrder : public ::testing::Test {};
+using AllLayouts =
+    ::testing::Types<Aabb4, Sphere4, Obb4, KDop4<dop_sets::Dop6>, KDop4<dop_sets::Dop14>,
+                     KDop4<dop_sets::Dop18>, KDop4<dop_sets::Zachmann24>, KDop4<dop_sets::Dop26>>;
+TYPED_TEST_SUITE(LaneOrder, AllLayouts);
+
+TYPED_TEST(LaneOrder, CenterDistancesOrderThePlacedVolumesByDistance) {
+  using BV = typename TypeParam::Volume;
+  std::mt19937_64 rng(67);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  for (int round = 0; round < 200; ++round) {
+    const Vec3 far = Vec3::Constant(round % 2 ? 1e5 : 0);
+    const Vec3 origin_a = far + testing::draw_vec3(unit, rng), origin_b = far + testing::draw_vec3(unit, rng);
+    const RigidTransform pose = testing::random_pose(rng, 1.0);
+    const BV a = random_volume<BV>(rng, far, 0.05);
+    std::array<double, 4> distance = {0.4, 1.0, 1.7, 2.5};
+    std::shuffle(distance.begin(), distance.end(), rng);
+    TypeParam la, lb;
+    for (int k = 0; k < 4; ++k) {
+      la.set(k, a, origin_a);
+      // B's volume k where the pose puts it at distance[k] from A's centre, in a random direction.
+      const Vec3 there = far + distance[k] * testing::draw_vec3(unit, rng).normalized();
+      lb.set(k, random_volume<BV>(rng, pose.rotation.transpose() * (there - pose.translation), 0.05),
+             origin_b);
+    }
+    const auto context = TypeParam::make_context(pose, origin_a, origin_b);
+    const std::array<float, 4> key = TypeParam::center_distances(la, TypeParam::place(lb, context));
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        if (distance[i] < distance[j]) ASSERT_LT(key[i], key[j]) << "round " << round;
+  }
 }
 
 TEST(KDop4, LanesContainTheirDops) {
