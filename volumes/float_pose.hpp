@@ -64,4 +64,16 @@ struct FloatPose {
   }
 };
 
+/// Per lane, the squared distance between the centres of four lanes stored as coordinate rows `cx`, `cy`,
+/// `cz` (Aabb4, Sphere4): their center_distances.
+template <class Lanes>
+std::array<float, 4> squared_center_distances(const Lanes& a, const Lanes& b) {
+  std::array<float, 4> out{};
+  for (int k = 0; k < 4; ++k) {
+    const float dx = a.cx[k] - b.cx[k], dy = a.cy[k] - b.cy[k], dz = a.cz[k] - b.cz[k];
+    out[k] = dx * dx + dy * dy + dz * dz;
+  }
+  return out;
+}
+
 }  // namespace bvhlab

@@ -78,12 +78,7 @@ struct alignas(16) Sphere4 {
   /// Per lane, the squared distance between the centres of `a`'s lane and `b`'s (placed in A's frame): the
   /// wide walk takes the nearest of the overlapping pairs first (traversal/wide_exact.hpp).
   static std::array<float, 4> center_distances(const Sphere4& a, const Placed& b) {
-    std::array<float, 4> out{};
-    for (int k = 0; k < kLanes; ++k) {
-      const float dx = a.cx[k] - b.cx[k], dy = a.cy[k] - b.cy[k], dz = a.cz[k] - b.cz[k];
-      out[k] = dx * dx + dy * dy + dz * dz;
-    }
-    return out;
+    return squared_center_distances(a, b);
   }
 
   /// Bit k set: lane k of `a` and lane k of `b` (placed by the pose) may overlap; empty lanes never do.
