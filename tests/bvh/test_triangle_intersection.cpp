@@ -1,6 +1,7 @@
 // Property tests: the fast triangle test against CGAL ground truth on random and adversarial families,
 // plus hand-written cases with known answers. Every family uses a fixed seed.
 #include "bench/core/generators.hpp"
+#include "bvh/triangle_batch.hpp"
 #include "bvh/triangle_intersection.hpp"
 #include "bvh/triangle_intersection_fast.hpp"
 #include "support/triangle_families.hpp"
@@ -37,7 +38,32 @@ using generators::uniform_point;
 
 struct FamilyStats {
   std::size_t pairs = 0, intersecting = 0, undecided = 0, disagreements = 0, known = 0, known_wrong = 0;
+  std::size_t batch_apart = 0, batch_problems = 0;
   std::string first_problem;
+};
+
+// Four pairs of a family at a time through the plane tests of bvh/triangle_batch.hpp: the vector lanes must
+// answer as the scalar reference, and a pair they call apart must be disjoint.
+struct BatchCheck {
+  TrianglePairs4 batch{};
+  bool exact[4] = {};
+  int filled = 0;
+
+  void add(const Pair& pair, bool intersects, FamilyStats& stats) {
+    batch.set(filled, pair.p, pair.q);
+    exact[filled++] = intersects;
+    if (filled < 4) return;
+    filled = 0;
+    const unsigned apart = triangle_pairs_apart(batch), reference = triangle_pairs_apart_scalar(batch);
+    for (int k = 0; k < 4; ++k) {
+      const bool wrong = (apart >> k & 1) && exact[k];
+      stats.batch_apart += apart >> k & 1;
+      if ((apart != reference || wrong) && stats.batch_problems++ == 0)
+        stats.first_problem = "plane tests of four: vector mask " + std::to_string(apart) + ", scalar " +
+                              std::to_string(reference) + ", lane " + std::to_string(k) +
+                              " apart but intersects: " + std::to_string(wrong);
+    }
+  }
 };
 
 // Per pair: ground truth, the fast test as the traversal calls it, the filter's own verdict, and the fast
@@ -45,6 +71,7 @@ struct FamilyStats {
 FamilyStats run_family(const char* name, std::uint64_t seed, std::size_t count, const Generator& generate) {
   Rng rng(seed);
   FamilyStats stats;
+  BatchCheck batch;
   for (std::size_t i = 0; i < count; ++i) {
     const Pair pair = generate(rng);
     const bool exact = triangles_intersect_exact(pair.p, pair.q);
@@ -56,6 +83,7 @@ FamilyStats run_family(const char* name, std::uint64_t seed, std::size_t count, 
         verdict != FilteredVerdict::undecided && (verdict == FilteredVerdict::intersecting) != exact;
     ++stats.pairs;
     stats.intersecting += exact;
+    batch.add(pair, exact, stats);
     stats.undecided += verdict == FilteredVerdict::undecided;
     if (fast != exact || swapped != exact || filter_wrong) {
       if (stats.disagreements++ == 0)
@@ -72,9 +100,10 @@ FamilyStats run_family(const char* name, std::uint64_t seed, std::size_t count, 
   }
   std::printf(
       "[family] %-24s pairs=%zu intersecting=%.3f undecided=%.4f disagreements=%zu known=%zu "
-      "known_wrong=%zu\n",
+      "known_wrong=%zu apart_by_planes=%.3f\n",
       name, stats.pairs, double(stats.intersecting) / double(stats.pairs),
-      double(stats.undecided) / double(stats.pairs), stats.disagreements, stats.known, stats.known_wrong);
+      double(stats.undecided) / double(stats.pairs), stats.disagreements, stats.known, stats.known_wrong,
+      double(stats.batch_apart) / double(stats.pairs));
   return stats;
 }
 
@@ -88,6 +117,7 @@ void check_family(const char* name, std::uint64_t seed, std::size_t count, const
   ::testing::Test::RecordProperty(std::string(name) + "_undecided", std::to_string(stats.undecided));
   EXPECT_EQ(stats.disagreements, 0u) << stats.first_problem;
   EXPECT_EQ(stats.known_wrong, 0u) << stats.first_problem;
+  EXPECT_EQ(stats.batch_problems, 0u) << stats.first_problem;
   const double fraction = double(stats.intersecting) / double(stats.pairs);
   EXPECT_GE(fraction, min_fraction) << name << ": too few intersecting pairs for a meaningful family";
   EXPECT_LE(fraction, 1.0 - min_fraction) << name << ": too few disjoint pairs for a meaningful family";
