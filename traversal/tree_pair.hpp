@@ -4,6 +4,7 @@
 #pragma once
 
 #include "../bvh/bvh.hpp"
+#include "../bvh/triangle_batch.hpp"
 #include "../bvh/triangle_intersection.hpp"
 #include "budget.hpp"
 #include "result.hpp"
@@ -183,6 +184,56 @@ class TreePair {
             on_hit(TrianglePair{a.triangle_ids()[ta], b.triangle_ids()[tb]}))
           return true;
       }
+    }
+    return false;
+  }
+
+  /// intersecting_triangles on leaf pairs (i[k], j[k]), k < n <= 4, in that order: the same tests, hits and
+  /// counts. Where each of these leaves holds one triangle, the pairs' plane tests run first, four at once
+  /// (bvh/triangle_batch.hpp), and a pair they prove apart skips its exact test. before(k) is called before
+  /// pair k is tested (a walk counts its visit there).
+  template <class OnHit, class Before>
+  [[gnu::always_inline]] bool intersecting_triangles4(const std::uint32_t* i, const std::uint32_t* j, int n,
+                                                      OnHit&& on_hit, Before&& before) const {
+    bool single = true;
+    for (int k = 0; k < n; ++k) single &= a.node(i[k]).count == 1 && b.node(j[k]).count == 1;
+    if (!single || n == 1) {  // one pair: the exact test's own plane tests cost no more
+      for (int k = 0; k < n; ++k) {
+        before(k);
+        if (intersecting_triangles(i[k], j[k], on_hit)) return true;
+      }
+      return false;
+    }
+    return intersecting_triangles_batch(i, j, n, on_hit, before);
+  }
+
+ private:
+  /// intersecting_triangles4's pairs of single triangles.
+  template <class OnHit, class Before>
+  [[gnu::always_inline]] bool intersecting_triangles_batch(const std::uint32_t* i, const std::uint32_t* j,
+                                                           int n, OnHit& on_hit, Before& before) const {
+    const auto& tri_a = a.triangles();
+    const auto& tri_b = b.triangles();
+    std::uint32_t ta[4], tb[4];
+    TrianglePairs4 batch;
+    for (int k = 0; k < n; ++k) {
+      ta[k] = a.node(i[k]).first;
+      tb[k] = b.node(j[k]).first;
+      batch.set_p(k, tri_a[ta[k]]);
+      if (k > 0 && tb[k] == tb[k - 1])  // A's side was split: B's triangle is moved once
+        batch.copy_q(k, k - 1);
+      else
+        batch.set_q(
+            k, {b_to_a.apply(tri_b[tb[k]][0]), b_to_a.apply(tri_b[tb[k]][1]), b_to_a.apply(tri_b[tb[k]][2])});
+    }
+    if (n % 2) batch.copy(n, 0);  // the odd lane of the last two repeats the first
+    const unsigned apart = triangle_pairs_apart(batch, n);
+    for (int k = 0; k < n; ++k) {
+      before(k);
+      ++counters.triangle_tests;
+      if (!(apart & (1u << k)) && triangles_intersect(tri_a[ta[k]], batch.q_triangle(k)) &&
+          on_hit(TrianglePair{a.triangle_ids()[ta[k]], b.triangle_ids()[tb[k]]}))
+        return true;
     }
     return false;
   }

@@ -27,6 +27,29 @@ struct WidePair {
   std::uint32_t a_node, a_lane, b_node, b_lane, placed;
 };
 
+/// The leaf pair (child_a, child_b) just taken and the leaf pairs next on the stack, up to four in all, in
+/// the order they would be taken (each taken one counts a visited pair): their triangle pairs' plane tests
+/// run at once (TreePair::intersecting_triangles4). True when on_hit stopped the walk.
+template <class Trees, class Tree, class OnHit>
+[[gnu::always_inline]] bool test_leaf_pairs(const Trees& trees, const Tree& wide_a, const Tree& wide_b,
+                                            std::uint32_t child_a, std::uint32_t child_b,
+                                            std::vector<WidePair>& stack, Counters& counters,
+                                            const OnHit& on_hit) {
+  std::uint32_t leaves_a[4] = {child_a & ~Tree::kLeaf}, leaves_b[4] = {child_b & ~Tree::kLeaf};
+  int n = 1;
+  for (; n < 4 && !stack.empty(); ++n) {
+    const WidePair& next = stack.back();
+    const std::uint32_t next_a = wide_a.node(next.a_node).child[next.a_lane];
+    const std::uint32_t next_b = wide_b.node(next.b_node).child[next.b_lane];
+    if (!(next_a & next_b & Tree::kLeaf)) break;
+    leaves_a[n] = next_a & ~Tree::kLeaf;
+    leaves_b[n] = next_b & ~Tree::kLeaf;
+    stack.pop_back();
+  }
+  return trees.intersecting_triangles4(leaves_a, leaves_b, n, on_hit,
+                                       [&counters](int k) { counters.nodes_visited += k > 0; });
+}
+
 template <class Lanes>
 void require_pair(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wide_a,
                   const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b) {
@@ -72,6 +95,12 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
   // and a pair keeps the block its B volume sits in: splitting A then compares against it without placing
   // it again. A box is cheaper to place again than to keep (bench/RESULTS.md, "Wide trees").
   constexpr bool keep = Lanes::kKeepsPlaced;
+  // Boxes and spheres meet many leaf pairs that their triangles' planes part: those layouts test up to four
+  // at once (Lanes::kBatchesLeafPairs). Around oriented boxes and k-DOPs leaf pairs are few and close, and
+  // the batch cost more than it saved (bench/RESULTS.md, "Four triangle pairs at once").
+  constexpr bool batches_leaf_pairs = requires {
+    requires Lanes::kBatchesLeafPairs;
+  };
   std::vector<typename Lanes::Placed> placed;
   if constexpr (keep) placed.reserve(32);
   std::vector<wide_detail::WidePair> stack;
@@ -114,15 +143,19 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
     const std::uint32_t child_a = node_a.child[p.a_lane], child_b = node_b.child[p.b_lane];
     const bool leaf_a = (child_a & Tree::kLeaf) != 0, leaf_b = (child_b & Tree::kLeaf) != 0;
     if (leaf_a && leaf_b) {
-      const bool done = trees.intersecting_triangles(child_a & ~Tree::kLeaf, child_b & ~Tree::kLeaf,
-                                                     [&](const TrianglePair& hit) {
-                                                       result.collides = true;
-                                                       result.probability = 1;
-                                                       if (!result.witness) result.witness = hit;
-                                                       if (mode == ContactMode::First) return true;
-                                                       result.contacts.push_back(hit);
-                                                       return false;
-                                                     });
+      const auto on_hit = [&](const TrianglePair& hit) {
+        result.collides = true;
+        result.probability = 1;
+        if (!result.witness) result.witness = hit;
+        if (mode == ContactMode::First) return true;
+        result.contacts.push_back(hit);
+        return false;
+      };
+      bool done = false;
+      if constexpr (batches_leaf_pairs)
+        done = test_leaf_pairs(trees, wide_a, wide_b, child_a, child_b, stack, counters, on_hit);
+      else
+        done = trees.intersecting_triangles(child_a & ~Tree::kLeaf, child_b & ~Tree::kLeaf, on_hit);
       if (done) return result;
       continue;
     }

@@ -93,6 +93,9 @@ struct alignas(16) Aabb4 {
   /// them rather than keep them: three products a lane are cheaper than the memory (kKeepsPlaced).
   using Placed = Aabb4;
   static constexpr bool kKeepsPlaced = false;
+  /// A wide walk meets many leaf pairs whose triangles' planes part them: it tests their planes four pairs at
+  /// once (traversal/wide_exact.hpp; layouts without this member test pair by pair).
+  static constexpr bool kBatchesLeafPairs = true;
   static Placed broadcast_placed(const Placed& from, int lane) { return broadcast(from, lane); }
   /// Per lane, the squared distance between the centres of `a`'s lane and `b`'s (placed in A's frame): the
   /// wide walk takes the nearest of the overlapping pairs first (traversal/wide_exact.hpp).

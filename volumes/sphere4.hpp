@@ -74,6 +74,9 @@ struct alignas(16) Sphere4 {
   /// B's spheres placed in A's frame are Sphere4s too; placing again is cheaper than keeping them.
   using Placed = Sphere4;
   static constexpr bool kKeepsPlaced = false;
+  /// A wide walk meets many leaf pairs whose triangles' planes part them: it tests their planes four pairs at
+  /// once (traversal/wide_exact.hpp; layouts without this member test pair by pair).
+  static constexpr bool kBatchesLeafPairs = true;
   static Placed broadcast_placed(const Placed& from, int lane) { return broadcast(from, lane); }
   /// Per lane, the squared distance between the centres of `a`'s lane and `b`'s (placed in A's frame): the
   /// wide walk takes the nearest of the overlapping pairs first (traversal/wide_exact.hpp).

@@ -61,22 +61,25 @@ TYPED_TEST(WideExact, FirstContactMatchesCgalOnRandomPoses) {
 TYPED_TEST(WideExact, AllContactsEqualCgalEnumeration) {
   const Mesh a = testing::make_torus(0.7, 0.25, 24, 12);
   const Mesh b = testing::make_torus(0.6, 0.2, 20, 10);
-  BuildOptions small_leaves;
-  small_leaves.max_leaf_triangles = 3;
-  const WidePair<TypeParam> trees(a, b, small_leaves);
   const CgalGroundTruth truth(a, b);
-  std::mt19937_64 rng(9);
-  std::size_t total = 0;
-  for (int k = 0; k < 40; ++k) {
-    const RigidTransform pose = testing::random_pose(rng, 0.8);
-    Result r = trees.query(pose, ContactMode::All);
-    std::sort(r.contacts.begin(), r.contacts.end());
-    const auto expected = truth.all_contacts(pose);
-    ASSERT_EQ(r.contacts, expected) << "pose " << k;
-    EXPECT_EQ(r.collides, !expected.empty());
-    total += expected.size();
+  // One triangle a leaf (leaf pairs' plane tests four at once) and up to three (one pair at a time).
+  for (const std::uint32_t leaf_triangles : {1u, 3u}) {
+    BuildOptions options;
+    options.max_leaf_triangles = leaf_triangles;
+    const WidePair<TypeParam> trees(a, b, options);
+    std::mt19937_64 rng(9);
+    std::size_t total = 0;
+    for (int k = 0; k < 40; ++k) {
+      const RigidTransform pose = testing::random_pose(rng, 0.8);
+      Result r = trees.query(pose, ContactMode::All);
+      std::sort(r.contacts.begin(), r.contacts.end());
+      const auto expected = truth.all_contacts(pose);
+      ASSERT_EQ(r.contacts, expected) << "pose " << k << ", " << leaf_triangles << " triangles a leaf";
+      EXPECT_EQ(r.collides, !expected.empty());
+      total += expected.size();
+    }
+    EXPECT_GT(total, 100u);
   }
-  EXPECT_GT(total, 100u);
 }
 
 // The wide walk takes fewer pairs off its stack than the binary one (a step settles four children) for about
