@@ -104,8 +104,10 @@ struct Plane2 {
 
 }  // namespace tri_batch_detail
 
-/// Bit k set when pair k is proven apart by a plane test (see the top of this file); never set for a pair
-/// that touches or intersects, nor for one holding NaN or infinity (no sign is certified there).
+/// Bit k set when pair k (k < n) is proven apart by a plane test (see the top of this file); never set for a
+/// pair that touches or intersects, nor for one holding NaN or infinity (no sign is certified there). Lanes
+/// go two at a time: for an odd n, lane n is computed too, so it must hold a finite pair (its bit is left
+/// for the caller to ignore).
 [[gnu::always_inline]] inline unsigned triangle_pairs_apart(const TrianglePairs4& pairs, int n = 4) {
   using tri_batch_detail::M2;
   using tri_batch_detail::Plane2;
