@@ -174,10 +174,8 @@ class TreePair {
     const TreeNode& na = a.node(i);
     const TreeNode& nb = b.node(j);
     const auto& tri_a = a.triangles();
-    const auto& tri_b = b.triangles();
     for (std::uint32_t tb = nb.first; tb < nb.first + nb.count; ++tb) {
-      const TrianglePoints moved = {b_to_a.apply(tri_b[tb][0]), b_to_a.apply(tri_b[tb][1]),
-                                    b_to_a.apply(tri_b[tb][2])};
+      const TrianglePoints moved = b_triangle_in_a(tb);
       for (std::uint32_t ta = na.first; ta < na.first + na.count; ++ta) {
         ++counters.triangle_tests;
         if (triangles_intersect(tri_a[ta], moved) &&
@@ -208,12 +206,17 @@ class TreePair {
   }
 
  private:
+  /// B's triangle tb (its index in B's tree order) moved into A's frame.
+  [[gnu::always_inline]] TrianglePoints b_triangle_in_a(std::uint32_t tb) const {
+    const TrianglePoints& t = b.triangles()[tb];
+    return {b_to_a.apply(t[0]), b_to_a.apply(t[1]), b_to_a.apply(t[2])};
+  }
+
   /// intersecting_triangles4's pairs of single triangles.
   template <class OnHit, class Before>
   [[gnu::always_inline]] bool intersecting_triangles_batch(const std::uint32_t* i, const std::uint32_t* j,
                                                            int n, OnHit& on_hit, Before& before) const {
     const auto& tri_a = a.triangles();
-    const auto& tri_b = b.triangles();
     std::uint32_t ta[4], tb[4];
     TrianglePairs4 batch;
     for (int k = 0; k < n; ++k) {
@@ -223,8 +226,7 @@ class TreePair {
       if (k > 0 && tb[k] == tb[k - 1])  // A's side was split: B's triangle is moved once
         batch.copy_q(k, k - 1);
       else
-        batch.set_q(
-            k, {b_to_a.apply(tri_b[tb[k]][0]), b_to_a.apply(tri_b[tb[k]][1]), b_to_a.apply(tri_b[tb[k]][2])});
+        batch.set_q(k, b_triangle_in_a(tb[k]));
     }
     if (n % 2) batch.copy(n, 0);  // the odd lane of the last two repeats the first
     const unsigned apart = triangle_pairs_apart(batch, n);

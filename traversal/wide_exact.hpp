@@ -33,8 +33,7 @@ struct WidePair {
 template <class Trees, class Tree, class OnHit>
 [[gnu::always_inline]] bool test_leaf_pairs(const Trees& trees, const Tree& wide_a, const Tree& wide_b,
                                             std::uint32_t child_a, std::uint32_t child_b,
-                                            std::vector<WidePair>& stack, Counters& counters,
-                                            const OnHit& on_hit) {
+                                            std::vector<WidePair>& stack, const OnHit& on_hit) {
   std::uint32_t leaves_a[4] = {child_a & ~Tree::kLeaf}, leaves_b[4] = {child_b & ~Tree::kLeaf};
   int n = 1;
   for (; n < 4 && !stack.empty(); ++n) {
@@ -47,7 +46,7 @@ template <class Trees, class Tree, class OnHit>
     stack.pop_back();
   }
   return trees.intersecting_triangles4(leaves_a, leaves_b, n, on_hit,
-                                       [&counters](int k) { counters.nodes_visited += k > 0; });
+                                       [&trees](int k) { trees.counters.nodes_visited += k > 0; });
 }
 
 template <class Lanes>
@@ -153,7 +152,7 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
       };
       bool done = false;
       if constexpr (batches_leaf_pairs)
-        done = test_leaf_pairs(trees, wide_a, wide_b, child_a, child_b, stack, counters, on_hit);
+        done = test_leaf_pairs(trees, wide_a, wide_b, child_a, child_b, stack, on_hit);
       else
         done = trees.intersecting_triangles(child_a & ~Tree::kLeaf, child_b & ~Tree::kLeaf, on_hit);
       if (done) return result;
