@@ -12,6 +12,7 @@
 #include "../volumes/aabb4.hpp"
 #include "../volumes/kdop4.hpp"
 #include "../volumes/obb4.hpp"
+#include "../volumes/restricted_box4.hpp"
 #include "../volumes/sphere4.hpp"
 #include "bvh.hpp"
 
@@ -53,9 +54,10 @@ WideTopology collapse_topology(std::span<const TreeNode> nodes, std::span<const 
 /// lane 0, so every volume the walk needs sits in some node's lane: a walk starts at (0, lane 0). Lanes are
 /// stored relative to origin(), the centre of the root's bounding box.
 ///
-/// (Aabb4 for boxes, KDop4 for k-DOPs, Sphere4 for spheres, Obb4 for oriented boxes.) Lanes provides:
-/// `Volume` (the binary tree's volume type), `set(lane, volume, origin)` (a default Lanes is four empty
-/// lanes), `volume(lane)` (its bounding box's volume, for the descent), and the test used by
+/// (Aabb4 for boxes, KDop4 for k-DOPs, Sphere4 for spheres, Obb4 for oriented boxes, RestrictedBox4 for
+/// restricted boxes.) Lanes provides: `Volume` (the binary tree's volume type), `set(lane, volume, origin)`
+/// (a default Lanes is four empty lanes) or `pack(boxes, origin)` (a node's children's decoded boxes at
+/// once), `volume(lane)` (its bounding box's volume, for the descent), and the test used by
 /// traversal/wide_exact.hpp: `PairContext`, `make_context(pose, origin_a, origin_b)`, `broadcast`, `place`,
 /// `overlap_placed`.
 template <class Lanes>
@@ -80,19 +82,38 @@ class WideBvh {
     WideBvh out;
     out.binary_identity_ = tree.identity();
     out.binary_revision_ = tree.volumes_revision();
-    out.origin_ = tree.volume(0).bounding_box().center();
+    // Layouts that pack a node's children together (RestrictedBox4) take their boxes, decoded; the others
+    // set each lane from the volume as stored.
+    constexpr bool packs = requires(std::span<const Box> boxes) {
+      Lanes::pack(boxes, Vec3::Zero());
+    };
+    std::vector<Box> boxes;
+    if constexpr (packs) {
+      boxes = tree.node_boxes();
+      out.origin_ = boxes[0].center();
+    } else {
+      out.origin_ = tree.volume(0).bounding_box().center();
+    }
     // Node 0: the root's own volume in lane 0; the wide nodes follow, shifted by one.
     out.nodes_.resize(topology.nodes.size() + 1);
-    out.nodes_[0].boxes.set(0, tree.volume(0), out.origin_);
-    out.nodes_[0].child[0] = tree.node(0).is_leaf() ? kLeaf : 1u;
-    for (std::size_t w = 0; w < topology.nodes.size(); ++w) {
-      const WideTopology::Node& from = topology.nodes[w];
-      Node& to = out.nodes_[w + 1];
-      for (std::uint32_t k = 0; k < from.count; ++k) {
-        const std::uint32_t c = from.child[k];
-        to.boxes.set(static_cast<int>(k), tree.volume(c), out.origin_);
+    const auto fill = [&](Node& to, std::span<const std::uint32_t> children) {
+      std::array<Box, 4> packed;
+      for (std::size_t k = 0; k < children.size(); ++k) {
+        const std::uint32_t c = children[k];
+        if constexpr (packs)
+          packed[k] = boxes[c];
+        else
+          to.boxes.set(static_cast<int>(k), tree.volume(c), out.origin_);
         to.child[k] = tree.node(c).is_leaf() ? (kLeaf | c) : topology.wide_of[c] + 1;
       }
+      if constexpr (packs) to.boxes = Lanes::pack(std::span(packed).first(children.size()), out.origin_);
+    };
+    const std::uint32_t root = 0;
+    fill(out.nodes_[0], std::span(&root, 1));
+    if (!tree.node(0).is_leaf()) out.nodes_[0].child[0] = 1u;
+    for (std::size_t w = 0; w < topology.nodes.size(); ++w) {
+      const WideTopology::Node& from = topology.nodes[w];
+      fill(out.nodes_[w + 1], std::span(from.child).first(from.count));
     }
     return out;
   }
@@ -120,7 +141,8 @@ template <class Set>
 using WideDopTree = WideBvh<KDop4<Set>>;
 
 /// The four-lane layout of a binary tree's volume, where it has one: WideLanes<Aabb>::type is Aabb4,
-/// WideLanes<KDop<Set>>::type KDop4<Set>, WideLanes<Sphere>::type Sphere4, WideLanes<Obb>::type Obb4.
+/// WideLanes<KDop<Set>>::type KDop4<Set>, WideLanes<Sphere>::type Sphere4, WideLanes<Obb>::type Obb4,
+/// WideLanes<RestrictedBox>::type RestrictedBox4.
 /// `HasWideLayout<BV>` says whether a volume has one.
 template <class BV>
 struct WideLanes {};
@@ -139,6 +161,10 @@ struct WideLanes<Sphere> {
 template <>
 struct WideLanes<Obb> {
   using type = Obb4;
+};
+template <>
+struct WideLanes<RestrictedBox> {
+  using type = RestrictedBox4;
 };
 template <class BV>
 concept HasWideLayout = requires {

@@ -52,7 +52,7 @@ struct StrategyInfo {
 };
 
 /// Empty when volume `bv` has a wide layout (bvh/wide_bvh.hpp); else the one message every caller gives:
-/// "bounding volume 'rbox' has no wide layout (the volumes that do: aabb, ...)".
+/// "bounding volume 'rss' has no wide layout (the volumes that do: aabb, ...)".
 std::string wide_layout_refusal(std::string_view bv);
 
 /// In registration order.

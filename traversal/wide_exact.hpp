@@ -162,7 +162,7 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
     counters.bv_tests += 4;
     if (leaf_a || (!leaf_b && node_b.boxes.volume(int(p.b_lane)) > node_a.boxes.volume(int(p.a_lane)))) {
       const typename Lanes::Placed children = Lanes::place(wide_b.node(child_b).boxes, lanes);
-      const Lanes a_volume = Lanes::broadcast(node_a.boxes, int(p.a_lane));
+      const auto a_volume = Lanes::broadcast(node_a.boxes, int(p.a_lane));  // unpacked, where a layout packs
       const unsigned hits = Lanes::overlap_placed(a_volume, children, lanes);
       const auto block = static_cast<std::uint32_t>(placed.size());
       if constexpr (keep) placed.push_back(children);

@@ -259,7 +259,7 @@ bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
   if (h.is_fcl()) return fcl_refusal(s, h.bv).empty();
-  if (s.wide && !wide_layout_refusal(h.bv).empty()) return false;  // e.g. rbox
+  if (s.wide && !wide_layout_refusal(h.bv).empty()) return false;  // e.g. rss
   return strategy_info(s.name).volume_refusal(h.bv).empty();  // e.g. distance on a volume without a bound
 }
 

@@ -98,7 +98,7 @@ TEST_F(RunTest, ExactAabbSceneNeverAnnotatesNorBuildsFcl) {
 // bytes of both forms: the wide layout and the binary tree whose leaves it reads.
 TEST_F(RunTest, WideSeriesAnswerExactlyAndCountTheLayoutsBytes) {
   const RunOutput run = run_scene(
-      scene(R"([{"bv": "obb"}, {"bv": "rbox"}])", R"([{"type": "exact"}, {"type": "exact", "wide": true}])"),
+      scene(R"([{"bv": "obb"}, {"bv": "rss"}])", R"([{"type": "exact"}, {"type": "exact", "wide": true}])"),
       options);
   std::size_t wide_rows = 0;
   for (const ResultRow& r : run.rows) {
@@ -106,7 +106,7 @@ TEST_F(RunTest, WideSeriesAnswerExactlyAndCountTheLayoutsBytes) {
     EXPECT_EQ(r.fn_rate, 0.0) << r.label;
     if (r.label != "exact wide") continue;
     ++wide_rows;
-    EXPECT_EQ(r.hierarchy, "obb");  // rbox has no wide layout: left out
+    EXPECT_EQ(r.hierarchy, "obb");  // rss has no wide layout: left out
     const auto binary = std::find_if(run.rows.begin(), run.rows.end(), [&](const ResultRow& b) {
       return b.label == "exact" && b.hierarchy == r.hierarchy && b.distance == r.distance;
     });

@@ -130,12 +130,15 @@ TEST(WideQuery, IsRefusedByNameWhereItDoesNotRun) {
   EXPECT_EQ(error_of([&] { (void)adb_tree.prepare(adb_tree, adb); }),
             "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts)");
 
-  const AnyTree rbox = tree("rbox", "none");
-  const std::string no_layout = error_of([&] { (void)rbox.prepare(rbox, wide(StrategyVariant{})); });
-  EXPECT_EQ(no_layout.rfind("bounding volume 'rbox' has no wide layout (the volumes that do: aabb, ", 0), 0u)
+#ifndef BVHLAB_LEAN_VOLUMES  // every volume of the sanitizer builds' lean registry has a wide layout
+  const AnyTree rss = tree("rss", "none");
+  const std::string no_layout = error_of([&] { (void)rss.prepare(rss, wide(StrategyVariant{})); });
+  EXPECT_EQ(no_layout.rfind("bounding volume 'rss' has no wide layout (the volumes that do: aabb, ", 0), 0u)
       << no_layout;
-  EXPECT_EQ(wide_layout_refusal("rbox"), no_layout);
+  EXPECT_EQ(wide_layout_refusal("rss"), no_layout);
+#endif
   EXPECT_EQ(wide_layout_refusal("obb"), "");
+  EXPECT_EQ(wide_layout_refusal("rbox"), "");
   EXPECT_NE(error_of([] { (void)wide_layout_refusal("octagon"); }).find("unknown bounding volume"),
             std::string::npos);
 

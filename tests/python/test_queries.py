@@ -347,7 +347,7 @@ def test_coherent_batches_answer_as_cold_ones_with_less_work(gear_trees, strateg
 def test_wide_batches_answer_as_binary_ones(gear, strategy):
     """wide=True walks the trees' wide layout: the binary walk's answers (and contacts) on fewer node pairs,
     the single query too; refused by name where it does not run."""
-    trees = {bv: bvhlab.Tree(gear, bv, "none") for bv in ("obb", "rbox")}
+    trees = {bv: bvhlab.Tree(gear, bv, "none") for bv in ("obb", "rss")}
     tree = trees["obb"]
     poses = np.concatenate([bvhlab.protocol_poses(d, 60) for d in (0.9, 1.4, 2.0)])
     binary = bvhlab.query_batch(tree, tree, poses, strategy=strategy)
@@ -357,8 +357,8 @@ def test_wide_batches_answer_as_binary_ones(gear, strategy):
     assert single.collides == bool(binary["collides"][0])
     with pytest.raises(ValueError, match="strategy adb does not run on wide trees"):
         bvhlab.query_batch(tree, tree, poses, strategy="adb", wide=True)
-    with pytest.raises(ValueError, match="bounding volume 'rbox' has no wide layout"):
-        bvhlab.query_batch(trees["rbox"], trees["rbox"], poses, strategy=strategy, wide=True)
+    with pytest.raises(ValueError, match="bounding volume 'rss' has no wide layout"):
+        bvhlab.query_batch(trees["rss"], trees["rss"], poses, strategy=strategy, wide=True)
     with pytest.raises(ValueError, match="coherent or wide, not both"):
         bvhlab.query_batch(tree, tree, poses, strategy=strategy, wide=True, coherent=True)
 

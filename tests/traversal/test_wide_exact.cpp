@@ -1,5 +1,6 @@
-// The exact query on wide trees (traversal/wide_exact.hpp), of boxes, spheres, oriented boxes and k-DOPs,
-// against CGAL's exact predicates and against the binary query it stands in for, on generated meshes.
+// The exact query on wide trees (traversal/wide_exact.hpp), of boxes, spheres, oriented boxes, k-DOPs and
+// restricted boxes, against CGAL's exact predicates and against the binary query it stands in for, on
+// generated meshes.
 #include "bench/core/ground_truth.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/wide_exact.hpp"
@@ -28,10 +29,10 @@ struct WidePair {
   }
 };
 
-// Every kind of four-lane layout: boxes, spheres, oriented boxes, and the k-DOPs through the 24-DOP (the
-// k-DOPs share one template over their direction tables, which tests/volumes/test_lanes.cpp checks one by
-// one; the protocol test runs the wide trees of every direction set).
-using LaneTypes = ::testing::Types<Aabb4, Sphere4, Obb4, KDop4<dop_sets::Zachmann24>>;
+// Every kind of four-lane layout: boxes, spheres, oriented boxes, restricted boxes, and the k-DOPs through
+// the 24-DOP (the k-DOPs share one template over their direction tables, which tests/volumes/test_lanes.cpp
+// checks one by one; the protocol test runs the wide trees of every direction set).
+using LaneTypes = ::testing::Types<Aabb4, Sphere4, Obb4, KDop4<dop_sets::Zachmann24>, RestrictedBox4>;
 template <class Lanes>
 class WideExact : public ::testing::Test {};
 TYPED_TEST_SUITE(WideExact, LaneTypes);
