@@ -5,7 +5,7 @@
 //   flags]
 //
 // Each iteration runs every pose of one distance ("all": every distance), so `time_per_query` is the
-// protocol's mean time per query. Each volume with a wide layout (all but rbox) also runs its wide form
+// protocol's mean time per query. Each volume with a wide layout (all but rss) also runs its wide form
 // (four children a node, traversal/wide_exact.hpp) as the series <volume>_wide, unless --wide=false. The
 // queries are the run-time layer's (engine/any_tree.hpp), compiled once in the engine.
 // Counters: BV tests and triangle tests per query, bytes per triangle.
