@@ -18,13 +18,11 @@
 #include "bench/bv_test/series.hpp"
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
-#include "engine/policies.hpp"
 #include "engine/protocol.hpp"
 
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -45,14 +43,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_bv_test: --steps must be at least 1\n");
     return 2;
   }
-  for (const auto& v : volumes) {
-    try {
-      (void)wide_layout_refusal(v);  // throws for a name the registry does not know
-    } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "bench_bv_test: --volumes: %s\n", e.what());
-      return 2;
-    }
-  }
+  if (!volumes_known("bench_bv_test", volumes)) return 2;
   static std::vector<RigidTransform> poses;
   for (double d : distances)
     for (const RigidTransform& pose : protocol_poses(d, steps)) poses.push_back(pose);

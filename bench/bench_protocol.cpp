@@ -144,14 +144,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_protocol: --steps must be at least 1\n");
     return 2;
   }
-  for (const auto& v : volumes) {
-    try {
-      (void)wide_layout_refusal(v);  // throws for a name the registry does not know
-    } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "bench_protocol: --volumes: %s\n", e.what());
-      return 2;
-    }
-  }
+  if (!volumes_known("bench_protocol", volumes)) return 2;
   static const std::vector<PoseSet> sets = make_pose_sets(steps);
   for_each_protocol_mesh("bench_protocol", meshes, [&](const std::string& label, const auto& mesh) {
     for (const auto& v : volumes) register_bvhlab(label, *mesh, v, sets, wide);

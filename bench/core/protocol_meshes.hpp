@@ -1,12 +1,15 @@
 // The benchmarks' loop over their --meshes: each found mesh loaded as the protocol scales it (engine/
 // mesh_catalog.hpp), with the label its benchmarks are named by; a mesh not found is skipped, said on stderr.
+// And the check of their --volumes against the registry.
 #pragma once
 
 #include "engine/mesh_catalog.hpp"
+#include "engine/policies.hpp"
 
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -25,6 +28,20 @@ void for_each_protocol_mesh(const char* program, const std::vector<std::string>&
     const auto mesh = std::make_shared<const Mesh>(load_protocol_mesh(file));
     register_mesh(std::filesystem::path(file).stem().string(), mesh);
   }
+}
+
+/// False, after a line on stderr naming the known ones, when `volumes` holds a name the registry does not
+/// know.
+inline bool volumes_known(const char* program, const std::vector<std::string>& volumes) {
+  for (const auto& v : volumes) {
+    try {
+      (void)wide_layout_refusal(v);  // throws for a name the registry does not know
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "%s: --volumes: %s\n", program, e.what());
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace bvhlab
