@@ -107,11 +107,11 @@ TEST_F(SceneTest, DefaultsFollowTheProtocol) {
 // left out, or refused when named); strategies without a wide walk, and coherent with wide, are refused.
 TEST_F(SceneTest, WideStrategiesRunWhereTheVolumeHasALayout) {
 #ifndef BVHLAB_LEAN_VOLUMES
-  const std::string without_layout = "rss";
-#else  // every volume of the sanitizer builds' lean registry has a wide layout
-  const std::string without_layout = "obb";
+  const std::string second_bv = "rss";
+#else  // every volume of the sanitizer builds' lean registry has a wide layout: a second one that has one
+  const std::string second_bv = "aabb";
 #endif
-  const std::string hierarchies = R"([{"bv": "obb"}, {"bv": ")" + without_layout + R"("}])";
+  const std::string hierarchies = R"([{"bv": "obb"}, {"bv": ")" + second_bv + R"("}])";
   const Scene scene = parse(scene_with(R"([{"mesh": "torus.obj"}])", hierarchies,
                                        R"([{"type": "exact"}, {"type": "exact", "wide": true}])", ""));
   ASSERT_EQ(scene.strategies.size(), 2u);
