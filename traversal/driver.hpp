@@ -85,6 +85,7 @@
 // overlap tests are left to the compiler, as before.
 #pragma once
 
+#include "inline_stack.hpp"
 #include "result.hpp"
 #include "tree_pair.hpp"
 
@@ -109,7 +110,6 @@ struct DepthFirst {
   template <class Pair>
   class Queue {
    public:
-    Queue() { items_.reserve(64); }
     [[nodiscard]] bool empty() const { return items_.empty(); }
     [[nodiscard]] const Pair& top() const { return items_.back(); }  ///< the next pair to be taken
     [[gnu::always_inline]] void push(const Pair& p) { items_.push_back(p); }
@@ -120,7 +120,8 @@ struct DepthFirst {
     }
 
    private:
-    std::vector<Pair> items_;
+    // In the walk's own frame, up to 2 KiB: 64 pairs of most volumes, 12 of the restricted boxtree's.
+    InlineStack<Pair, std::clamp<std::size_t>(2048 / sizeof(Pair), 8, 64)> items_;
   };
 };
 

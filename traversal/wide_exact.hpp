@@ -11,6 +11,7 @@
 
 #include "../bvh/wide_bvh.hpp"
 #include "exact.hpp"
+#include "inline_stack.hpp"
 
 #include <array>
 #include <stdexcept>
@@ -30,10 +31,10 @@ struct WidePair {
 /// The leaf pair (child_a, child_b) just taken and the leaf pairs next on the stack, up to four in all, in
 /// the order they would be taken (each taken one counts a visited pair): their triangle pairs' plane tests
 /// run at once (TreePair::intersecting_triangles4). True when on_hit stopped the walk.
-template <class Trees, class Tree, class OnHit>
+template <class Trees, class Tree, class Stack, class OnHit>
 [[gnu::always_inline]] bool test_leaf_pairs(const Trees& trees, const Tree& wide_a, const Tree& wide_b,
-                                            std::uint32_t child_a, std::uint32_t child_b,
-                                            std::vector<WidePair>& stack, const OnHit& on_hit) {
+                                            std::uint32_t child_a, std::uint32_t child_b, Stack& stack,
+                                            const OnHit& on_hit) {
   std::uint32_t leaves_a[4] = {child_a & ~Tree::kLeaf}, leaves_b[4] = {child_b & ~Tree::kLeaf};
   int n = 1;
   for (; n < 4 && !stack.empty(); ++n) {
@@ -100,10 +101,11 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
   constexpr bool batches_leaf_pairs = requires {
     requires Lanes::kBatchesLeafPairs;
   };
+  // Placed blocks are large (256 bytes for oriented boxes, 400 for the 24-DOP) and kept by few layouts: on
+  // the heap. The stack of 20-byte pairs stays in the walk's own frame (traversal/inline_stack.hpp).
   std::vector<typename Lanes::Placed> placed;
   if constexpr (keep) placed.reserve(32);
-  std::vector<wide_detail::WidePair> stack;
-  stack.reserve(64);
+  InlineStack<wide_detail::WidePair, 64> stack;
   // Pushes the pairs of the lanes `hits` marks (`base` with the lane set on the split side), so that the
   // one whose centres are nearest is taken first: looking for a first contact, that pair is the likeliest
   // to hold one (the distances are computed only where two lanes or more overlap). All contacts need every

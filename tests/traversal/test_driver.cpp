@@ -52,6 +52,43 @@ TEST(QueuePolicies, TakeInTheirOrder) {
   EXPECT_EQ(best_rest, (std::vector<double>{2.0, 1.0}));
 }
 
+// The depth-first stack keeps its first pairs in place and moves to the heap past them: the pairs come back
+// last in, first out, whole, across the move (a rbox pair: 168 bytes of walker state), and when pushed and
+// popped around the boundary.
+TEST(QueuePolicies, TheInlineStackKeepsEveryPairAcrossItsMoveToTheHeap) {
+  using Pair = QueuedPair<RestrictedBox, double>;
+  InlineStack<Pair, 4> stack;
+  const auto pair = [](std::uint32_t k) {
+    Pair p{double(k), k, 1000 + k, {}, {}, {}};
+    p.wa.half = {double(k), 0.5, -1.0};
+    p.wb.depth = 3 * k;
+    return p;
+  };
+  EXPECT_TRUE(stack.empty());
+  for (std::uint32_t k = 0; k < 3; ++k) stack.push_back(pair(k));
+  stack.pop_back();  // 0, 1 left
+  for (std::uint32_t k = 2; k < 40; ++k) {
+    stack.push_back(pair(k));
+    if (k % 5 == 0) stack.pop_back();  // on either side of the boundaries at 4, 8, 16 and 32
+  }
+  std::vector<std::uint32_t> expected = {0, 1};
+  for (std::uint32_t k = 2; k < 40; ++k)
+    if (k % 5 != 0) expected.push_back(k);
+  ASSERT_EQ(stack.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(stack[i].a, expected[i]);
+  while (!stack.empty()) {
+    const Pair top = stack.back();
+    const Pair want = pair(expected.back());
+    EXPECT_EQ(top.key, want.key);
+    EXPECT_EQ(top.b, want.b);
+    EXPECT_EQ(top.wa.half, want.wa.half);
+    EXPECT_EQ(top.wb.depth, want.wb.depth);
+    expected.pop_back();
+    stack.pop_back();
+  }
+  EXPECT_TRUE(expected.empty());
+}
+
 /// The exact hooks with a key (A's node size), so that the key-ordered queue policies can run them.
 struct KeyedExactHooks : ExactHooks<Aabb, QueuedPair<Aabb, float>> {
   using ExactHooks::ExactHooks;
