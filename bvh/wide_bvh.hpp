@@ -109,8 +109,7 @@ class WideBvh {
       if constexpr (packs) to.boxes = Lanes::pack(std::span(packed).first(children.size()), out.origin_);
     };
     const std::uint32_t root = 0;
-    fill(out.nodes_[0], std::span(&root, 1));
-    if (!tree.node(0).is_leaf()) out.nodes_[0].child[0] = 1u;
+    fill(out.nodes_[0], std::span(&root, 1));  // an inner root is wide node 0, here 1
     for (std::size_t w = 0; w < topology.nodes.size(); ++w) {
       const WideTopology::Node& from = topology.nodes[w];
       fill(out.nodes_[w + 1], std::span(from.child).first(from.count));

@@ -50,6 +50,16 @@ template <class Trees, class Tree, class Stack, class OnHit>
                                        [&trees](int k) { trees.counters.nodes_visited += k > 0; });
 }
 
+/// A's lanes in the form the tests read, made once for both the test and the order of the pairs it leaves:
+/// a packing layout's lanes unpacked (RestrictedBox4), any other layout's as stored.
+template <class Lanes>
+[[gnu::always_inline]] decltype(auto) tested_lanes(const Lanes& lanes) {
+  if constexpr (requires { Lanes::unpack(lanes); })
+    return Lanes::unpack(lanes);
+  else
+    return (lanes);
+}
+
 template <class Lanes>
 void require_pair(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wide_a,
                   const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b) {
@@ -133,8 +143,8 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
   counters.bv_tests += 1;
   const typename Lanes::Placed root_b = Lanes::place(wide_b.node(0).boxes, lanes);
   if constexpr (keep) placed.push_back(root_b);
-  push(Lanes::overlap_placed(wide_a.node(0).boxes, root_b, lanes) & 1u, wide_a.node(0).boxes, root_b,
-       {0, 0, 0, 0, 0}, false);
+  const auto& root_a = wide_detail::tested_lanes(wide_a.node(0).boxes);
+  push(Lanes::overlap_placed(root_a, root_b, lanes) & 1u, root_a, root_b, {0, 0, 0, 0, 0}, false);
   while (!stack.empty()) {
     const wide_detail::WidePair p = stack.back();
     stack.pop_back();
@@ -177,8 +187,9 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
           return Lanes::place(Lanes::broadcast(node_b.boxes, int(p.b_lane)), lanes);
       };
       const typename Lanes::Placed b_volume = placed_b();
-      const unsigned hits = Lanes::overlap_placed(wide_a.node(child_a).boxes, b_volume, lanes);
-      push(hits, wide_a.node(child_a).boxes, b_volume, {child_a, 0, p.b_node, p.b_lane, p.placed}, false);
+      const auto& a_children = wide_detail::tested_lanes(wide_a.node(child_a).boxes);
+      const unsigned hits = Lanes::overlap_placed(a_children, b_volume, lanes);
+      push(hits, a_children, b_volume, {child_a, 0, p.b_node, p.b_lane, p.placed}, false);
     }
   }
   return result;
