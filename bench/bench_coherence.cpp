@@ -3,7 +3,7 @@
 //
 //   bench_coherence [--meshes=a.stl,b.obj] [--volumes=aabb,dop24] [--steps=2000] [--strides=1,8,64]
 //                   [--distances=0.6,1.0,1.4] [--judge=work|time] [--max_cold_run=128] [--max_jump=0.2]
-//                   [benchmark flags]
+//                   [--raise_hold=8] [benchmark flags]
 //
 // One iteration is one cold pass and one coherent pass over the same poses (a fresh state), in alternating
 // order, each timed on its own: the ratio of each iteration's two passes is what is compared, so a stall
@@ -172,6 +172,7 @@ int main(int argc, char** argv) {
   std::string judge_name = "work";
   int max_cold_run = static_cast<int>(CoherenceOptions{}.max_cold_run);
   double max_jump = CoherenceOptions{}.max_jump;
+  int raise_hold = CoherenceOptions{}.raise_hold;
   if (auto exit = initialize_benchmark(
           "bench_coherence",
           {{"meshes", &meshes, "meshes to run"},
@@ -181,7 +182,8 @@ int main(int argc, char** argv) {
            {"steps", &steps, "poses per full turn"},
            {"judge", &judge_name, "what decides front or root: work or time"},
            {"max_cold_run", &max_cold_run, "longest run of cold queries (0: none)"},
-           {"max_jump", &max_jump, "a pose jump, in B's root radii, starts from the root"}},
+           {"max_jump", &max_jump, "a pose jump, in B's root radii, starts from the root"},
+           {"raise_hold", &raise_hold, "queries a pair waits before raising is tried again (0 to 255)"}},
           argc, argv))
     return *exit;
   if (steps < 1 || std::any_of(strides.begin(), strides.end(), [](double m) { return !(m >= 1); })) {
@@ -198,6 +200,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_coherence: --max_cold_run must be at least 0\n");
     return 2;
   }
+  if (raise_hold < 0 || raise_hold > 255) {
+    std::fprintf(stderr, "bench_coherence: --raise_hold must be 0 to 255\n");
+    return 2;
+  }
+  coherence_options.raise_hold = static_cast<std::uint8_t>(raise_hold);
   coherence_options.max_cold_run = static_cast<std::uint32_t>(max_cold_run);
   coherence_options.max_jump = max_jump;
   try {
