@@ -106,11 +106,13 @@ class TypedQuery final : public PreparedQuery {
   void run(std::span<const RigidTransform> poses, const ResultSink& sink,
            CoherentState& state) const override {
     if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
+    const CoherentState::InUse held(state);  // once for the run, not per query
     for (std::size_t i = 0; i < poses.size(); ++i) sink(i, query(poses[i], state));
   }
   void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out) const override {
     if (coherent_) {
       CoherentState state;
+      const CoherentState::InUse held(state);
       return timed_series(poses, warmup, out, [&](const RigidTransform& pose) { return query(pose, state); });
     }
     timed_series(poses, warmup, out, [this](const RigidTransform& pose) { return query(pose); });
@@ -118,6 +120,7 @@ class TypedQuery final : public PreparedQuery {
   void time(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,
             CoherentState& state) const override {
     if (!coherent_) throw std::logic_error("a coherent run of a query not prepared coherent");
+    const CoherentState::InUse held(state);
     timed_coherent_series(poses, warmup, out, coherent_query(), state);
   }
   void time_per_pose(std::span<const RigidTransform> poses, int warmup, std::vector<QueryRecord>& out,

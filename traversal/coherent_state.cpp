@@ -48,22 +48,24 @@ void CoherentState::bind(const TreeKey& a, const TreeKey& b, const Vec3& centre,
   b_radius_ = radius;
 }
 
-void CoherentState::check_trees(const TreeKey& a, const TreeKey& b) const {
-  if (!bound()) return;
-  if (a != a_ || b != b_)
-    throw std::invalid_argument(
-        "coherent query: the state was made for other trees (one state per pair of trees; a tree rebuilt or "
-        "made anew needs a new state; reset() does not rebind it)");
+void CoherentState::refuse_other_trees() {
+  throw std::invalid_argument(
+      "coherent query: the state was made for other trees (one state per pair of trees; a tree rebuilt or "
+      "made anew needs a new state; reset() does not rebind it)");
 }
 
-CoherentState::InUse::InUse(CoherentState& state) : state_(state) {
+void CoherentState::InUse::acquire() {
   if (state_.busy_.busy.exchange(true, std::memory_order_acquire))
     throw std::logic_error(
         "coherent query: the state is in use by another query (a state belongs to one caller; give each "
         "thread its own)");
+  owner_ = true;
+  outer_ = held_here_;
+  held_here_ = &state_;
 }
 
-CoherentState::InUse::~InUse() {
+void CoherentState::InUse::release() {
+  held_here_ = outer_;
   state_.busy_.busy.store(false, std::memory_order_release);
 }
 

@@ -99,17 +99,31 @@ class CoherentState {
   [[nodiscard]] bool bound() const { return a_.address != nullptr; }
   /// Throws std::invalid_argument unless the state is unbound or bound to these trees: the same objects,
   /// with the topology they had (not rebuilt, not another tree made at the address of one that is gone).
-  void check_trees(const TreeKey& a, const TreeKey& b) const;
-  /// Marks the state in use for one query; throws std::logic_error when another query holds it.
+  void check_trees(const TreeKey& a, const TreeKey& b) const {
+    if (bound() && (a != a_ || b != b_)) refuse_other_trees();
+  }
+  /// Marks the state in use; throws std::logic_error when another thread's query holds it. Each coherent
+  /// query holds it for itself; a loop of queries may hold it around them all (the engine's runs do), so
+  /// that each query finds it held by its own thread and skips the atomic exchange, which cost about a
+  /// sixth of a query decided at the root pair (bench/RESULTS.md, "The state held for a run").
   class InUse {
    public:
-    explicit InUse(CoherentState& state);
-    ~InUse();
+    explicit InUse(CoherentState& state) : state_(state) {
+      if (held_here_ == &state) return;  // this thread holds it already: the loop around this query
+      acquire();
+    }
+    ~InUse() {
+      if (owner_) release();
+    }
     InUse(const InUse&) = delete;
     InUse& operator=(const InUse&) = delete;
 
    private:
+    void acquire();
+    void release();
     CoherentState& state_;
+    bool owner_ = false;                    ///< this guard took the state (not one around it)
+    const CoherentState* outer_ = nullptr;  ///< what this thread held before
   };
 
   /// True when `pose` lies farther than max_jump from the pose of the last query that stored its front or
@@ -161,6 +175,7 @@ class CoherentState {
 
  private:
   [[nodiscard]] bool moved_too_far(const RigidTransform& pose) const;
+  [[noreturn]] static void refuse_other_trees();
 
   CoherenceOptions options_;
   TreeKey a_, b_;
@@ -177,6 +192,8 @@ class CoherentState {
   double front_cost_ = -1, root_cost_ = -1;
   std::uint32_t cold_left_ = 0;  ///< queries from the root still to run before the front is tried again
   std::uint32_t cold_run_ = 2;   ///< the length of the next such run
+  /// The state this thread holds (InUse), if any.
+  static inline thread_local const CoherentState* held_here_ = nullptr;
   /// Set while a query uses the state; a copy of the state is not in use.
   struct BusyFlag {
     std::atomic<bool> busy{false};

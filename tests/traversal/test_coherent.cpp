@@ -6,7 +6,10 @@
 #include "support/errors.hpp"
 
 #include <algorithm>
+#include <future>
 #include <optional>
+#include <string>
+#include <thread>
 #include <utility>
 
 namespace bvhlab::coherent_tests {
@@ -231,13 +234,29 @@ TEST(Coherent, RefusesWhatItCannotServe) {
   scaled.rotation *= 2;
   EXPECT_THROW(query_exact_coherent(a, b, scaled, state), std::invalid_argument);
   {
-    const CoherentState::InUse held(state);  // as another thread's query would
-    EXPECT_NE(testing::error_of([&] {
-                query_exact_coherent(a, b, RigidTransform::identity(), state);
-              }).find("in use by another query"),
-              std::string::npos);
+    std::promise<void> taken, done;
+    std::thread other([&] {
+      const CoherentState::InUse held(state);  // as another thread's query would
+      taken.set_value();
+      done.get_future().wait();
+    });
+    taken.get_future().wait();
+    const std::string error =
+        testing::error_of([&] { query_exact_coherent(a, b, RigidTransform::identity(), state); });
     CoherentState copy = state;  // a copy is a state of its own, not in use
-    EXPECT_NO_THROW(query_exact_coherent(a, b, RigidTransform::identity(), copy));
+    const std::string copy_error =
+        testing::error_of([&] { query_exact_coherent(a, b, RigidTransform::identity(), copy); });
+    done.set_value();
+    other.join();
+    EXPECT_NE(error.find("in use by another query"), std::string::npos) << error;
+    EXPECT_EQ(copy_error, "(no error)");
+  }
+  EXPECT_NO_THROW(query_exact_coherent(a, b, RigidTransform::identity(), state));
+  {
+    // A thread that holds the state for a loop of queries runs them (the engine's runs do so).
+    const CoherentState::InUse held(state);
+    EXPECT_NO_THROW(query_exact_coherent(a, b, RigidTransform::identity(), state));
+    EXPECT_NO_THROW(query_exact_coherent(a, b, RigidTransform::identity(), state));
   }
   EXPECT_NO_THROW(query_exact_coherent(a, b, RigidTransform::identity(), state));
   EXPECT_THROW(CoherentState(CoherenceOptions{.max_pairs = 0}), std::invalid_argument);
