@@ -250,7 +250,7 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   state.serve(CoherentState::Use::Exact);
   // The cold query's answer, with what this query spent before it, recorded as a query from the root.
   const auto cold_answer = [&](const Counters& spent) {
-    Result cold_result = query_exact(a, b, b_to_a, mode, leaves);
+    Result cold_result = exact_traversal(a, b, b_to_a, mode, leaves);
     cold_result.counters += spent;
     state.witness.reset();
     state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
@@ -277,14 +277,15 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
     }
   }
   // Objects apart at the last query: walking the stored tree is testing the root pair, so it is tested
-  // directly, without the walk's bookkeeping; a root pair that overlaps now is walked from there.
+  // directly, without the walk's bookkeeping; a root pair that overlaps now is walked from there. An answer
+  // from the root pair alone is what a query from the root would give at the same cost: it is not recorded
+  // as the front's cost (record_cost), which compares walks with queries from the root.
   std::optional<typename Walk::Pair> overlapping_root;
   if (!cold && state.root_apart()) {
     ++result.counters.nodes_visited;
     const auto root = trees.template root<typename Walk::Pair>();
     if (!trees.overlap(root)) {
       state.restamp(b_to_a);
-      state.record_cost(result.counters, seconds(), CoherentState::Start::Front);
       return result;
     }
     overlapping_root = root;

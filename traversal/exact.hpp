@@ -53,14 +53,11 @@ void check_exact_query(const RigidTransform& b_to_a, ContactMode mode) {
       throw std::invalid_argument("all contacts: point surfaces have no triangle pairs to list");
 }
 
-/// Exact first-contact (or all-contacts) query. `b_to_a` maps B's local frame into A's. `leaves` is the
-/// leaf test (TreePair's Leaves); the default tests triangles, and traversal/point_leaves.hpp passes the
-/// surfaces of point clouds (query_exact_points). Const and thread-safe on shared trees: all traversal
-/// state lives on this call's stack.
-template <TreeVolume BV, class Leaves = TriangleLeaves>
-Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
-                   ContactMode mode = ContactMode::First, const Leaves& leaves = kTriangleLeaves) {
-  check_exact_query<Leaves>(b_to_a, mode);
+/// query_exact after check_exact_query, for callers that made the checks already (the coherent query's cold
+/// answers).
+template <TreeVolume BV, class Leaves>
+Result exact_traversal(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, ContactMode mode,
+                       const Leaves& leaves) {
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;
@@ -71,6 +68,17 @@ Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_t
   Unlimited limit;
   traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
   return result;
+}
+
+/// Exact first-contact (or all-contacts) query. `b_to_a` maps B's local frame into A's. `leaves` is the
+/// leaf test (TreePair's Leaves); the default tests triangles, and traversal/point_leaves.hpp passes the
+/// surfaces of point clouds (query_exact_points). Const and thread-safe on shared trees: all traversal
+/// state lives on this call's stack.
+template <TreeVolume BV, class Leaves = TriangleLeaves>
+Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
+                   ContactMode mode = ContactMode::First, const Leaves& leaves = kTriangleLeaves) {
+  check_exact_query<Leaves>(b_to_a, mode);
+  return exact_traversal(a, b, b_to_a, mode, leaves);
 }
 
 }  // namespace bvhlab
