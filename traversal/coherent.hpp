@@ -260,6 +260,17 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   // tried: the query is the cold one, but for the turn's last, a walk from the root that leaves its front.
   const bool cold = state.cold_turns_left() > 0;
   if (state.cold_turns_left() > 1) return cold_answer({});
+  // With nothing stored (the poses jumped before, or the state is new) there is no remembered contact or root
+  // pair to try first: the jump is judged before the traversal's set-up, so that while the poses keep
+  // jumping the cold query answers at little more than its own cost.
+  std::optional<bool> jumped;
+  if (!cold && !state.witness && state.pairs().empty()) {
+    jumped = state.jumped(b_to_a);
+    if (*jumped && state.jumping_on()) {
+      state.forget_front(b_to_a);
+      return cold_answer({});
+    }
+  }
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;
@@ -294,12 +305,12 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   // jump, the walk starts from the root and leaves a front for the steps that follow. While the poses keep
   // jumping, that walk would cost a cold query and more each time for a front never used (bench/RESULTS.md,
   // "How far a pose may jump"): the cold query answers and the state notes the pose alone.
-  const bool jumped = !cold && state.jumped(b_to_a);
-  if (jumped && state.jumping_on()) {
+  if (!jumped) jumped = !cold && state.jumped(b_to_a);
+  if (*jumped && state.jumping_on()) {
     state.forget_front(b_to_a);
     return cold_answer(result.counters);  // with the remembered contact's or the root pair's test, if made
   }
-  const bool from_front = !cold && !jumped && !state.pairs().empty();
+  const bool from_front = !cold && !*jumped && !state.pairs().empty();
   if (!from_front) state.pairs().clear();
   std::vector<FrontPair>& next = state.spare();
   Walk walk(trees, state.pairs(), next, hooks, state.options().raise_hold);
