@@ -60,6 +60,32 @@ template <class Lanes>
     return (lanes);
 }
 
+/// Pushes the pairs of the lanes `hits` marks (`base` with the lane set on the split side). With
+/// `nearest_first`, the one whose centres are nearest is taken first: looking for a first contact, that pair
+/// is the likeliest to hold one (the distances are computed only where two lanes or more overlap).
+/// Otherwise in the lanes' order. Inlined into the walk's three calls: as one function called from there,
+/// the calls and the copies they needed made the OBB walk about a tenth slower (bench/RESULTS.md).
+template <class Lanes, class Stack, class AVolumes, class BPlaced>
+[[gnu::always_inline]] inline void push_hits(Stack& stack, unsigned hits, bool nearest_first,
+                                             const AVolumes& a_volumes, const BPlaced& b_placed,
+                                             const WidePair& base, bool split_b) {
+  std::array<float, 4> distance{};
+  if (nearest_first && (hits & (hits - 1)) != 0) distance = Lanes::center_distances(a_volumes, b_placed);
+  std::array<std::uint32_t, 4> order;  // the lanes hit, in the order they are to be taken
+  int n = 0;
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    if (!(hits & (1u << k))) continue;
+    int i = n++;
+    for (; i > 0 && distance[k] < distance[order[i - 1]]; --i) order[i] = order[i - 1];
+    order[i] = k;
+  }
+  while (n-- > 0) {
+    WidePair child = base;
+    (split_b ? child.b_lane : child.a_lane) = order[n];
+    stack.push_back(child);
+  }
+}
+
 template <class Lanes>
 void require_pair(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wide_a,
                   const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b) {
@@ -116,35 +142,16 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
   std::vector<typename Lanes::Placed> placed;
   if constexpr (keep) placed.reserve(32);
   InlineStack<wide_detail::WidePair, 64> stack;
-  // Pushes the pairs of the lanes `hits` marks (`base` with the lane set on the split side), so that the
-  // one whose centres are nearest is taken first: looking for a first contact, that pair is the likeliest
-  // to hold one (the distances are computed only where two lanes or more overlap). All contacts need every
-  // pair, so that walk keeps the lanes' order (the binary walk's).
+  // First contacts take the pair whose centres are nearest first (push_hits); all contacts need every pair,
+  // so that walk keeps the lanes' order (the binary walk's).
   const bool nearest_first = mode == ContactMode::First;
-  const auto push = [&stack, nearest_first](unsigned hits, const auto& a_volumes, const auto& b_placed,
-                                            const wide_detail::WidePair& base, bool split_b) {
-    std::array<float, 4> distance{};
-    if (nearest_first && (hits & (hits - 1)) != 0) distance = Lanes::center_distances(a_volumes, b_placed);
-    std::array<std::uint32_t, 4> order;  // the lanes hit, in the order they are to be taken
-    int n = 0;
-    for (std::uint32_t k = 0; k < 4; ++k) {
-      if (!(hits & (1u << k))) continue;
-      int i = n++;
-      for (; i > 0 && distance[k] < distance[order[i - 1]]; --i) order[i] = order[i - 1];
-      order[i] = k;
-    }
-    while (n-- > 0) {
-      wide_detail::WidePair child = base;
-      (split_b ? child.b_lane : child.a_lane) = order[n];
-      stack.push_back(child);
-    }
-  };
   // The roots, as any pair (B's root placed in block 0 where the walk keeps blocks).
   counters.bv_tests += 1;
   const typename Lanes::Placed root_b = Lanes::place(wide_b.node(0).boxes, lanes);
   if constexpr (keep) placed.push_back(root_b);
   const auto& root_a = wide_detail::tested_lanes(wide_a.node(0).boxes);
-  push(Lanes::overlap_placed(root_a, root_b, lanes) & 1u, root_a, root_b, {0, 0, 0, 0, 0}, false);
+  wide_detail::push_hits<Lanes>(stack, Lanes::overlap_placed(root_a, root_b, lanes) & 1u, nearest_first,
+                                root_a, root_b, {0, 0, 0, 0, 0}, false);
   while (!stack.empty()) {
     const wide_detail::WidePair p = stack.back();
     stack.pop_back();
@@ -178,7 +185,8 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
       const unsigned hits = Lanes::overlap_placed(a_volume, children, lanes);
       const auto block = static_cast<std::uint32_t>(placed.size());
       if constexpr (keep) placed.push_back(children);
-      push(hits, a_volume, children, {p.a_node, p.a_lane, child_b, 0, block}, true);
+      wide_detail::push_hits<Lanes>(stack, hits, nearest_first, a_volume, children,
+                                    {p.a_node, p.a_lane, child_b, 0, block}, true);
     } else {
       const auto placed_b = [&] {
         if constexpr (keep)
@@ -189,7 +197,8 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
       const typename Lanes::Placed b_volume = placed_b();
       const auto& a_children = wide_detail::tested_lanes(wide_a.node(child_a).boxes);
       const unsigned hits = Lanes::overlap_placed(a_children, b_volume, lanes);
-      push(hits, a_children, b_volume, {child_a, 0, p.b_node, p.b_lane, p.placed}, false);
+      wide_detail::push_hits<Lanes>(stack, hits, nearest_first, a_children, b_volume,
+                                    {child_a, 0, p.b_node, p.b_lane, p.placed}, false);
     }
   }
   return result;
