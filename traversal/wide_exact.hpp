@@ -64,7 +64,8 @@ template <class Lanes>
 /// `nearest_first`, the one whose centres are nearest is taken first: looking for a first contact, that pair
 /// is the likeliest to hold one (the distances are computed only where two lanes or more overlap).
 /// Otherwise in the lanes' order. Inlined into the walk's three calls: as one function called from there,
-/// the calls and the copies they needed made the OBB walk about a tenth slower (bench/RESULTS.md).
+/// the calls and the copies they needed made the OBB walk about a tenth slower (bench/RESULTS.md, "The push
+/// inlined").
 template <class Lanes, class Stack, class AVolumes, class BPlaced>
 [[gnu::always_inline]] inline void push_hits(Stack& stack, unsigned hits, bool nearest_first,
                                              const AVolumes& a_volumes, const BPlaced& b_placed,
