@@ -10,7 +10,8 @@
 // anytime distance's goal: the share of apart poses (distance > 0) whose interval, with a tenth of the full
 // query's BV tests, is at most a tenth of the distance wide (`anytime_tenth`; -1 when no pose is apart),
 // and the same with three tenths of the tests (`anytime_3tenths`).
-// Each bvhlab series has a `/coherent` twin: the poses in order, each starting where the last one ended.
+// Each bvhlab series has a `/coherent` twin: the poses in order, each starting where the last one ended;
+// and, for volumes with a wide distance walk (obb), a `<bv>_wide` twin on the trees' wide layout.
 // bvhlab's queries are the run-time layer's prepared queries (engine/any_tree.hpp), compiled once there.
 #include "bench/core/bench_flags.hpp"
 #include "bench/core/protocol_meshes.hpp"
@@ -74,10 +75,21 @@ std::size_t disagreements(const std::vector<double>& distances, const std::vecto
   return out;
 }
 
-/// A tree's distance queries (the run-time layer's, engine/any_tree.hpp): full, and full coherent.
+/// A tree's distance queries (the run-time layer's, engine/any_tree.hpp): full, full coherent, and full on
+/// the wide layout (null where the volume has no wide distance walk).
 struct Queries {
-  std::unique_ptr<PreparedQuery> full, coherent;
+  std::unique_ptr<PreparedQuery> full, coherent, wide;
 };
+
+/// The wide variant's prepared query, or null where the strategy refuses it for this volume.
+std::unique_ptr<PreparedQuery> prepare_wide(const AnyTree& tree, StrategyVariant variant) {
+  variant.wide = true;
+  try {
+    return tree.prepare(tree, variant);
+  } catch (const std::invalid_argument&) {
+    return nullptr;
+  }
+}
 
 /// Each pose's proximity under `query`; its work added to `work`.
 std::vector<Proximity> proximities(const PreparedQuery& query, std::span<const RigidTransform> poses,
@@ -138,14 +150,38 @@ void register_coherent(const std::string& name, const std::shared_ptr<const Quer
   })->Unit(benchmark::kMillisecond);
 }
 
+/// The same poses through the wide walk; `wide_disagree` counts poses whose distance is not the binary
+/// walk's (it must be 0: the same triangle pairs measured alike).
+void register_wide(const std::string& name, const std::shared_ptr<const Queries>& q, const PoseSet& set,
+                   const std::vector<double>& binary) {
+  benchmark::RegisterBenchmark(name.c_str(), [q, &set, binary](benchmark::State& state) {
+    Counters pass;
+    double sum = 0;
+    std::size_t disagree = 0;
+    for (auto _ : state) {
+      pass = {};
+      sum = 0;
+      disagree = 0;
+      const std::vector<Proximity> got = proximities(*q->wide, set.poses, pass);
+      for (std::size_t i = 0; i < got.size(); ++i) {
+        sum += got[i].distance;
+        disagree += got[i].distance != binary[i];
+      }
+      benchmark::DoNotOptimize(sum);
+    }
+    set_counters(state, set.poses.size(), pass, sum);
+    state.counters["wide_disagree"] = static_cast<double>(disagree);
+  })->Unit(benchmark::kMillisecond);
+}
+
 void register_bvhlab(const std::string& mesh_name, const Mesh& mesh, const std::string& bv,
                      const std::vector<PoseSet>& sets) {
   // The prepared queries keep the tree alive.
   const AnyTree tree = AnyTree::build(mesh, MeshUnits{}, bv, density_spec("none", {}), BuildOptions{});
   StrategyVariant full = strategy_variant("distance", {}, Budget{}), coherent = full;
   coherent.coherent = true;
-  const auto q =
-      std::make_shared<const Queries>(Queries{tree.prepare(tree, full), tree.prepare(tree, coherent)});
+  const auto q = std::make_shared<const Queries>(
+      Queries{tree.prepare(tree, full), tree.prepare(tree, coherent), prepare_wide(tree, full)});
   for (const auto& set : sets) {
     std::vector<Proximity> first(set.poses.size());
     std::vector<Counters> first_work(set.poses.size());
@@ -175,6 +211,8 @@ void register_bvhlab(const std::string& mesh_name, const Mesh& mesh, const std::
       state.counters["anytime_3tenths"] = anytime_3tenths;
     })->Unit(benchmark::kMillisecond);
     register_coherent(name + "/coherent", q, set, distances);
+    if (q->wide)
+      register_wide("distance/" + mesh_name + "/" + bv + "_wide/d:" + set.label, q, set, distances);
   }
 }
 

@@ -17,6 +17,7 @@
 #include "bvh.hpp"
 
 #include <array>
+#include <concepts>
 #include <cstdint>
 #include <span>
 #include <stdexcept>
@@ -171,5 +172,16 @@ concept HasWideLayout = requires {
 };
 template <HasWideLayout BV>
 using WideTreeOf = WideBvh<typename WideLanes<BV>::type>;
+
+/// Lanes whose four volumes bound their distance to another volume's, placed (Obb4::distance_bounds): the
+/// wide distance walk (traversal/wide_distance.hpp) runs on them.
+template <class Lanes>
+concept WideDistanceLanes = requires(const Lanes& a, const typename Lanes::Placed& b,
+                                     const typename Lanes::PairContext& c) {
+  { Lanes::distance_bounds(a, b, c) } -> std::same_as<std::array<float, 4>>;
+};
+/// Whether trees of volume BV have a wide layout that the distance walk runs on.
+template <class BV>
+concept HasWideDistance = HasWideLayout<BV> && WideDistanceLanes<typename WideLanes<BV>::type>;
 
 }  // namespace bvhlab

@@ -6,4 +6,5 @@
 #include "traversal/coherent.hpp"
 #include "traversal/distance.hpp"
 #include "traversal/exact.hpp"
+#include "traversal/wide_distance.hpp"
 #include "traversal/wide_exact.hpp"

@@ -28,7 +28,7 @@ struct StrategyInfo {
   bool needs_polygons = false;         ///< cannot run on trees saved without polygons
   bool needs_density = false;          ///< does not run on trees without a density
   bool coherent = false;               ///< runs coherent over a sequence of poses (traversal/coherent.hpp)
-  bool wide = false;                   ///< runs on the trees' wide layout (traversal/wide_exact.hpp)
+  bool wide = false;                   ///< runs on the trees' wide layout (traversal/wide_*.hpp)
   std::vector<std::string> densities;  ///< the registered densities it runs on
   std::vector<std::string> volumes;    ///< the registered volumes it runs on
   std::vector<ParamSpec> parameters;
@@ -44,7 +44,7 @@ struct StrategyInfo {
   /// coherent (the strategies that do: exact, all_contacts)".
   [[nodiscard]] std::string coherent_refusal() const;
   /// Empty when it runs on the trees' wide layout; else the one message every caller gives: "strategy adb
-  /// does not run on wide trees (the strategies that do: exact, all_contacts)".
+  /// does not run on wide trees (the strategies that do: exact, all_contacts, distance)".
   [[nodiscard]] std::string wide_refusal() const;
   /// Empty when its answers name intersecting triangle pairs (needs_polygons); else the one message every
   /// caller gives for contact geometry asked of it.

@@ -147,7 +147,7 @@ class TypedQuery final : public PreparedQuery {
   /// Whether a prepared query of this type may walk the wide layouts (prepare sets them only for a wide
   /// variant).
   static constexpr bool kWalksWide =
-      kRunsWide<S> && HasWideLayout<BV> && std::is_same_v<Held, HierarchyOnly<BV>>;
+      kRunsWide<S> && HasWideLayout<BV> && kWalksWideOn<S, BV> && std::is_same_v<Held, HierarchyOnly<BV>>;
   Result with_geometry(const RigidTransform& pose, Result r) const {
     if (geometry_) (*geometry_)(pose, r);
     return r;
@@ -315,12 +315,16 @@ struct TreeQueries {
     }
   }
 
-  /// The refusals of a wide variant: a strategy without a wide walk, a volume without a wide layout, point
-  /// leaves, a coherent walk.
+  /// The refusals of a wide variant: a strategy without a wide walk, a volume without a wide layout or one
+  /// the strategy's wide walk does not take, point leaves, a coherent walk.
   template <class S>
   static void check_wide(const StrategyVariant& variant, bool cloud) {
     if (!kRunsWide<S>) throw std::invalid_argument(strategy_info(variant.strategy).wide_refusal());
     if (!HasWideLayout<BV>) throw std::invalid_argument(wide_layout_refusal(BV::name()));
+    if constexpr (!kWalksWideOn<S, BV>)
+      throw std::invalid_argument("strategy " + std::string(S::name()) + " has no wide walk on '" +
+                                  std::string(BV::name()) + "' trees (" + std::string(S::wide_volumes()) +
+                                  ")");
     if (variant.coherent)
       throw std::invalid_argument(
           "a coherent query walks the binary trees; ask for coherent or wide, not both");

@@ -407,8 +407,8 @@ void bind_queries(py::module_& m) {
 
   const char* wide_help =
       " wide=True walks the trees' wide layout, four children a node tested at once (strategies exact and "
-      "all_contacts on aabb, the k-DOPs, obb and sphere; not with coherent): the same answers in less time; "
-      "each tree builds it on first use and keeps it.";
+      "all_contacts on aabb, the k-DOPs, obb and sphere, distance on obb; not with coherent): the same "
+      "answers in less time; each tree builds it on first use and keeps it.";
   const char* strategy_help =
       " strategy: a name of bvhlab.strategies(), its parameters as keyword arguments (p_min=0.9); bv_tests "
       "and "

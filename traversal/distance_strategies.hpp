@@ -5,6 +5,7 @@
 #pragma once
 
 #include "../adb/parameters.hpp"
+#include "../bvh/wide_bvh.hpp"
 #include "coherent_state.hpp"
 #include "distance_result.hpp"
 #include "strategy.hpp"
@@ -78,6 +79,18 @@ struct DistanceStrategy : distance_strategy_detail::ProximityTraits {
                                CoherentState& state) {
     return distance_strategy_detail::as_result(query_distance_coherent(a.bvh, b.bvh, b_to_a, state));
   }
+  /// The wide walk (traversal/wide_distance.hpp) needs lanes with a distance bound.
+  static constexpr bool wide = true;
+  template <class BV>
+  static constexpr bool walks_wide = HasWideDistance<BV>;
+  static constexpr std::string_view wide_volumes() {
+    return "the wide distance walk needs four-lane distance bounds: obb has them";
+  }
+  template <class TreeA, class TreeB, class Lanes>
+  static Result query_wide(const TreeA& a, const WideBvh<Lanes>& wide_a, const TreeB& b,
+                           const WideBvh<Lanes>& wide_b, const RigidTransform& b_to_a, Options) {
+    return distance_strategy_detail::as_result(query_distance_wide(a.bvh, wide_a, b.bvh, wide_b, b_to_a));
+  }
 };
 
 /// The distance under a budget: a guaranteed interval [lower_bound, distance] and the nearest pair so far.
@@ -89,6 +102,7 @@ struct AnytimeDistanceStrategy : DistanceStrategy {
   }
   static constexpr bool exact = false;
   static constexpr BudgetUse budget = BudgetUse::Required;
+  static constexpr bool wide = false;  // the budgeted search and its dives walk the binary trees
   static Options configure(const ParamValues&, const Budget& given) {
     distance_detail::check_anytime_budget(given);  // refused here, so that running cannot fail
     return given;

@@ -8,4 +8,5 @@
 #include "distance.hpp"
 #include "exact.hpp"
 #include "strategy_types.hpp"
+#include "wide_distance.hpp"
 #include "wide_exact.hpp"

@@ -42,6 +42,9 @@
 //   S::query_wide(a, wide_a, b, wide_b, b_to_a, options)
 //                          Result of S::query, walking the wide trees built from a.bvh and b.bvh (four
 //                          children a node tested at once). The same answers as S::query.
+//   S::walks_wide<BV>      optional constexpr bool: whether the wide walk runs on trees of volume BV
+//   (default:
+//                          every volume with a wide layout); the run-time layer refuses the others by name.
 #pragma once
 
 #include "../adb/parameters.hpp"
@@ -81,6 +84,15 @@ template <class S>
 inline constexpr bool kRunsWide = requires {
   requires S::wide;
 };
+
+/// Whether S's wide walk runs on trees of volume BV (S::walks_wide<BV>, above; by default it does).
+template <class S, class BV>
+inline constexpr bool kWalksWideOn = [] {
+  if constexpr (requires { S::template walks_wide<BV>; })
+    return bool(S::template walks_wide<BV>);
+  else
+    return true;
+}();
 
 /// Whether S reads only the trees' hierarchies (S::density_free, above).
 template <class S>

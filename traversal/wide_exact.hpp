@@ -87,15 +87,17 @@ template <class Lanes, class Stack, class AVolumes, class BPlaced>
   }
 }
 
+/// Refuses wide trees that were not built from these binary trees, or before a refit; `who` names the query.
 template <class Lanes>
 void require_pair(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wide_a,
-                  const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b) {
-  const auto check = [](const auto& tree, const auto& wide, const char* side) {
+                  const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b,
+                  const char* who = "wide exact query") {
+  const auto check = [who](const auto& tree, const auto& wide, const char* side) {
     if (wide.binary_identity() != tree.identity())
-      throw std::invalid_argument(std::string("wide exact query: wide tree ") + side +
+      throw std::invalid_argument(std::string(who) + ": wide tree " + side +
                                   " was not built from binary tree " + side);
     if (wide.binary_revision() != tree.volumes_revision())
-      throw std::invalid_argument(std::string("wide exact query: binary tree ") + side +
+      throw std::invalid_argument(std::string(who) + ": binary tree " + side +
                                   " was refitted after wide tree " + side + " was built; build it again");
   };
   check(a, wide_a, "A");

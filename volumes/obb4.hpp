@@ -43,12 +43,34 @@ inline F4 abs(F4 a) {
 inline F4 max(F4 a, F4 b) {
   return {_mm_max_ps(a.v, b.v)};
 }
+inline F4 zero_like(F4) {
+  return {_mm_setzero_ps()};
+}
+inline F4 splat_like(F4, float x) {
+  return {_mm_set1_ps(x)};
+}
+inline F4 operator/(F4 a, F4 b) {
+  return {_mm_div_ps(a.v, b.v)};
+}
+/// `value` where `x` >= `threshold`, else 0.
+inline F4 where_at_least(F4 x, F4 threshold, F4 value) {
+  return {_mm_and_ps(_mm_cmpge_ps(x.v, threshold.v), value.v)};
+}
 #endif
 inline float abs(float a) {
   return std::abs(a);
 }
 inline float max(float a, float b) {
   return a > b ? a : b;
+}
+inline float zero_like(float) {
+  return 0;
+}
+inline float splat_like(float, float x) {
+  return x;
+}
+inline float where_at_least(float x, float threshold, float value) {
+  return x >= threshold ? value : 0.0f;
 }
 }  // namespace obb4_detail
 
@@ -75,6 +97,11 @@ struct alignas(16) Obb4 {
   /// slack 64 FLT_EPSILON M = 128u M is twice that.
   static constexpr float kSlackFactor = 64 * std::numeric_limits<float>::epsilon();
   static constexpr float kWidenM = 32 * std::numeric_limits<float>::epsilon();
+  /// The distance bound's squares, sums and root round by a few float ulps, and the face axes are unit to a
+  /// few: the bound is shrunk by this factor to stay below the distance.
+  static constexpr float kBoundRounding = 1 - 16 * std::numeric_limits<float>::epsilon();
+  /// The distance bound's shortest edge axis, squared (obb.hpp's kMinEdgeAxis).
+  static constexpr float kMinEdgeAxisSquared = 0.01f;
 
   /// The pose for lanes stored relative to origin_a (A's) and origin_b (B's): float_pose.hpp.
   static PairContext make_context(const RigidTransform& pose, const Vec3& origin_a = Vec3::Zero(),
@@ -148,6 +175,22 @@ struct alignas(16) Obb4 {
     return mask;
   }
 
+  /// The distance bound on four lanes (the wide distance walk, traversal/wide_distance.hpp): per lane a
+  /// lower bound on the distance between `a`'s box and `b`'s (placed), the larger of the Euclidean lengths
+  /// of the three face gaps in either box's frame or an edge-axis gap over the axis's length, each gap less
+  /// overlap()'s slack: obb.hpp's bound, in float. Infinity for an empty lane. A lane's bound is positive
+  /// only where overlap_placed() parts it (the same face gaps, computed alike).
+  static Row distance_bounds_scalar(const Obb4& a, const Placed& b, const PairContext& c) {
+    Row out{};
+    for (int k = 0; k < kLanes; ++k) {
+      const float slack = kSlackFactor * ((a.mag[k] + b.mag[k]) + c.translation_magnitude);
+      const float squared = squared_bound(load_lane(a, k), load_lane(b, k), kWidenM, slack);
+      out[k] = a.empty(k) || b.empty(k) ? std::numeric_limits<float>::infinity()
+                                        : std::sqrt(squared) * kBoundRounding;
+    }
+    return out;
+  }
+
 #if BVHLAB_OBB4_SSE2
   [[gnu::always_inline]] static Placed place(const Obb4& b, const PairContext& c) {
     const Lane<obb4_detail::F4> placed =
@@ -174,6 +217,22 @@ struct alignas(16) Obb4 {
     gap = other_gap(la, lb, r, gap);
     return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(gap.v, slack.v))) ^ 0xFu;
   }
+  [[gnu::always_inline]] static Row distance_bounds(const Obb4& a, const Placed& b, const PairContext& c) {
+    using obb4_detail::F4;
+    const F4 slack =
+        F4{_mm_set1_ps(kSlackFactor)} * ((F4{_mm_load_ps(a.mag.data())} + F4{_mm_load_ps(b.mag.data())}) +
+                                         F4{_mm_set1_ps(c.translation_magnitude)});
+    const F4 squared = squared_bound(load_vector(a), load_vector(b), F4{_mm_set1_ps(kWidenM)}, slack);
+    const __m128 bound = _mm_mul_ps(_mm_sqrt_ps(squared.v), _mm_set1_ps(kBoundRounding));
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 empty = _mm_or_ps(_mm_cmplt_ps(_mm_load_ps(a.half[0].data()), zero),
+                                   _mm_cmplt_ps(_mm_load_ps(b.half[0].data()), zero));
+    Row out;
+    _mm_storeu_ps(out.data(),
+                  _mm_or_ps(_mm_and_ps(empty, _mm_set1_ps(std::numeric_limits<float>::infinity())),
+                            _mm_andnot_ps(empty, bound)));
+    return out;
+  }
 #else
   static Placed place(const Obb4& b, const PairContext& c) {
     Obb4 out = b;
@@ -191,6 +250,9 @@ struct alignas(16) Obb4 {
       if (!(largest_gap(load_lane(a, k), load_lane(b, k), kWidenM) > slack)) mask |= 1u << k;
     }
     return mask;
+  }
+  static Row distance_bounds(const Obb4& a, const Placed& b, const PairContext& c) {
+    return distance_bounds_scalar(a, b, c);
   }
 #endif
 
@@ -277,6 +339,56 @@ struct alignas(16) Obb4 {
       }
     }
     return gap;
+  }
+  /// The square of the bound (before kBoundRounding): the face gaps (less `slack`, where positive) squared
+  /// and summed over each box's three axes, the larger of the two sums, or a larger square of an edge-axis
+  /// gap over its axis's length. The gaps are written as face_gap_a and other_gap write them, so that a
+  /// positive bound implies a gap overlap_placed() counts.
+  template <class V, class W>
+  [[gnu::always_inline]] static V squared_bound(const Lane<V>& a, const Lane<V>& b, W widen_by, V slack) {
+    using obb4_detail::abs;
+    using obb4_detail::max;
+    Relative<V> r;
+    (void)face_gap_a(a, b, widen_by, r);
+    const V zero = obb4_detail::zero_like(slack);
+    V on_a = zero, on_b = zero;
+    for (int i = 0; i < 3; ++i) {
+      const V radius_b = (r.am[i][0] * b.half[0] + r.am[i][1] * b.half[1]) + r.am[i][2] * b.half[2];
+      const V gap = max(zero, abs(r.t[i]) - a.half[i] - radius_b - slack);
+      on_a = on_a + gap * gap;
+    }
+    for (int j = 0; j < 3; ++j) {
+      const V distance = abs((r.t[0] * r.m[0][j] + r.t[1] * r.m[1][j]) + r.t[2] * r.m[2][j]);
+      const V radius_a = (r.am[0][j] * a.half[0] + r.am[1][j] * a.half[1]) + r.am[2][j] * a.half[2];
+      const V gap = max(zero, distance - radius_a - b.half[j] - slack);
+      on_b = on_b + gap * gap;
+    }
+    return edge_axes(a, b, r, slack, max(on_a, on_b));
+  }
+  /// `best` raised by the nine edge axes a_i x b_j. An axis is not unit: its gap counts divided by its
+  /// length, computed from m and lengthened by what m's rounding may hide (kWidenM an entry), and axes
+  /// within about 6 degrees of parallel are left out, as in obb.hpp's bound.
+  template <class V>
+  [[gnu::always_inline]] static V edge_axes(const Lane<V>& a, const Lane<V>& b, const Relative<V>& r, V slack,
+                                            V best) {
+    using obb4_detail::abs;
+    using obb4_detail::max;
+    const V zero = obb4_detail::zero_like(slack);
+    const V shortest = obb4_detail::splat_like(slack, kMinEdgeAxisSquared);
+    const V lengthen = obb4_detail::splat_like(slack, 6 * kWidenM);
+    for (int i = 0; i < 3; ++i) {
+      const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+      for (int j = 0; j < 3; ++j) {
+        const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+        const V distance = abs(r.t[i2] * r.m[i1][j] - r.t[i1] * r.m[i2][j]);
+        const V radius_a = a.half[i1] * r.am[i2][j] + a.half[i2] * r.am[i1][j];
+        const V radius_b = b.half[j1] * r.am[i][j2] + b.half[j2] * r.am[i][j1];
+        const V gap = max(zero, distance - radius_a - radius_b - slack);
+        const V length = r.m[i1][j] * r.m[i1][j] + r.m[i2][j] * r.m[i2][j];
+        best = max(best, obb4_detail::where_at_least(length, shortest, gap * gap / (length + lengthen)));
+      }
+    }
+    return best;
   }
   /// The largest gap over the 15 axes of A's box `a` and B's placed box `b` (obb.hpp's test; > 0 where an
   /// axis separates), |m| widened by `widen`.

@@ -118,17 +118,51 @@ TEST(WideQuery, ALoadedTreeAndContactGeometryWalkWideToo) {
   EXPECT_GT(contacts, 0u);
 }
 
+// The distance strategy walks wide trees of oriented boxes (the layout with a four-lane distance bound):
+// the binary walk's distances, bit for bit; on boxes it is refused by name, and its anytime form (whose
+// budget and dives walk the binary trees) does not run wide.
+TEST(WideQuery, DistanceAnswersAsTheBinaryWalkOnOrientedBoxes) {
+  const Mesh torus_a = testing::make_torus(0.7, 0.25, 16, 8), torus_b = testing::make_torus(0.5, 0.2, 12, 8);
+  const auto obb = AnyTree::build(torus_a, MeshUnits{}, "obb", density_spec("none", {}), BuildOptions{});
+  const auto obb_b = AnyTree::build(torus_b, MeshUnits{}, "obb", density_spec("none", {}), BuildOptions{});
+  std::vector<RigidTransform> poses = sliding_poses();
+  for (RigidTransform& pose : sliding_poses())
+    poses.push_back({pose.rotation, pose.translation + Vec3(0, 1, 0)});
+  const StrategyVariant distance = strategy_variant("distance", {}, Budget{});
+  const auto binary = results_of(obb, obb_b, distance, poses),
+             walked = results_of(obb, obb_b, wide(distance), poses);
+  int apart = 0;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    ASSERT_TRUE(walked[i].proximity.has_value());
+    EXPECT_EQ(walked[i].proximity->distance, binary[i].proximity->distance) << "pose " << i;
+    EXPECT_EQ(walked[i].collides, binary[i].collides) << "pose " << i;
+    apart += binary[i].proximity->distance > 0;
+  }
+  EXPECT_GT(apart, 10);
+  EXPECT_LT(apart, int(poses.size()) - 5);
+
+  const auto aabb = AnyTree::build(torus_a, MeshUnits{}, "aabb", density_spec("none", {}), BuildOptions{});
+  EXPECT_EQ(error_of([&] { (void)aabb.prepare(aabb, wide(distance)); }),
+            "strategy distance has no wide walk on 'aabb' trees (the wide distance walk needs four-lane "
+            "distance bounds: obb has them)");
+  const StrategyVariant anytime = wide(strategy_variant("distance_anytime", {}, Budget{100, 0}));
+  EXPECT_NE(error_of([&] { (void)obb.prepare(obb, anytime); }).find("does not run on wide trees"),
+            std::string::npos);
+}
+
 TEST(WideQuery, IsRefusedByNameWhereItDoesNotRun) {
   const auto tree = [](const std::string& bv, const char* density) {
     return AnyTree::build(testing::make_torus(0.7, 0.25, 12, 6), MeshUnits{}, bv, density_spec(density, {}),
                           BuildOptions{});
   };
   StrategyVariant adb = wide(strategy_variant("adb", {}, Budget{}));
-  EXPECT_EQ(error_of([&] { check_strategy_options(adb); }),
-            "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts)");
+  EXPECT_EQ(
+      error_of([&] { check_strategy_options(adb); }),
+      "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts, distance)");
   const AnyTree adb_tree = tree("aabb", "adb");
-  EXPECT_EQ(error_of([&] { (void)adb_tree.prepare(adb_tree, adb); }),
-            "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts)");
+  EXPECT_EQ(
+      error_of([&] { (void)adb_tree.prepare(adb_tree, adb); }),
+      "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts, distance)");
 
 #ifndef BVHLAB_LEAN_VOLUMES  // every volume of the sanitizer builds' lean registry has a wide layout
   const AnyTree rss = tree("rss", "none");

@@ -363,6 +363,20 @@ def test_wide_batches_answer_as_binary_ones(gear, strategy):
         bvhlab.query_batch(tree, tree, poses, strategy=strategy, wide=True, coherent=True)
 
 
+def test_wide_distances_are_the_binary_ones(gear):
+    """strategy="distance" with wide=True walks an OBB tree's wide layout: the binary walk's distances, bit for
+    bit; on boxes it is refused by name."""
+    tree = bvhlab.Tree(gear, "obb", "none")
+    poses = np.concatenate([bvhlab.protocol_poses(d, 40) for d in (1.0, 1.6, 2.0)])
+    binary = bvhlab.query_batch(tree, tree, poses, strategy="distance")
+    walked = bvhlab.query_batch(tree, tree, poses, strategy="distance", wide=True)
+    np.testing.assert_array_equal(walked["distance"], binary["distance"])
+    assert (binary["distance"] > 0).sum() > 20 and (binary["distance"] == 0).sum() > 5
+    boxes = bvhlab.Tree(gear, "aabb", "none")
+    with pytest.raises(ValueError, match="strategy distance has no wide walk on 'aabb' trees"):
+        bvhlab.query(boxes, boxes, poses[0], strategy="distance", wide=True)
+
+
 def test_coherent_states_take_their_bounds(gear_trees):
     """CoherentState's keywords are its bounds: with max_jump 0 every pose that is not answered by the
     remembered contact or the root pair alone jumps, and jumps in a row cost the cold query's work (and at

@@ -5,6 +5,7 @@
 #include "support/random_clouds.hpp"
 #include "support/test_volumes.hpp"
 #include "support/volume_lists.hpp"
+#include "volumes/obb4.hpp"
 
 #include <gtest/gtest.h>
 
@@ -404,6 +405,62 @@ TYPED_TEST(DistanceBound, SameAtCoordinatesAround1e6) {
   EXPECT_GT(positive, cases * 9 / 10);  // not vacuous: the bounds compared are mostly positive
   std::printf("[ measured ] %s: largest relative change of the bound at coordinates 1e6: %.2e\n",
               std::string(BV::name()).c_str(), worst);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// The oriented boxes' four-lane bound (Obb4::distance_bounds, the wide distance walk's): one box of A against
+// four of B, placed as the walk places them, lanes stored relative to origins near the clouds (as a wide
+// tree stores them, also at coordinates around 1e6). Never above the lane's point distance, the vector
+// path equal to the scalar reference, positive only where the four-lane overlap test parts the lane, and
+// infinite for an empty lane.
+
+TEST(ObbLanes, DistanceBoundsNeverExceedThePointDistance) {
+  std::mt19937_64 rng(3804);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  int positive = 0, lanes = 0;
+  double tightest = 0;
+  for (int round = 0; round < 2500; ++round) {
+    const Pair pair = random_pair(rng);
+    const Obb box_a = Obb::fit(pair.a);
+    const Vec3 origin_a = box_a.bounding_box().center(), origin_b = Obb::fit(pair.b).bounding_box().center();
+    Obb4 a, b;
+    a.set(0, box_a, origin_a);
+    a = Obb4::broadcast(a, 0);
+    std::array<std::vector<Vec3>, 4> clouds;  // B's lanes: the cloud, moved by up to its own size
+    const double size = diameter_of(pair.b) + 1e-3;
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 shift(size * unit(rng), size * unit(rng), size * unit(rng));
+      for (const Vec3& q : pair.b) clouds[k].push_back(q + (k == 0 ? Vec3::Zero() : shift));
+      if (round % 7 != k) b.set(k, Obb::fit(clouds[k]), origin_b);  // now and then a lane stays empty
+    }
+    const auto context = Obb4::make_context(pair.pose, origin_a, origin_b);
+    const Obb4 placed = Obb4::place(b, context);
+    const auto bounds = Obb4::distance_bounds(a, placed, context);
+    ASSERT_EQ(bounds, Obb4::distance_bounds_scalar(a, placed, context)) << "round " << round;
+    const unsigned overlapping = Obb4::overlap_placed(a, placed, context);
+    for (int k = 0; k < 4; ++k) {
+      if (b.empty(k)) {
+        ASSERT_EQ(bounds[k], std::numeric_limits<float>::infinity()) << "round " << round << " lane " << k;
+        continue;
+      }
+      ++lanes;
+      double magnitude = 0;
+      const double distance = point_distance(pair.a, clouds[k], pair.pose, &magnitude);
+      ASSERT_GE(bounds[k], 0) << "round " << round << " lane " << k;
+      ASSERT_LE(bounds[k], distance + kEps * distance + 1e-17 * magnitude)
+          << "round " << round << " lane " << k << ": bound " << bounds[k] << " > point distance "
+          << distance;
+      if (bounds[k] > 0) {
+        ++positive;
+        ASSERT_FALSE(overlapping & (1u << k)) << "round " << round << " lane " << k;
+      }
+      if (distance > 0) tightest = std::max(tightest, bounds[k] / distance);
+    }
+  }
+  EXPECT_GT(positive, lanes / 3);
+  EXPECT_GT(tightest, 0.9);  // not vacuous: some bounds come close to the distance
+  std::printf("[ measured ] obb lanes: %d of %d bounds positive, largest bound / distance 1 - %.1e\n",
+              positive, lanes, 1 - tightest);
 }
 
 }  // namespace

@@ -1,0 +1,135 @@
+// The distance query on wide trees (bvh/wide_bvh.hpp): query_distance's best-first search, where one step
+// bounds a volume of one tree against all four children of a node of the other at once (the lanes'
+// distance_bounds, e.g. Obb4's). The same distance as query_distance on the binary trees the wide ones were
+// built from: the triangle pairs are measured by the same loop, and every pair whose bound is below the
+// best distance found is opened, so the nearest pair is always reached; where several pairs lie at that
+// distance, the points and triangles may be another of them.
+//
+// A layout takes part when its lanes have a distance bound (WideDistanceLanes, bvh/wide_bvh.hpp); the
+// distance strategy refuses the others by name (traversal/distance_strategies.hpp).
+//
+// Counters: bv_tests counts four a step (each lane is a bound, occupied or not), as the wide exact walk;
+// nodes_visited the pairs taken off the queue; triangle_tests the triangle pairs measured.
+#pragma once
+
+#include "distance.hpp"
+#include "wide_exact.hpp"
+
+#include <cstdint>
+#include <queue>
+#include <vector>
+
+namespace bvhlab {
+
+namespace wide_distance_detail {
+
+/// A pair on the queue: lane a_lane of A's wide node a_node against lane b_lane of B's b_node. The key is
+/// the negated bound (the nearest first) or, for overlapping volumes (bound 0), a positive count of
+/// admissions: the last admitted first, a dive to the leaves as in query_distance.
+struct QueuedPair {
+  double key;
+  std::uint32_t a_node, a_lane, b_node, b_lane;
+  bool operator<(const QueuedPair& other) const { return key < other.key; }
+};
+
+/// The queue, with room for a typical front reserved at once (as BestFirst's, traversal/driver.hpp).
+class Queue : public std::priority_queue<QueuedPair> {
+ public:
+  Queue() { c.reserve(512); }
+};
+
+/// Files the lanes of one step whose bound is below the best distance found.
+class Admitter {
+ public:
+  explicit Admitter(const NearestPair& nearest) : nearest_(nearest) {}
+  [[gnu::always_inline]] void admit(Queue& queue, const std::array<float, 4>& bounds, QueuedPair base,
+                                    bool split_b) {
+    for (std::uint32_t k = 0; k < 4; ++k) {
+      const double bound = bounds[k];
+      if (!(bound < nearest_.distance)) continue;
+      QueuedPair p = base;
+      (split_b ? p.b_lane : p.a_lane) = k;
+      p.key = bound > 0 ? -bound : ++overlapping_;
+      queue.push(p);
+    }
+  }
+  static double bound_of(double key) { return key > 0 ? 0 : -key; }
+
+ private:
+  const NearestPair& nearest_;
+  double overlapping_ = 0;
+};
+
+}  // namespace wide_distance_detail
+
+/// The distance between the triangles of two binary trees, walking their wide trees (same contract as
+/// query_distance). Throws std::invalid_argument for a non-rigid pose, a tree without triangles, or wide
+/// trees of other binary trees. Const and thread-safe on shared trees.
+template <WideDistanceLanes Lanes>
+DistanceResult query_distance_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wide_a,
+                                   const Bvh<typename Lanes::Volume>& b, const WideBvh<Lanes>& wide_b,
+                                   const RigidTransform& b_to_a) {
+  using BV = typename Lanes::Volume;
+  using Tree = WideBvh<Lanes>;
+  using wide_distance_detail::Admitter;
+  distance_detail::check_query(a, b, b_to_a, "wide distance query");
+  DistanceResult result;
+  if (a.empty() || b.empty()) {  // no pair at all: infinitely far, and exactly so
+    result.lower_bound = result.distance;
+    return result;
+  }
+  wide_detail::require_pair(a, wide_a, b, wide_b, "wide distance query");
+  // The triangle loop reads no volume context (as in query_exact_wide).
+  const typename VolumeWalker<BV>::Context unused_context{};
+  const TreePair<BV> trees(a, b, b_to_a, unused_context, result.counters);
+  const typename Lanes::PairContext lanes = Lanes::make_context(b_to_a, wide_a.origin(), wide_b.origin());
+  Counters& counters = result.counters;
+  NearestPair nearest;
+  Admitter admitter(nearest);
+  wide_distance_detail::Queue queue;
+
+  counters.bv_tests += 1;
+  const auto& root_a = wide_detail::tested_lanes(wide_a.node(0).boxes);
+  const std::array<float, 4> root =
+      Lanes::distance_bounds(root_a, Lanes::place(wide_b.node(0).boxes, lanes), lanes);
+  constexpr float kNone = std::numeric_limits<float>::infinity();  // the pseudo-node's empty lanes
+  admitter.admit(queue, {root[0], kNone, kNone, kNone}, {0, 0, 0, 0, 0}, false);
+  while (!queue.empty()) {
+    const wide_distance_detail::QueuedPair p = queue.top();
+    queue.pop();
+    // Every pair still queued is at least as far: none holds a nearer triangle pair.
+    if (Admitter::bound_of(p.key) >= nearest.distance) break;
+    ++counters.nodes_visited;
+    const typename Tree::Node& node_a = wide_a.node(p.a_node);
+    const typename Tree::Node& node_b = wide_b.node(p.b_node);
+    const std::uint32_t child_a = node_a.child[p.a_lane], child_b = node_b.child[p.b_lane];
+    const bool leaf_a = (child_a & Tree::kLeaf) != 0, leaf_b = (child_b & Tree::kLeaf) != 0;
+    if (leaf_a && leaf_b) {
+      if (distance_detail::nearer_triangles(trees, child_a & ~Tree::kLeaf, child_b & ~Tree::kLeaf, nearest))
+        break;  // touching: nothing is nearer
+      continue;
+    }
+    // Split the larger of the two (a leaf cannot be split): its four children against the other's volume.
+    counters.bv_tests += 4;
+    if (leaf_a || (!leaf_b && node_b.boxes.volume(int(p.b_lane)) > node_a.boxes.volume(int(p.a_lane)))) {
+      const auto a_volume = Lanes::broadcast(node_a.boxes, int(p.a_lane));
+      const auto bounds =
+          Lanes::distance_bounds(a_volume, Lanes::place(wide_b.node(child_b).boxes, lanes), lanes);
+      admitter.admit(queue, bounds, {0, p.a_node, p.a_lane, child_b, 0}, true);
+    } else {
+      const auto b_volume = Lanes::place(Lanes::broadcast(node_b.boxes, int(p.b_lane)), lanes);
+      const auto bounds =
+          Lanes::distance_bounds(wide_detail::tested_lanes(wide_a.node(child_a).boxes), b_volume, lanes);
+      admitter.admit(queue, bounds, {0, child_a, 0, p.b_node, p.b_lane}, false);
+    }
+  }
+  result.distance = nearest.distance;
+  result.lower_bound = nearest.distance;
+  result.exact = true;
+  result.on_a = nearest.on_a;
+  result.on_b = nearest.on_b;
+  if (std::isfinite(nearest.distance)) result.triangles = nearest.triangles;
+  return result;
+}
+
+}  // namespace bvhlab
