@@ -36,6 +36,8 @@ StrategyInfo strategy_row() {
   });
   with_each_volume([&]<class BV>(std::type_identity<BV>) {
     if constexpr (kAcceptsVolume<S, BV>) info.volumes.emplace_back(BV::name());
+    if constexpr (kRunsWide<S> && kAcceptsVolume<S, BV> && HasWideLayout<BV> && kWalksWideOn<S, BV>)
+      info.wide_volumes.emplace_back(BV::name());
   });
   const auto specs = S::parameters();
   info.parameters.assign(specs.begin(), specs.end());
@@ -117,6 +119,16 @@ std::string StrategyInfo::wide_refusal() const {
   if (wide) return "";
   return "strategy " + name +
          " does not run on wide trees (the strategies that do: " + strategies_with(&StrategyInfo::wide) + ")";
+}
+
+std::string StrategyInfo::wide_walk_refusal(std::string_view bv) const {
+  if (std::string refusal = wide_refusal(); !refusal.empty()) return refusal;
+  if (std::string refusal = wide_layout_refusal(bv); !refusal.empty()) return refusal;
+  if (std::find(wide_volumes.begin(), wide_volumes.end(), bv) != wide_volumes.end()) return "";
+  std::string those;
+  for (const std::string& v : wide_volumes) those += (those.empty() ? "" : ", ") + v;
+  return "strategy " + name + " has no wide walk on '" + std::string(bv) +
+         "' trees (the volumes it walks wide: " + those + ")";
 }
 
 std::string wide_layout_refusal(std::string_view bv) {
@@ -204,6 +216,7 @@ nlohmann::json policies_json() {
                           {"needs_density", s.needs_density},
                           {"coherent", s.coherent},
                           {"wide", s.wide},
+                          {"wide_volumes", s.wide_volumes},
                           {"densities", s.densities},
                           {"volumes", s.volumes},
                           {"parameters", parameters_json(s.parameters)}});

@@ -25,12 +25,13 @@ struct StrategyInfo {
   std::string name, description;
   bool exact = false;  ///< answers agree with the exact ground truth
   BudgetUse budget = BudgetUse::None;
-  bool needs_polygons = false;         ///< cannot run on trees saved without polygons
-  bool needs_density = false;          ///< does not run on trees without a density
-  bool coherent = false;               ///< runs coherent over a sequence of poses (traversal/coherent.hpp)
-  bool wide = false;                   ///< runs on the trees' wide layout (traversal/wide_*.hpp)
-  std::vector<std::string> densities;  ///< the registered densities it runs on
-  std::vector<std::string> volumes;    ///< the registered volumes it runs on
+  bool needs_polygons = false;            ///< cannot run on trees saved without polygons
+  bool needs_density = false;             ///< does not run on trees without a density
+  bool coherent = false;                  ///< runs coherent over a sequence of poses (traversal/coherent.hpp)
+  bool wide = false;                      ///< runs on the trees' wide layout (traversal/wide_*.hpp)
+  std::vector<std::string> densities;     ///< the registered densities it runs on
+  std::vector<std::string> volumes;       ///< the registered volumes it runs on
+  std::vector<std::string> wide_volumes;  ///< those its wide walk runs on (empty: no wide walk)
   std::vector<ParamSpec> parameters;
   [[nodiscard]] bool accepts(std::string_view density) const;
   /// Empty when it runs on `density`; else the one message every caller gives: "strategy adb does not run
@@ -46,6 +47,10 @@ struct StrategyInfo {
   /// Empty when it runs on the trees' wide layout; else the one message every caller gives: "strategy adb
   /// does not run on wide trees (the strategies that do: exact, all_contacts, distance)".
   [[nodiscard]] std::string wide_refusal() const;
+  /// Empty when its wide walk runs on trees of volume `bv`; else the one message every caller gives: the
+  /// wide_refusal() above, wide_layout_refusal(bv) below, or "strategy distance has no wide walk on 'aabb'
+  /// trees (the volumes it walks wide: obb)".
+  [[nodiscard]] std::string wide_walk_refusal(std::string_view bv) const;
   /// Empty when its answers name intersecting triangle pairs (needs_polygons); else the one message every
   /// caller gives for contact geometry asked of it.
   [[nodiscard]] std::string contact_geometry_refusal() const;

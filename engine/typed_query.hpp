@@ -322,9 +322,7 @@ struct TreeQueries {
     if (!kRunsWide<S>) throw std::invalid_argument(strategy_info(variant.strategy).wide_refusal());
     if (!HasWideLayout<BV>) throw std::invalid_argument(wide_layout_refusal(BV::name()));
     if constexpr (!kWalksWideOn<S, BV>)
-      throw std::invalid_argument("strategy " + std::string(S::name()) + " has no wide walk on '" +
-                                  std::string(BV::name()) + "' trees (" + std::string(S::wide_volumes()) +
-                                  ")");
+      throw std::invalid_argument(strategy_info(variant.strategy).wide_walk_refusal(BV::name()));
     if (variant.coherent)
       throw std::invalid_argument(
           "a coherent query walks the binary trees; ask for coherent or wide, not both");

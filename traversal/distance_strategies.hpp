@@ -79,13 +79,10 @@ struct DistanceStrategy : distance_strategy_detail::ProximityTraits {
                                CoherentState& state) {
     return distance_strategy_detail::as_result(query_distance_coherent(a.bvh, b.bvh, b_to_a, state));
   }
-  /// The wide walk (traversal/wide_distance.hpp) needs lanes with a distance bound.
+  /// The wide walk (traversal/wide_distance.hpp) needs lanes with a distance bound: obb's.
   static constexpr bool wide = true;
   template <class BV>
   static constexpr bool walks_wide = HasWideDistance<BV>;
-  static constexpr std::string_view wide_volumes() {
-    return "the wide distance walk needs four-lane distance bounds: obb has them";
-  }
   template <class TreeA, class TreeB, class Lanes>
   static Result query_wide(const TreeA& a, const WideBvh<Lanes>& wide_a, const TreeB& b,
                            const WideBvh<Lanes>& wide_b, const RigidTransform& b_to_a, Options) {

@@ -210,7 +210,7 @@ QueryRequest query_request(const QueryArgs& args, bool trees) {
       throw CLI::ValidationError("--wide", "FCL hierarchies have no wide layout here; give a bvhlab volume");
     if (std::string refusal = strategy.wide_refusal(); !refusal.empty())
       throw CLI::ValidationError("--wide", refusal);
-    if (std::string refusal = trees ? "" : wide_layout_refusal(args.bv); !refusal.empty())
+    if (std::string refusal = trees ? "" : strategy.wide_walk_refusal(args.bv); !refusal.empty())
       throw CLI::ValidationError("--wide", refusal);
     if (args.coherent)
       throw CLI::ValidationError("--wide",
@@ -534,9 +534,10 @@ Command add_query_command(CLI::App& app) {
                   "Start each pose where the previous one ended (less work on poses close to each other; "
                   "traversal/README.md, \"Coherent queries\"): the poses of --poses or a --protocol turn in "
                   "order, and each --repeat pass");
-  query->add_flag("--wide", args->wide,
-                  "Walk the trees' wide layout: four children a node tested at once (exact and all_contacts; "
-                  "aabb, the k-DOPs, obb and sphere). The same answers, in less time");
+  query->add_flag(
+      "--wide", args->wide,
+      "Walk the trees' wide layout: four children a node tested at once (exact and all_contacts on "
+      "aabb, the k-DOPs, obb and sphere; distance on obb). The same answers, in less time");
   query->add_flag("--contact-geometry", args->geometry,
                   "Also give each contact's geometry: the segment where its two triangles meet, its midpoint "
                   "and a normal from A into B (in A's frame; no penetration depth)");

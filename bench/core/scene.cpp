@@ -62,7 +62,8 @@ bool parse_strategy_hierarchies(const Node& s, const Scene& scene, StrategySpec&
       if (std::string refusal = fcl_refusal(spec, h.bv); !refusal.empty()) hs.child(k).fail(refusal);
     } else if (std::string refusal = strategy_info(spec.name).volume_refusal(h.bv); !refusal.empty()) {
       hs.child(k).fail(refusal);
-    } else if (std::string no_layout = spec.wide ? wide_layout_refusal(h.bv) : ""; !no_layout.empty()) {
+    } else if (std::string no_layout = spec.wide ? strategy_info(spec.name).wide_walk_refusal(h.bv) : "";
+               !no_layout.empty()) {
       hs.child(k).fail(no_layout);
     }
     spec.hierarchies.push_back(name);
@@ -259,7 +260,7 @@ bool Scene::applies(const StrategySpec& s, const HierarchySpec& h) const {
       std::find(s.hierarchies.begin(), s.hierarchies.end(), h.name) == s.hierarchies.end())
     return false;
   if (h.is_fcl()) return fcl_refusal(s, h.bv).empty();
-  if (s.wide && !wide_layout_refusal(h.bv).empty()) return false;  // e.g. rss
+  if (s.wide && !strategy_info(s.name).wide_walk_refusal(h.bv).empty()) return false;  // e.g. rss
   return strategy_info(s.name).volume_refusal(h.bv).empty();  // e.g. distance on a volume without a bound
 }
 

@@ -137,6 +137,24 @@ TEST_F(SceneTest, WideStrategiesRunWhereTheVolumeHasALayout) {
   refused(R"([{"type": "exact", "wide": "yes"}])", "/strategies/0/wide: expected true or false");
 }
 
+// A strategy whose wide walk takes only some layouts (the distance: oriented boxes) runs wide on those,
+// leaves the others out, and refuses them when named.
+TEST_F(SceneTest, WideDistanceRunsOnOrientedBoxesOnly) {
+  const std::string hierarchies = R"([{"bv": "obb"}, {"bv": "aabb"}])";
+  const Scene scene = parse(scene_with(R"([{"mesh": "torus.obj"}])", hierarchies,
+                                       R"([{"type": "distance"}, {"type": "distance", "wide": true}])", ""));
+  ASSERT_EQ(scene.strategies.size(), 2u);
+  EXPECT_TRUE(scene.applies(scene.strategies[1], scene.hierarchies[0]));
+  EXPECT_FALSE(scene.applies(scene.strategies[1], scene.hierarchies[1]));  // aabb: no four-lane bound
+  EXPECT_TRUE(scene.applies(scene.strategies[0], scene.hierarchies[1]));
+  const std::string message =
+      error_of(scene_with(R"([{"mesh": "torus.obj"}])", hierarchies,
+                          R"([{"type": "distance", "wide": true, "hierarchies": ["aabb"]}])", ""));
+  EXPECT_NE(message.find("/strategies/0/hierarchies/0: strategy distance has no wide walk on 'aabb' trees"),
+            std::string::npos)
+      << message;
+}
+
 TEST_F(SceneTest, CoherentStrategiesAndProtocolStrides) {
   const Scene scene =
       parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",

@@ -143,8 +143,11 @@ TEST(WideQuery, DistanceAnswersAsTheBinaryWalkOnOrientedBoxes) {
 
   const auto aabb = AnyTree::build(torus_a, MeshUnits{}, "aabb", density_spec("none", {}), BuildOptions{});
   EXPECT_EQ(error_of([&] { (void)aabb.prepare(aabb, wide(distance)); }),
-            "strategy distance has no wide walk on 'aabb' trees (the wide distance walk needs four-lane "
-            "distance bounds: obb has them)");
+            "strategy distance has no wide walk on 'aabb' trees (the volumes it walks wide: obb)");
+  EXPECT_EQ(strategy_info("distance").wide_walk_refusal("aabb"),
+            "strategy distance has no wide walk on 'aabb' trees (the volumes it walks wide: obb)");
+  EXPECT_EQ(strategy_info("distance").wide_walk_refusal("obb"), "");
+  EXPECT_EQ(strategy_info("exact").wide_walk_refusal("aabb"), "");
   const StrategyVariant anytime = wide(strategy_variant("distance_anytime", {}, Budget{100, 0}));
   EXPECT_NE(error_of([&] { (void)obb.prepare(obb, anytime); }).find("does not run on wide trees"),
             std::string::npos);
