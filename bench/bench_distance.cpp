@@ -125,11 +125,13 @@ double anytime_share(const AnyTree& tree, const std::vector<RigidTransform>& pos
   return apart ? double(narrow) / apart : -1;
 }
 
-/// The same poses in order through the coherent distance query, a fresh state each pass (its first pose is
-/// cold); `coherent_disagree` counts poses whose distance is not the cold query's (it must be 0).
-void register_coherent(const std::string& name, const std::shared_ptr<const Queries>& q, const PoseSet& set,
-                       const std::vector<double>& cold) {
-  benchmark::RegisterBenchmark(name.c_str(), [q, &set, cold](benchmark::State& state) {
+/// A twin of the full query's series: the same poses through the coherent query (in order, a fresh state
+/// each pass, its first pose cold) or through the wide walk; `<twin>_disagree` counts poses whose distance
+/// is not the binary cold query's (it must be 0: the same triangle pairs, measured alike).
+enum class Twin { Coherent, Wide };
+void register_twin(const std::string& name, const std::shared_ptr<const Queries>& q, Twin twin,
+                   const PoseSet& set, const std::vector<double>& cold) {
+  benchmark::RegisterBenchmark(name.c_str(), [q, twin, &set, cold](benchmark::State& state) {
     Counters pass;
     double sum = 0;
     std::size_t disagree = 0;
@@ -138,7 +140,9 @@ void register_coherent(const std::string& name, const std::shared_ptr<const Quer
       sum = 0;
       disagree = 0;
       CoherentState coherent;
-      const std::vector<Proximity> got = proximities(*q->coherent, set.poses, pass, &coherent);
+      const std::vector<Proximity> got = twin == Twin::Coherent
+                                             ? proximities(*q->coherent, set.poses, pass, &coherent)
+                                             : proximities(*q->wide, set.poses, pass);
       for (std::size_t i = 0; i < got.size(); ++i) {
         sum += got[i].distance;
         disagree += got[i].distance != cold[i];
@@ -146,31 +150,8 @@ void register_coherent(const std::string& name, const std::shared_ptr<const Quer
       benchmark::DoNotOptimize(sum);
     }
     set_counters(state, set.poses.size(), pass, sum);
-    state.counters["coherent_disagree"] = static_cast<double>(disagree);
-  })->Unit(benchmark::kMillisecond);
-}
-
-/// The same poses through the wide walk; `wide_disagree` counts poses whose distance is not the binary
-/// walk's (it must be 0: the same triangle pairs measured alike).
-void register_wide(const std::string& name, const std::shared_ptr<const Queries>& q, const PoseSet& set,
-                   const std::vector<double>& binary) {
-  benchmark::RegisterBenchmark(name.c_str(), [q, &set, binary](benchmark::State& state) {
-    Counters pass;
-    double sum = 0;
-    std::size_t disagree = 0;
-    for (auto _ : state) {
-      pass = {};
-      sum = 0;
-      disagree = 0;
-      const std::vector<Proximity> got = proximities(*q->wide, set.poses, pass);
-      for (std::size_t i = 0; i < got.size(); ++i) {
-        sum += got[i].distance;
-        disagree += got[i].distance != binary[i];
-      }
-      benchmark::DoNotOptimize(sum);
-    }
-    set_counters(state, set.poses.size(), pass, sum);
-    state.counters["wide_disagree"] = static_cast<double>(disagree);
+    state.counters[twin == Twin::Coherent ? "coherent_disagree" : "wide_disagree"] =
+        static_cast<double>(disagree);
   })->Unit(benchmark::kMillisecond);
 }
 
@@ -210,9 +191,10 @@ void register_bvhlab(const std::string& mesh_name, const Mesh& mesh, const std::
       state.counters["anytime_tenth"] = anytime_tenth;
       state.counters["anytime_3tenths"] = anytime_3tenths;
     })->Unit(benchmark::kMillisecond);
-    register_coherent(name + "/coherent", q, set, distances);
+    register_twin(name + "/coherent", q, Twin::Coherent, set, distances);
     if (q->wide)
-      register_wide("distance/" + mesh_name + "/" + bv + "_wide/d:" + set.label, q, set, distances);
+      register_twin("distance/" + mesh_name + "/" + bv + "_wide/d:" + set.label, q, Twin::Wide, set,
+                    distances);
   }
 }
 
