@@ -173,12 +173,14 @@ concept HasWideLayout = requires {
 template <HasWideLayout BV>
 using WideTreeOf = WideBvh<typename WideLanes<BV>::type>;
 
-/// Lanes whose four volumes bound their distance to another volume's, placed (Obb4::distance_bounds): the
-/// wide distance walk (traversal/wide_distance.hpp) runs on them.
+/// Lanes whose four volumes bound their distance to a volume of the other tree: one lane of A's node against
+/// B's four children placed by the pose, and A's four children against one lane of B's node
+/// (Obb4::distance_bounds_to_b, _to_a). The wide distance walk (traversal/wide_distance.hpp) runs on them.
 template <class Lanes>
-concept WideDistanceLanes = requires(const Lanes& a, const typename Lanes::Placed& b,
+concept WideDistanceLanes = requires(const Lanes& a, const Lanes& b, int lane,
                                      const typename Lanes::PairContext& c) {
-  { Lanes::distance_bounds(a, b, c) } -> std::same_as<std::array<float, 4>>;
+  { Lanes::distance_bounds_to_b(a, lane, b, c) } -> std::same_as<std::array<float, 4>>;
+  { Lanes::distance_bounds_to_a(a, b, lane, c) } -> std::same_as<std::array<float, 4>>;
 };
 /// Whether trees of volume BV have a wide layout that the distance walk runs on.
 template <class BV>

@@ -1,9 +1,9 @@
 // The distance query on wide trees (bvh/wide_bvh.hpp): query_distance's best-first search, where one step
 // bounds a volume of one tree against all four children of a node of the other at once (the lanes'
-// distance_bounds, e.g. Obb4's). The same distance as query_distance on the binary trees the wide ones were
-// built from: the triangle pairs are measured by the same loop, and every pair whose bound is below the
-// best distance found is opened, so the nearest pair is always reached; where several pairs lie at that
-// distance, the points and triangles may be another of them.
+// distance_bounds_to_b and _to_a, e.g. Obb4's). The same distance as query_distance on the binary trees
+// the wide ones were built from: the triangle pairs are measured by the same loop, and every pair whose
+// bound is below the best distance found is opened, so the nearest pair is always reached; where several
+// pairs lie at that distance, the points and triangles may be another of them.
 //
 // A layout takes part when its lanes have a distance bound (WideDistanceLanes, bvh/wide_bvh.hpp); the
 // distance strategy refuses the others by name (traversal/distance_strategies.hpp).
@@ -89,9 +89,8 @@ DistanceResult query_distance_wide(const Bvh<typename Lanes::Volume>& a, const W
   wide_distance_detail::Queue queue;
 
   counters.bv_tests += 1;
-  const auto& root_a = wide_detail::tested_lanes(wide_a.node(0).boxes);
   const std::array<float, 4> root =
-      Lanes::distance_bounds(root_a, Lanes::place(wide_b.node(0).boxes, lanes), lanes);
+      Lanes::distance_bounds_to_b(wide_a.node(0).boxes, 0, wide_b.node(0).boxes, lanes);
   constexpr float kNone = std::numeric_limits<float>::infinity();  // the pseudo-node's empty lanes
   admitter.admit(queue, {root[0], kNone, kNone, kNone}, {0, 0, 0, 0, 0}, false);
   while (!queue.empty()) {
@@ -112,14 +111,12 @@ DistanceResult query_distance_wide(const Bvh<typename Lanes::Volume>& a, const W
     // Split the larger of the two (a leaf cannot be split): its four children against the other's volume.
     counters.bv_tests += 4;
     if (leaf_a || (!leaf_b && node_b.boxes.volume(int(p.b_lane)) > node_a.boxes.volume(int(p.a_lane)))) {
-      const auto a_volume = Lanes::broadcast(node_a.boxes, int(p.a_lane));
       const auto bounds =
-          Lanes::distance_bounds(a_volume, Lanes::place(wide_b.node(child_b).boxes, lanes), lanes);
+          Lanes::distance_bounds_to_b(node_a.boxes, int(p.a_lane), wide_b.node(child_b).boxes, lanes);
       admitter.admit(queue, bounds, {0, p.a_node, p.a_lane, child_b, 0}, true);
     } else {
-      const auto b_volume = Lanes::place(Lanes::broadcast(node_b.boxes, int(p.b_lane)), lanes);
       const auto bounds =
-          Lanes::distance_bounds(wide_detail::tested_lanes(wide_a.node(child_a).boxes), b_volume, lanes);
+          Lanes::distance_bounds_to_a(wide_a.node(child_a).boxes, node_b.boxes, int(p.b_lane), lanes);
       admitter.admit(queue, bounds, {0, child_a, 0, p.b_node, p.b_lane}, false);
     }
   }

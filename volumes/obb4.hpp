@@ -218,20 +218,20 @@ struct alignas(16) Obb4 {
     return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(gap.v, slack.v))) ^ 0xFu;
   }
   [[gnu::always_inline]] static Row distance_bounds(const Obb4& a, const Placed& b, const PairContext& c) {
-    using obb4_detail::F4;
-    const F4 slack =
-        F4{_mm_set1_ps(kSlackFactor)} * ((F4{_mm_load_ps(a.mag.data())} + F4{_mm_load_ps(b.mag.data())}) +
-                                         F4{_mm_set1_ps(c.translation_magnitude)});
-    const F4 squared = squared_bound(load_vector(a), load_vector(b), F4{_mm_set1_ps(kWidenM)}, slack);
-    const __m128 bound = _mm_mul_ps(_mm_sqrt_ps(squared.v), _mm_set1_ps(kBoundRounding));
-    const __m128 zero = _mm_setzero_ps();
-    const __m128 empty = _mm_or_ps(_mm_cmplt_ps(_mm_load_ps(a.half[0].data()), zero),
-                                   _mm_cmplt_ps(_mm_load_ps(b.half[0].data()), zero));
-    Row out;
-    _mm_storeu_ps(out.data(),
-                  _mm_or_ps(_mm_and_ps(empty, _mm_set1_ps(std::numeric_limits<float>::infinity())),
-                            _mm_andnot_ps(empty, bound)));
-    return out;
+    return bounds_of(load_vector(a), load_vector(b), load_row(a.mag), load_row(b.mag), c);
+  }
+  /// The walk's two steps, without an Obb4 made for the broadcast or placed volumes (building one costs
+  /// its 64 floats twice): lane `a_lane` of `a` against B's `b_children`, placed by the pose, and A's
+  /// `a_children` against lane `b_lane` of `b`, placed. Equal to distance_bounds on broadcast() and place().
+  [[gnu::always_inline]] static Row distance_bounds_to_b(const Obb4& a, int a_lane, const Obb4& b_children,
+                                                         const PairContext& c) {
+    return bounds_of(load_broadcast(a, a_lane), place_lane(load_vector(b_children), c, splat_float),
+                     obb4_detail::F4{_mm_set1_ps(a.mag[a_lane])}, load_row(b_children.mag), c);
+  }
+  [[gnu::always_inline]] static Row distance_bounds_to_a(const Obb4& a_children, const Obb4& b, int b_lane,
+                                                         const PairContext& c) {
+    return bounds_of(load_vector(a_children), place_lane(load_broadcast(b, b_lane), c, splat_float),
+                     load_row(a_children.mag), obb4_detail::F4{_mm_set1_ps(b.mag[b_lane])}, c);
   }
 #else
   static Placed place(const Obb4& b, const PairContext& c) {
@@ -254,6 +254,12 @@ struct alignas(16) Obb4 {
   static Row distance_bounds(const Obb4& a, const Placed& b, const PairContext& c) {
     return distance_bounds_scalar(a, b, c);
   }
+  static Row distance_bounds_to_b(const Obb4& a, int a_lane, const Obb4& b_children, const PairContext& c) {
+    return distance_bounds_scalar(broadcast(a, a_lane), place(b_children, c), c);
+  }
+  static Row distance_bounds_to_a(const Obb4& a_children, const Obb4& b, int b_lane, const PairContext& c) {
+    return distance_bounds_scalar(a_children, place(broadcast(b, b_lane), c), c);
+  }
 #endif
 
  private:
@@ -274,6 +280,37 @@ struct alignas(16) Obb4 {
     for (int e = 0; e < 9; ++e) out.axes[e] = {_mm_load_ps(b.axes[e].data())};
     for (int r = 0; r < 3; ++r)
       out.center[r] = {_mm_load_ps(b.center[r].data())}, out.half[r] = {_mm_load_ps(b.half[r].data())};
+    return out;
+  }
+  [[gnu::always_inline]] static Lane<obb4_detail::F4> load_broadcast(const Obb4& b, int k) {
+    Lane<obb4_detail::F4> out;
+    for (int e = 0; e < 9; ++e) out.axes[e] = {_mm_set1_ps(b.axes[e][k])};
+    for (int r = 0; r < 3; ++r)
+      out.center[r] = {_mm_set1_ps(b.center[r][k])}, out.half[r] = {_mm_set1_ps(b.half[r][k])};
+    return out;
+  }
+  [[gnu::always_inline]] static obb4_detail::F4 load_row(const Row& row) {
+    return {_mm_load_ps(row.data())};
+  }
+  [[gnu::always_inline]] static obb4_detail::F4 splat(float x) {
+    return {_mm_set1_ps(x)};
+  }
+  static constexpr auto splat_float = [](float x) { return obb4_detail::F4{_mm_set1_ps(x)}; };
+  /// The four bounds of A's lanes `la` and B's placed lanes `lb` (scales `mag_a`, `mag_b`): as
+  /// distance_bounds_scalar, lane by lane.
+  [[gnu::always_inline]] static Row bounds_of(const Lane<obb4_detail::F4>& la,
+                                              const Lane<obb4_detail::F4>& lb, obb4_detail::F4 mag_a,
+                                              obb4_detail::F4 mag_b, const PairContext& c) {
+    using obb4_detail::F4;
+    const F4 slack = splat(kSlackFactor) * ((mag_a + mag_b) + splat(c.translation_magnitude));
+    const F4 squared = squared_bound(la, lb, splat(kWidenM), slack);
+    const __m128 bound = _mm_mul_ps(_mm_sqrt_ps(squared.v), _mm_set1_ps(kBoundRounding));
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 empty = _mm_or_ps(_mm_cmplt_ps(la.half[0].v, zero), _mm_cmplt_ps(lb.half[0].v, zero));
+    Row out;
+    _mm_storeu_ps(out.data(),
+                  _mm_or_ps(_mm_and_ps(empty, _mm_set1_ps(std::numeric_limits<float>::infinity())),
+                            _mm_andnot_ps(empty, bound)));
     return out;
   }
 #endif

@@ -437,6 +437,11 @@ TEST(ObbLanes, DistanceBoundsNeverExceedThePointDistance) {
     const Obb4 placed = Obb4::place(b, context);
     const auto bounds = Obb4::distance_bounds(a, placed, context);
     ASSERT_EQ(bounds, Obb4::distance_bounds_scalar(a, placed, context)) << "round " << round;
+    // The walk's steps, which build no broadcast or placed Obb4, answer alike: lane 0 of A's node against
+    // B's four placed, and four A lanes (here A's one, broadcast) against each placed B lane.
+    ASSERT_EQ(bounds, Obb4::distance_bounds_to_b(a, 0, b, context)) << "round " << round;
+    for (int k = 0; k < 4; ++k)
+      ASSERT_EQ(Obb4::distance_bounds_to_a(a, b, k, context)[0], bounds[k]) << "round " << round << " " << k;
     const unsigned overlapping = Obb4::overlap_placed(a, placed, context);
     for (int k = 0; k < 4; ++k) {
       if (b.empty(k)) {
