@@ -26,7 +26,8 @@
 //   DepthFirst          a stack: the last admitted pair first. With SplitLarger's order [right, left], the
 //                       left child is visited first.
 //   BestFirst           a priority queue on Pair::key: the highest key first (std::priority_queue, ties in
-//                       its order).
+//                       its order), with the highest pair pushed since the last pop held beside the heap:
+//                       taken next when nothing queued beats it (ties to it), without a push or pop.
 //   OrderedDepthFirst   a stack on which the pairs admitted since the last pop are ordered by key: depth
 //                       first, into the most promising child (e.g. the most probable) first.
 //
@@ -129,21 +130,43 @@ struct BestFirst {
   template <class Pair>
   class Queue {
    public:
-    [[nodiscard]] bool empty() const { return items_.empty(); }
-    [[nodiscard]] const Pair& top() const { return items_.top(); }  ///< the highest key
+    [[nodiscard]] bool empty() const { return !holding_ && items_.empty(); }
+    [[nodiscard]] const Pair& top() const {
+      return takes_held() ? held_ : items_.top();
+    }  ///< the highest key
+    // Best first mostly takes next a child of the pair it has just taken: holding the best of them outside
+    // the heap spares a push and a pop for each such child (on the pinion's wide OBB distance query, half).
     [[gnu::always_inline]] void push(const Pair& p) {
-      // Room for a typical front at the first push: growing it pair by pair copies the whole heap each time
-      // it doubles, a pause a deadline cannot interrupt. Not at construction: a root decision needs none.
-      if (items_.capacity() == 0) items_.reserve_empty(kReservedPairs);
-      items_.push(p);
+      if (!holding_) {
+        held_ = p;
+        holding_ = true;
+      } else if (held_.key < p.key) {
+        push_to_heap(held_);
+        held_ = p;
+      } else {
+        push_to_heap(p);
+      }
     }
     [[gnu::always_inline]] Pair pop() {
+      if (takes_held()) {
+        holding_ = false;
+        return held_;
+      }
       const Pair p = items_.top();
       items_.pop();
       return p;
     }
 
    private:
+    [[nodiscard]] bool takes_held() const {
+      return holding_ && (items_.empty() || !(held_.key < items_.top().key));
+    }
+    [[gnu::always_inline]] void push_to_heap(const Pair& p) {
+      // Room for a typical front at the first push: growing it pair by pair copies the whole heap each time
+      // it doubles, a pause a deadline cannot interrupt. Not at construction: a root decision needs none.
+      if (items_.capacity() == 0) items_.reserve_empty(kReservedPairs);
+      items_.push(p);
+    }
     struct ByKey {
       bool operator()(const Pair& x, const Pair& y) const { return x.key < y.key; }
     };
@@ -160,6 +183,8 @@ struct BestFirst {
     // 16 KiB of pairs: far below malloc's mmap threshold, so the reservation costs one ordinary allocation.
     static constexpr std::size_t kReservedPairs = std::max<std::size_t>(64, 16384 / sizeof(Pair));
     Heap items_;
+    Pair held_{};
+    bool holding_ = false;
   };
 };
 
