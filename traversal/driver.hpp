@@ -131,9 +131,8 @@ struct BestFirst {
   class Queue {
    public:
     [[nodiscard]] bool empty() const { return !holding_ && items_.empty(); }
-    [[nodiscard]] const Pair& top() const {
-      return takes_held() ? held_ : items_.top();
-    }  ///< the highest key
+    /// The highest key.
+    [[nodiscard]] const Pair& top() const { return takes_held() ? held_ : items_.top(); }
     // Best first mostly takes next a child of the pair it has just taken: holding the best of them outside
     // the heap spares a push and a pop for each such child (on the pinion's wide OBB distance query, half).
     [[gnu::always_inline]] void push(const Pair& p) {

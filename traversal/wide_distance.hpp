@@ -13,11 +13,11 @@
 #pragma once
 
 #include "distance.hpp"
+#include "driver.hpp"
 #include "wide_exact.hpp"
 
+#include <array>
 #include <cstdint>
-#include <queue>
-#include <vector>
 
 namespace bvhlab {
 
@@ -31,47 +31,27 @@ struct QueuedPair {
   float key;
   std::uint32_t a_node, b_node;
   std::uint8_t a_lane, b_lane;
-  bool operator<(const QueuedPair& other) const { return key < other.key; }
 };
 static_assert(sizeof(QueuedPair) == 16);
 
-/// The queue, with room for a typical front reserved at once (as BestFirst's, traversal/driver.hpp).
-class Queue : public std::priority_queue<QueuedPair> {
- public:
-  Queue() { c.reserve(1024); }
-};
+/// The queue: best first, which also spares the heap the nearest lane of a step when nothing queued is
+/// nearer (BestFirst, traversal/driver.hpp).
+using Queue = BestFirst::Queue<QueuedPair>;
 
-/// Files the lanes of one step whose bound is below the best distance found, but the nearest of them when
-/// nothing queued comes before it: that one is the next pair best first takes, and it is walked at once,
-/// without the heap's push and pop (about half the pairs a far query opens).
+/// Files the lanes of one step whose bound is below the best distance found.
 class Admitter {
  public:
   explicit Admitter(const NearestPair& nearest) : nearest_(nearest) {}
-  /// Returns whether `next` holds the pair to walk next (otherwise the queue's top is).
-  [[gnu::always_inline]] bool admit(Queue& queue, const std::array<float, 4>& bounds, QueuedPair base,
-                                    bool split_b, QueuedPair& next) {
-    bool holding = false;
+  [[gnu::always_inline]] void admit(Queue& queue, const std::array<float, 4>& bounds, QueuedPair base,
+                                    bool split_b) {
     for (std::uint8_t k = 0; k < 4; ++k) {
       const float bound = bounds[k];
       if (!(bound < nearest_.distance)) continue;
       QueuedPair p = base;
       (split_b ? p.b_lane : p.a_lane) = k;
       p.key = bound > 0 ? -bound : float(++overlapping_);
-      if (!holding) {
-        next = p;
-        holding = true;
-      } else if (next.key < p.key) {
-        queue.push(next);
-        next = p;
-      } else {
-        queue.push(p);
-      }
+      queue.push(p);
     }
-    if (holding && !queue.empty() && next.key < queue.top().key) {
-      queue.push(next);  // a queued pair is nearer
-      return false;
-    }
-    return holding;
   }
   static double bound_of(float key) { return key > 0 ? 0 : -double(key); }
 
@@ -112,13 +92,9 @@ DistanceResult query_distance_wide(const Bvh<typename Lanes::Volume>& a, const W
   const std::array<float, 4> root =
       Lanes::distance_bounds_to_b(wide_a.node(0).boxes, 0, wide_b.node(0).boxes, lanes);
   constexpr float kNone = std::numeric_limits<float>::infinity();  // the pseudo-node's empty lanes
-  wide_distance_detail::QueuedPair p{};
-  bool holding = admitter.admit(queue, {root[0], kNone, kNone, kNone}, {0, 0, 0, 0, 0}, false, p);
-  while (holding || !queue.empty()) {
-    if (!holding) {
-      p = queue.top();
-      queue.pop();
-    }
+  admitter.admit(queue, {root[0], kNone, kNone, kNone}, {0, 0, 0, 0, 0}, false);
+  while (!queue.empty()) {
+    const wide_distance_detail::QueuedPair p = queue.pop();
     // p is the nearest pair left: every other is at least as far, and none holds a nearer triangle pair.
     if (Admitter::bound_of(p.key) >= nearest.distance) break;
     ++counters.nodes_visited;
@@ -129,7 +105,6 @@ DistanceResult query_distance_wide(const Bvh<typename Lanes::Volume>& a, const W
     if (leaf_a && leaf_b) {
       if (distance_detail::nearer_triangles(trees, child_a & ~Tree::kLeaf, child_b & ~Tree::kLeaf, nearest))
         break;  // touching: nothing is nearer
-      holding = false;
       continue;
     }
     // Split the larger of the two (a leaf cannot be split): its four children against the other's volume.
@@ -137,11 +112,11 @@ DistanceResult query_distance_wide(const Bvh<typename Lanes::Volume>& a, const W
     if (leaf_a || (!leaf_b && node_b.boxes.volume(int(p.b_lane)) > node_a.boxes.volume(int(p.a_lane)))) {
       const auto bounds =
           Lanes::distance_bounds_to_b(node_a.boxes, int(p.a_lane), wide_b.node(child_b).boxes, lanes);
-      holding = admitter.admit(queue, bounds, {0, p.a_node, child_b, p.a_lane, 0}, true, p);
+      admitter.admit(queue, bounds, {0, p.a_node, child_b, p.a_lane, 0}, true);
     } else {
       const auto bounds =
           Lanes::distance_bounds_to_a(wide_a.node(child_a).boxes, node_b.boxes, int(p.b_lane), lanes);
-      holding = admitter.admit(queue, bounds, {0, child_a, p.b_node, 0, p.b_lane}, false, p);
+      admitter.admit(queue, bounds, {0, child_a, p.b_node, 0, p.b_lane}, false);
     }
   }
   result.distance = nearest.distance;
