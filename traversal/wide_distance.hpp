@@ -98,25 +98,23 @@ DistanceResult query_distance_wide(const Bvh<typename Lanes::Volume>& a, const W
     // p is the nearest pair left: every other is at least as far, and none holds a nearer triangle pair.
     if (Admitter::bound_of(p.key) >= nearest.distance) break;
     ++counters.nodes_visited;
-    const typename Tree::Node& node_a = wide_a.node(p.a_node);
-    const typename Tree::Node& node_b = wide_b.node(p.b_node);
-    const std::uint32_t child_a = node_a.child[p.a_lane], child_b = node_b.child[p.b_lane];
-    const bool leaf_a = (child_a & Tree::kLeaf) != 0, leaf_b = (child_b & Tree::kLeaf) != 0;
-    if (leaf_a && leaf_b) {
-      if (distance_detail::nearer_triangles(trees, child_a & ~Tree::kLeaf, child_b & ~Tree::kLeaf, nearest))
+    const wide_detail::OpenedPair<Tree> q = wide_detail::open_pair(wide_a, wide_b, p);
+    if (q.leaf_a && q.leaf_b) {
+      if (distance_detail::nearer_triangles(trees, q.child_a & ~Tree::kLeaf, q.child_b & ~Tree::kLeaf,
+                                            nearest))
         break;  // touching: nothing is nearer
       continue;
     }
     // Split the larger of the two (a leaf cannot be split): its four children against the other's volume.
     counters.bv_tests += 4;
-    if (leaf_a || (!leaf_b && node_b.boxes.volume(int(p.b_lane)) > node_a.boxes.volume(int(p.a_lane)))) {
+    if (q.splits_b(p.a_lane, p.b_lane)) {
       const auto bounds =
-          Lanes::distance_bounds_to_b(node_a.boxes, int(p.a_lane), wide_b.node(child_b).boxes, lanes);
-      admitter.admit(queue, bounds, {0, p.a_node, child_b, p.a_lane, 0}, true);
+          Lanes::distance_bounds_to_b(q.node_a.boxes, int(p.a_lane), wide_b.node(q.child_b).boxes, lanes);
+      admitter.admit(queue, bounds, {0, p.a_node, q.child_b, p.a_lane, 0}, true);
     } else {
       const auto bounds =
-          Lanes::distance_bounds_to_a(wide_a.node(child_a).boxes, node_b.boxes, int(p.b_lane), lanes);
-      admitter.admit(queue, bounds, {0, child_a, p.b_node, 0, p.b_lane}, false);
+          Lanes::distance_bounds_to_a(wide_a.node(q.child_a).boxes, q.node_b.boxes, int(p.b_lane), lanes);
+      admitter.admit(queue, bounds, {0, q.child_a, p.b_node, 0, p.b_lane}, false);
     }
   }
   result.distance = nearest.distance;

@@ -104,6 +104,30 @@ void require_pair(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lanes>& wi
   check(b, wide_b, "B");
 }
 
+/// A pair taken from a walk's stack or queue, opened: the two nodes, the children their lanes hold, and
+/// which of those are leaves. Both wide walks (exact and distance) start each step so.
+template <class Tree>
+struct OpenedPair {
+  const typename Tree::Node& node_a;
+  const typename Tree::Node& node_b;
+  std::uint32_t child_a, child_b;
+  bool leaf_a, leaf_b;
+
+  /// Whether the step splits B's lane: the larger of the two volumes is split, and a leaf cannot be.
+  [[nodiscard]] bool splits_b(std::uint32_t a_lane, std::uint32_t b_lane) const {
+    return leaf_a || (!leaf_b && node_b.boxes.volume(int(b_lane)) > node_a.boxes.volume(int(a_lane)));
+  }
+};
+
+template <class Tree, class Pair>
+[[gnu::always_inline]] inline OpenedPair<Tree> open_pair(const Tree& wide_a, const Tree& wide_b,
+                                                         const Pair& p) {
+  const typename Tree::Node& node_a = wide_a.node(p.a_node);
+  const typename Tree::Node& node_b = wide_b.node(p.b_node);
+  const std::uint32_t child_a = node_a.child[p.a_lane], child_b = node_b.child[p.b_lane];
+  return {node_a, node_b, child_a, child_b, (child_a & Tree::kLeaf) != 0, (child_b & Tree::kLeaf) != 0};
+}
+
 }  // namespace wide_detail
 
 /// Exact query on the wide trees of two binary trees (same contract as query_exact; throws
@@ -159,11 +183,8 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
     const wide_detail::WidePair p = stack.back();
     stack.pop_back();
     ++counters.nodes_visited;
-    const typename Tree::Node& node_a = wide_a.node(p.a_node);
-    const typename Tree::Node& node_b = wide_b.node(p.b_node);
-    const std::uint32_t child_a = node_a.child[p.a_lane], child_b = node_b.child[p.b_lane];
-    const bool leaf_a = (child_a & Tree::kLeaf) != 0, leaf_b = (child_b & Tree::kLeaf) != 0;
-    if (leaf_a && leaf_b) {
+    const wide_detail::OpenedPair<Tree> q = wide_detail::open_pair(wide_a, wide_b, p);
+    if (q.leaf_a && q.leaf_b) {
       const auto on_hit = [&](const TrianglePair& hit) {
         result.collides = true;
         result.probability = 1;
@@ -174,34 +195,35 @@ Result query_exact_wide(const Bvh<typename Lanes::Volume>& a, const WideBvh<Lane
       };
       bool done = false;
       if constexpr (batches_leaf_pairs)
-        done = test_leaf_pairs(trees, wide_a, wide_b, child_a, child_b, stack, on_hit);
+        done = test_leaf_pairs(trees, wide_a, wide_b, q.child_a, q.child_b, stack, on_hit);
       else
-        done = trees.intersecting_triangles(child_a & ~Tree::kLeaf, child_b & ~Tree::kLeaf, on_hit);
+        done = trees.intersecting_triangles(q.child_a & ~Tree::kLeaf, q.child_b & ~Tree::kLeaf, on_hit);
       if (done) return result;
       continue;
     }
     // Split the larger of the two (a leaf cannot be split): its four children against the other's volume.
     counters.bv_tests += 4;
-    if (leaf_a || (!leaf_b && node_b.boxes.volume(int(p.b_lane)) > node_a.boxes.volume(int(p.a_lane)))) {
-      const typename Lanes::Placed children = Lanes::place(wide_b.node(child_b).boxes, lanes);
-      const auto a_volume = Lanes::broadcast(node_a.boxes, int(p.a_lane));  // unpacked, where a layout packs
+    if (q.splits_b(p.a_lane, p.b_lane)) {
+      const typename Lanes::Placed children = Lanes::place(wide_b.node(q.child_b).boxes, lanes);
+      // A's volume unpacked, where a layout packs its lanes.
+      const auto a_volume = Lanes::broadcast(q.node_a.boxes, int(p.a_lane));
       const unsigned hits = Lanes::overlap_placed(a_volume, children, lanes);
       const auto block = static_cast<std::uint32_t>(placed.size());
       if constexpr (keep) placed.push_back(children);
       wide_detail::push_hits<Lanes>(stack, hits, nearest_first, a_volume, children,
-                                    {p.a_node, p.a_lane, child_b, 0, block}, true);
+                                    {p.a_node, p.a_lane, q.child_b, 0, block}, true);
     } else {
       const auto placed_b = [&] {
         if constexpr (keep)
           return Lanes::broadcast_placed(placed[p.placed], int(p.b_lane));
         else
-          return Lanes::place(Lanes::broadcast(node_b.boxes, int(p.b_lane)), lanes);
+          return Lanes::place(Lanes::broadcast(q.node_b.boxes, int(p.b_lane)), lanes);
       };
       const typename Lanes::Placed b_volume = placed_b();
-      const auto& a_children = wide_detail::tested_lanes(wide_a.node(child_a).boxes);
+      const auto& a_children = wide_detail::tested_lanes(wide_a.node(q.child_a).boxes);
       const unsigned hits = Lanes::overlap_placed(a_children, b_volume, lanes);
       wide_detail::push_hits<Lanes>(stack, hits, nearest_first, a_children, b_volume,
-                                    {child_a, 0, p.b_node, p.b_lane, p.placed}, false);
+                                    {q.child_a, 0, p.b_node, p.b_lane, p.placed}, false);
     }
   }
   return result;
