@@ -22,6 +22,7 @@
 // poses keep jumping, the query is the cold one and stores no front.
 #pragma once
 
+#include "coherent_binding.hpp"
 #include "coherent_state.hpp"
 #include "exact.hpp"
 
@@ -37,23 +38,6 @@ namespace coherent_detail {
 
 inline constexpr std::uint32_t kCold = ~std::uint32_t{0};
 using LeafPair = std::pair<std::uint32_t, std::uint32_t>;
-
-/// What a state is bound to of `tree`: its address, identity and node count.
-template <TreeVolume BV>
-CoherentState::TreeKey key_of(const Bvh<BV>& tree) {
-  return {&tree, tree.identity(), tree.nodes().size()};
-}
-
-/// Binds a new state to its trees (and B's root box: what a pose jump is measured against, in B's frame);
-/// throws std::invalid_argument for a state bound to other trees.
-template <TreeVolume BV>
-void attach(CoherentState& state, const Bvh<BV>& a, const Bvh<BV>& b) {
-  if (!state.bound() && !b.empty()) {
-    const Box box = b.root_volume().bounding_box();
-    state.bind(key_of(a), key_of(b), box.center(), box.extent().norm() / 2);
-  }
-  state.check_trees(key_of(a), key_of(b));
-}
 
 /// One walk over the stored traversal tree (`stored`, possibly empty: from the root), writing the new one
 /// into `next`. Iterative: a stack of items, each a pair to visit or an inner pair to try to raise.

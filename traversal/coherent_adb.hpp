@@ -4,7 +4,7 @@
 #pragma once
 
 #include "adb.hpp"
-#include "coherent.hpp"
+#include "coherent_binding.hpp"
 #include "coherent_state.hpp"
 
 namespace bvhlab {

@@ -4,6 +4,7 @@
 #include "adb/adb_density.hpp"
 #include "coherent_paths.hpp"
 #include "support/errors.hpp"
+#include "traversal/coherent.hpp"
 #include "traversal/coherent_adb.hpp"
 #include "volumes/aabb.hpp"
 #include "volumes/obb.hpp"
