@@ -29,6 +29,7 @@ StrategyInfo strategy_row() {
   info.needs_density = !S::template accepts<NoDensity>;
   info.coherent = kRunsCoherent<S>;
   info.wide = kRunsWide<S>;
+  info.density_free = kDensityFree<S>;
   static_assert(!kRunsWide<S> || kDensityFree<S>,
                 "a wide strategy is compiled once per volume: density_free");
   with_each_density([&]<class D>(std::type_identity<D>) {

@@ -25,10 +25,11 @@ struct StrategyInfo {
   std::string name, description;
   bool exact = false;  ///< answers agree with the exact ground truth
   BudgetUse budget = BudgetUse::None;
-  bool needs_polygons = false;            ///< cannot run on trees saved without polygons
-  bool needs_density = false;             ///< does not run on trees without a density
-  bool coherent = false;                  ///< runs coherent over a sequence of poses (traversal/coherent.hpp)
-  bool wide = false;                      ///< runs on the trees' wide layout (traversal/wide_*.hpp)
+  bool needs_polygons = false;  ///< cannot run on trees saved without polygons
+  bool needs_density = false;   ///< does not run on trees without a density
+  bool coherent = false;        ///< runs coherent over a sequence of poses (traversal/coherent.hpp)
+  bool wide = false;            ///< runs on the trees' wide layout (traversal/wide_*.hpp)
+  bool density_free = false;    ///< reads the hierarchies alone: one compiled query per volume (kDensityFree)
   std::vector<std::string> densities;     ///< the registered densities it runs on
   std::vector<std::string> volumes;       ///< the registered volumes it runs on
   std::vector<std::string> wide_volumes;  ///< those its wide walk runs on (empty: no wide walk)

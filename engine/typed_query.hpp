@@ -32,20 +32,16 @@ inline constexpr bool takes_leaf_test_on = requires(const TreeT& tree, const Rig
                                                     const SurfaceLeaves<BV>& leaves) {
   S::query(tree, tree, pose, options, leaves);
 };
-/// Strategy S runs on point clouds of BV and D.
-template <class S, class BV, class D>
-inline constexpr bool takes_leaf_test = takes_leaf_test_on<S, BV, Tree<BV, D>>;
-
-/// Why strategy S, configured with `options`, cannot query point clouds on trees of BV and D; empty when it
-/// can: it takes a leaf test (takes_leaf_test) and answers something other than triangle pairs
+/// Why strategy S, configured with `options`, cannot query point clouds on trees of BV read as TreeT; empty
+/// when it can: it takes a leaf test (takes_leaf_test_on) and answers something other than triangle pairs
 /// (all_contacts).
-template <class S, TreeVolume BV, class D>
+template <class S, TreeVolume BV, class TreeT>
 std::string cloud_query_refusal(const typename S::Options& options, std::string_view name) {
   if constexpr (std::is_same_v<typename S::Options, ContactMode>)
     if (options == ContactMode::All)
       return "strategy " + std::string(name) +
              " lists intersecting triangle pairs, and a point cloud has none";
-  if constexpr (!takes_leaf_test<S, BV, D>)
+  if constexpr (!takes_leaf_test_on<S, BV, TreeT>)
     return "strategy " + std::string(name) + " takes no leaf test, so it cannot query point clouds";
   return {};
 }
@@ -178,19 +174,22 @@ class TypedQuery final : public PreparedQuery {
 
 /// The prepared query of strategy S (configured as `options`) on `trees`, with the surface test when a side
 /// is a cloud (compiled only with kClouds: trees whose density a cloud's tree can carry). The caller checked
-/// the variant against the trees.
+/// the rest of the variant against the trees (TreeQueries::check_variant); a strategy that cannot query
+/// clouds is refused here, where its options are known.
 template <class S, class BV, bool kClouds, class Held>
 std::unique_ptr<PreparedQuery> make_query(QueryTrees<Held> trees, typename S::Options options,
                                           const StrategyVariant& variant) {
   if (!trees.side_a.is_cloud() && !trees.side_b.is_cloud())
     return std::make_unique<TypedQuery<S, BV, Held, false>>(std::move(trees), std::move(options),
                                                             variant.coherent, variant.contact_geometry);
+  if (const std::string refusal = cloud_query_refusal<S, BV, HeldTree<Held>>(options, variant.strategy);
+      !refusal.empty())
+    throw std::invalid_argument(refusal);
   if constexpr (kClouds && takes_leaf_test_on<S, BV, HeldTree<Held>>)
     return std::make_unique<TypedQuery<S, BV, Held, true>>(std::move(trees), std::move(options),
                                                            variant.coherent);
   else
-    throw std::logic_error("cloud_query_refusal let strategy " + variant.strategy +
-                           " through without a leaf test");
+    throw std::logic_error("check_variant let a point cloud's tree through to strategy " + variant.strategy);
 }
 
 /// The queries of the density-free strategies on volume slot V, for trees of any density: compiled in the
@@ -208,8 +207,8 @@ struct DensityFreeQueries<V, false> {};  ///< a slot beyond the registered volum
 template <std::size_t V, bool kRegistered>
 std::unique_ptr<PreparedQuery> DensityFreeQueries<V, kRegistered>::prepare(
     QueryTrees<HierarchyOnly<BV>> trees, const StrategyVariant& variant) {
-  // The strategy is looked up by name again and its options made again (the caller checked them): a member
-  // template per strategy would not be covered by the class's extern declaration.
+  // The strategy is looked up by name again (the caller checked the variant against the trees, all but the
+  // options): a member template per strategy would not be covered by the class's extern declaration.
   return with_strategy(
       variant.strategy, [&]<class S>(std::type_identity<S>) -> std::unique_ptr<PreparedQuery> {
         if constexpr (kDensityFree<S> && kAcceptsVolume<S, BV>)
@@ -225,7 +224,8 @@ template <class BV, class D>
 struct TreeQueries {
   using Base = TypedBase<BV, D>;
 
-  /// Strategy `variant.strategy` on `self` and `b`, checked against both; QueryOps::prepare.
+  /// Strategy `variant.strategy` on `self` and `b`, checked against both; QueryOps::prepare. The checks and
+  /// the density-free strategies' queries are compiled once per volume and density, not once per strategy.
   static std::unique_ptr<PreparedQuery> prepare(ModelPtr self, ModelPtr b, const StrategyVariant& variant) {
     auto other = std::dynamic_pointer_cast<const Base>(b);
     if (!other)
@@ -233,14 +233,16 @@ struct TreeQueries {
                                   self->info.annotation + " vs " + b->info.bv + ", " + b->info.annotation +
                                   ")");
     auto a = std::static_pointer_cast<const Base>(std::move(self));
+    const StrategyInfo& info = strategy_info(variant.strategy);
+    check_variant(info, *a, *other, variant);
+    if (info.density_free) return prepare_density_free(std::move(a), std::move(other), variant);
     std::unique_ptr<PreparedQuery> out;
     with_strategy(variant.strategy, [&]<class S>(std::type_identity<S>) {
-      if constexpr (!kAcceptsVolume<S, BV>)
-        throw std::invalid_argument(strategy_info(variant.strategy).volume_refusal(BV::name()));
-      else if constexpr (S::template accepts<D>)
+      if constexpr (!kDensityFree<S> && kAcceptsVolume<S, BV> && S::template accepts<D>)
         out = prepare_typed<S>(std::move(a), std::move(other), variant);
       else
-        throw std::invalid_argument(strategy_info(variant.strategy).refusal(D::name()));
+        throw std::logic_error("check_variant let strategy " + variant.strategy + " through on " +
+                               std::string(BV::name()) + ", " + std::string(D::name()));
     });
     return out;
   }
@@ -267,62 +269,40 @@ struct TreeQueries {
   }
 
  private:
-  /// S configured, checked against both trees, with the surface test when either is a cloud's.
-  template <class S>
-  static std::unique_ptr<PreparedQuery> prepare_typed(std::shared_ptr<const Base> a,
-                                                      std::shared_ptr<const Base> b,
-                                                      const StrategyVariant& variant) {
+  /// Every check of `variant` on trees `a` and `b` that the strategy's row (`info`) answers, in this order:
+  /// the volume, the density and its parameters, coherent, contact geometry, wide, the point clouds' sides
+  /// or the polygons. The strategy's options and, on clouds, its leaf test follow (make_query).
+  static void check_variant(const StrategyInfo& info, const Base& a, const Base& b,
+                            const StrategyVariant& variant) {
+    const auto refuse_if = [](const std::string& refusal) {
+      if (!refusal.empty()) throw std::invalid_argument(refusal);
+    };
+    refuse_if(info.volume_refusal(BV::name()));
+    refuse_if(info.refusal(D::name()));
     if constexpr (ProbabilityDensity<D>)  // refuses trees annotated with other parameters, before any pose
-      (void)D::estimator(a->tree.density, b->tree.density);
-    auto options = strategy_options<S>(variant.values, variant.budget);
-    if (variant.coherent && !kRunsCoherent<S>)
-      throw std::invalid_argument(strategy_info(variant.strategy).coherent_refusal());
-    if (variant.contact_geometry && !S::needs_polygons)
-      throw std::invalid_argument(strategy_info(variant.strategy).contact_geometry_refusal());
-    if (variant.wide) check_wide<S>(variant, a->side().is_cloud() || b->side().is_cloud());
-    if (a->side().is_cloud() || b->side().is_cloud()) {
+      (void)D::estimator(a.tree.density, b.tree.density);
+    if (variant.coherent) refuse_if(info.coherent_refusal());
+    if (variant.contact_geometry) refuse_if(info.contact_geometry_refusal());
+    const bool cloud = a.side().is_cloud() || b.side().is_cloud();
+    if (variant.wide) check_wide(info, variant, cloud);
+    if (cloud) {
       if (variant.contact_geometry)
         throw std::invalid_argument("contact geometry needs triangles; a point cloud's tree has none");
-      if constexpr (kCloudDensity<D>)
-        check_points<S>(*a, *b, options, variant);
-      else
-        throw std::logic_error("a tree over points with density " + a->info.density);
-    } else if (S::needs_polygons && !(a->info.polygons && b->info.polygons)) {
+      if constexpr (!kCloudDensity<D>)
+        throw std::logic_error("a tree over points with density " + a.info.density);
+      (void)SurfaceLeaves<BV>(a.tree.bvh, a.side(), b.tree.bvh, b.side(), RigidTransform{});
+    } else if (info.needs_polygons && !(a.info.polygons && b.info.polygons)) {
       throw std::invalid_argument(
           "strategy " + variant.strategy +
-          " tests triangles, and a tree was loaded without polygons (load it with its "
-          "mesh)");
-    }
-    const SurfaceSide side_a = a->side(), side_b = b->side();
-    const Base& a_tree = *a;
-    const Base& b_tree = *b;
-    const Bvh<BV>& bvh_a = a->tree.bvh;
-    const Bvh<BV>& bvh_b = b->tree.bvh;
-    if constexpr (kDensityFree<S>) {
-      QueryTrees<HierarchyOnly<BV>> trees{std::move(a), std::move(b), {bvh_a}, {bvh_b}, side_a, side_b};
-      if constexpr (HasWideLayout<BV>)
-        if (variant.wide) {
-          trees.a.wide = &a_tree.wide_layout();
-          trees.b.wide = &b_tree.wide_layout();
-        }
-      return DensityFreeQueries<type_index<BV>(RegisteredVolumes{})>::prepare(std::move(trees), variant);
-    } else {
-      const Tree<BV, D>& tree_a = a->tree;
-      const Tree<BV, D>& tree_b = b->tree;
-      QueryTrees<std::reference_wrapper<const Tree<BV, D>>> trees{
-          std::move(a), std::move(b), std::cref(tree_a), std::cref(tree_b), side_a, side_b};
-      return make_query<S, BV, kCloudDensity<D>>(std::move(trees), std::move(options), variant);
+          " tests triangles, and a tree was loaded without polygons (load it with its mesh)");
     }
   }
 
   /// The refusals of a wide variant: a strategy without a wide walk, a volume without a wide layout or one
-  /// the strategy's wide walk does not take, point leaves, a coherent walk.
-  template <class S>
-  static void check_wide(const StrategyVariant& variant, bool cloud) {
-    if (!kRunsWide<S>) throw std::invalid_argument(strategy_info(variant.strategy).wide_refusal());
-    if (!HasWideLayout<BV>) throw std::invalid_argument(wide_layout_refusal(BV::name()));
-    if constexpr (!kWalksWideOn<S, BV>)
-      throw std::invalid_argument(strategy_info(variant.strategy).wide_walk_refusal(BV::name()));
+  /// the strategy's wide walk does not take, a coherent walk, point leaves.
+  static void check_wide(const StrategyInfo& info, const StrategyVariant& variant, bool cloud) {
+    if (std::string refusal = info.wide_walk_refusal(BV::name()); !refusal.empty())
+      throw std::invalid_argument(refusal);
     if (variant.coherent)
       throw std::invalid_argument(
           "a coherent query walks the binary trees; ask for coherent or wide, not both");
@@ -331,14 +311,37 @@ struct TreeQueries {
           "a wide query tests triangles at the leaves; a point cloud's tree has none");
   }
 
-  /// SurfaceLeaves' checks of the two sides and the strategy's (so running cannot fail).
+  /// A density-free strategy (checked): its query reads the hierarchies (and the wide layouts when asked),
+  /// compiled once for the volume (DensityFreeQueries).
+  static std::unique_ptr<PreparedQuery> prepare_density_free(std::shared_ptr<const Base> a,
+                                                             std::shared_ptr<const Base> b,
+                                                             const StrategyVariant& variant) {
+    const Bvh<BV>& bvh_a = a->tree.bvh;
+    const Bvh<BV>& bvh_b = b->tree.bvh;
+    const SurfaceSide side_a = a->side(), side_b = b->side();
+    const Base& a_tree = *a;
+    const Base& b_tree = *b;
+    QueryTrees<HierarchyOnly<BV>> trees{std::move(a), std::move(b), {bvh_a}, {bvh_b}, side_a, side_b};
+    if constexpr (HasWideLayout<BV>)
+      if (variant.wide) {
+        trees.a.wide = &a_tree.wide_layout();
+        trees.b.wide = &b_tree.wide_layout();
+      }
+    return DensityFreeQueries<type_index<BV>(RegisteredVolumes{})>::prepare(std::move(trees), variant);
+  }
+
+  /// Strategy S, which reads the density (checked), configured.
   template <class S>
-  static void check_points(const Base& a, const Base& b, const typename S::Options& options,
-                           const StrategyVariant& variant) {
-    (void)SurfaceLeaves<BV>(a.tree.bvh, a.side(), b.tree.bvh, b.side(), RigidTransform{});
-    if (const std::string refusal = cloud_query_refusal<S, BV, D>(options, variant.strategy);
-        !refusal.empty())
-      throw std::invalid_argument(refusal);
+  static std::unique_ptr<PreparedQuery> prepare_typed(std::shared_ptr<const Base> a,
+                                                      std::shared_ptr<const Base> b,
+                                                      const StrategyVariant& variant) {
+    auto options = strategy_options<S>(variant.values, variant.budget);
+    const SurfaceSide side_a = a->side(), side_b = b->side();
+    const Tree<BV, D>& tree_a = a->tree;
+    const Tree<BV, D>& tree_b = b->tree;
+    QueryTrees<std::reference_wrapper<const Tree<BV, D>>> trees{
+        std::move(a), std::move(b), std::cref(tree_a), std::cref(tree_b), side_a, side_b};
+    return make_query<S, BV, kCloudDensity<D>>(std::move(trees), std::move(options), variant);
   }
 };
 
