@@ -70,7 +70,9 @@ namespace detail {
 /// is only the most probable of the latest children. Read once, on an exhausted budget.
 template <class Queue>
 double highest_queued(const Queue& queue) {
-  if constexpr (requires { queue.items(); }) {
+  if constexpr (requires { queue.highest_key(); }) {  // a queue that knows (the frame's run-time order)
+    return queue.highest_key();
+  } else if constexpr (requires { queue.items(); }) {
     double best = 0;
     for (const auto& pair : queue.items()) best = std::max(best, pair.key);
     return best;

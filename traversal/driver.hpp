@@ -79,7 +79,7 @@
 // DepthFirst, SplitLarger, Unlimited; ADB (traversal/adb.hpp) is AdbHooks with BestFirst, SplitBoth,
 // BudgetLimit. A probability-ordered depth-first descent is AdbHooks with OrderedDepthFirst
 // (tests/traversal/test_driver.cpp runs it); a frame-budget schedule (traversal/frame_budget.hpp) is
-// AdbHooks with BestFirst and SplitBoth, stepped.
+// AdbHooks with SplitBoth, stepped, its queue best first or ordered depth first as the frame asks.
 //
 // The hot path's members are [[gnu::always_inline]]: the loop must compile to one function whatever the
 // including unit's inlining budget (large units otherwise leave pieces of it out of line). The volumes' own

@@ -62,24 +62,56 @@ double levels_below(const Bvh<BV>& tree, std::uint32_t node) {
   return std::max(0.0, std::log2(std::max(triangles, 1.0)) + (2.0 / 3.0) * std::log2(own / root));
 }
 
+/// The queue policy of a pair's traversal in the frame's order (FrameOptions::order), chosen at run time: a
+/// best-first queue or an ordered depth-first stack behind one type, so that a volume and density compile
+/// one pair run and one scheduling loop instead of one per order (half the frame budget's compile time).
+/// The price is a branch per push and pop that goes the same way all frame.
+struct FrameOrderQueue {
+  template <class Pair>
+  class Queue {
+   public:
+    void order_by(FrameOrder order) { depth_first_ = order == FrameOrder::depth_first; }
+    [[nodiscard]] bool empty() const { return depth_first_ ? stack_.empty() : heap_.empty(); }
+    [[nodiscard]] const Pair& top() const { return depth_first_ ? stack_.top() : heap_.top(); }
+    [[gnu::always_inline]] void push(const Pair& p) {
+      if (depth_first_)
+        stack_.push(p);
+      else
+        heap_.push(p);
+    }
+    [[gnu::always_inline]] Pair pop() { return depth_first_ ? stack_.pop() : heap_.pop(); }
+    /// The highest key queued (0 when none): AdbHooks' best-effort answer (detail::highest_queued).
+    [[nodiscard]] double highest_key() const {
+      return depth_first_ ? detail::highest_queued(stack_) : detail::highest_queued(heap_);
+    }
+
+   private:
+    BestFirst::Queue<Pair> heap_;
+    OrderedDepthFirst::Queue<Pair> stack_;
+    bool depth_first_ = false;
+  };
+};
+
 /// One candidate pair's ADB traversal, resumable: the state query_adb keeps on its stack, kept between
-/// steps, in the order of `Queue` (BestFirst or OrderedDepthFirst). Not movable (the traversal's parts refer
-/// to each other): built in place in a std::optional.
-template <TreeVolume BV, ProbabilityDensity D, class Queue>
+/// steps, in the frame's order (FrameOrderQueue). Not movable (the traversal's parts refer to each other):
+/// built in place in a std::optional.
+template <TreeVolume BV, ProbabilityDensity D>
 class PairRun {
  public:
   using Estimate = NodeEstimate<decltype(density_estimator(std::declval<const Tree<BV, D>&>(),
                                                            std::declval<const Tree<BV, D>&>(),
                                                            std::declval<const RigidTransform&>()))>;
   using Hooks = AdbHooks<BV, Estimate, TriangleLeaves, estimates_in_node_frames<D, BV>>;
-  using Steps = Traversal<Queue, SplitBoth, BV, Hooks, TestCap>;
+  using Steps = Traversal<FrameOrderQueue, SplitBoth, BV, Hooks, TestCap>;
 
-  PairRun(const FramePair<BV, D>& pair, const AdbOptions& options)
+  PairRun(const FramePair<BV, D>& pair, const AdbOptions& options, FrameOrder order)
       : context_(VolumeWalker<BV>::make_context(pair.b_to_a)),
         trees_(pair.a->bvh, pair.b->bvh, pair.b_to_a, context_, result_.counters),
         estimate_{density_estimator(*pair.a, *pair.b, pair.b_to_a)},
         hooks_(trees_, result_, options, estimate_),
-        state_(pair.a->bvh.empty() || pair.b->bvh.empty() ? TraversalState::Done : TraversalState::Stopped) {}
+        state_(pair.a->bvh.empty() || pair.b->bvh.empty() ? TraversalState::Done : TraversalState::Stopped) {
+    queue_.order_by(order);
+  }
   PairRun(const PairRun&) = delete;
   PairRun& operator=(const PairRun&) = delete;
 
@@ -228,12 +260,11 @@ const FrameMemory::Entry* recalled(const FrameMemory* memory, const FramePair<BV
   return memory && pair.identity ? memory->recall(*pair.identity, pair.a, pair.b) : nullptr;
 }
 
-/// schedule_frame with each pair's traversal in the order of `Queue`; `clock` runs from the call.
-template <class Queue, TreeVolume BV, ProbabilityDensity D>
-std::vector<PairOutcome> schedule_in_order(std::span<const FramePair<BV, D>> pairs,
-                                           const FrameOptions& options, FrameMemory* memory,
-                                           BudgetLimit& clock) {
-  using Run = PairRun<BV, D, Queue>;
+/// schedule_frame; `clock` runs from the call.
+template <TreeVolume BV, ProbabilityDensity D>
+std::vector<PairOutcome> schedule_pairs(std::span<const FramePair<BV, D>> pairs, const FrameOptions& options,
+                                        FrameMemory* memory, BudgetLimit& clock) {
+  using Run = PairRun<BV, D>;
   const FramePolicy& policy = frame_policy(options.policy);
   const AdbOptions adb = options.pair_options();
   for (std::size_t k = 0; k < pairs.size(); ++k) validate_pair(pairs[k], k, adb);
@@ -250,7 +281,7 @@ std::vector<PairOutcome> schedule_in_order(std::span<const FramePair<BV, D>> pai
   };
   // Runs pair k's root or next step; true when the frame's budget of BV tests has run out.
   const auto advance = [&](std::size_t k, bool root) {
-    Run& run = root ? runs[k].emplace(pairs[k], adb) : *runs[k];
+    Run& run = root ? runs[k].emplace(pairs[k], adb, options.order) : *runs[k];
     const std::uint64_t before = run.bv_tests();
     const TraversalState progress = root ? run.begin(tests.allowance(k, before), recalled(memory, pairs[k]))
                                          : run.step(tests.allowance(k, before));
@@ -316,9 +347,7 @@ std::vector<PairOutcome> schedule_frame(std::span<const FramePair<BV, D>> pairs,
                                         FrameMemory* memory) {
   BudgetLimit clock(Budget{0, options.budget.deadline_us});  // the deadline counts from here
   options.validate();
-  if (options.order == FrameOrder::depth_first)
-    return frame_detail::schedule_in_order<OrderedDepthFirst>(pairs, options, memory, clock);
-  return frame_detail::schedule_in_order<BestFirst>(pairs, options, memory, clock);
+  return frame_detail::schedule_pairs(pairs, options, memory, clock);
 }
 
 }  // namespace bvhlab
