@@ -1,16 +1,16 @@
 // The points runner (bench/points/points.hpp): clouds from each pair's meshes, the mesh truth with its
-// ambiguous band, and every series timed over the same poses.
+// ambiguous band, and every series timed over the same poses. Every query runs through the run-time layer
+// (engine/any_tree.hpp), which compiles each strategy once for the CLI, Python and every runner.
 #include "bench/points/points.hpp"
 
-#include "adb/point_density.hpp"
 #include "bench/core/ground_truth.hpp"
 #include "bench/pairs/measure.hpp"
 #include "bench/pairs/prepare.hpp"
 #include "bench/report_tables.hpp"
-#include "bvh/point_surface.hpp"
+#include "bvh/point_cloud.hpp"
+#include "engine/any_tree.hpp"
 #include "engine/protocol.hpp"
-#include "traversal/point_leaves.hpp"
-#include "volumes/aabb.hpp"
+#include "engine/specs.hpp"
 
 #ifdef BVHLAB_HAVE_FCL
 #include "bench/core/fcl_octree.hpp"
@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <span>
 
 namespace bvhlab {
 
@@ -32,52 +33,63 @@ struct TruthPose {
   bool truth = false, ambiguous = false;
 };
 
-/// The poses of every distance in order, and each one's truth; ambiguous where B moved by `shift` along an
-/// axis, either way, changes the answer.
-std::vector<TruthPose> mesh_truth(const Bvh<Aabb>& a, const Bvh<Aabb>& b,
-                                  const std::vector<RigidTransform>& poses,
+bool collides(const PreparedQuery& query, const RigidTransform& pose) {
+  bool answer = false;
+  query.run(std::span(&pose, 1), [&](std::size_t, const Result& r) { answer = r.collides; });
+  return answer;
+}
+
+/// The poses of every distance in order, and each one's truth from the meshes' exact query; ambiguous where
+/// B moved by `shift` along an axis, either way, changes the answer.
+std::vector<TruthPose> mesh_truth(const PreparedQuery& exact, const std::vector<RigidTransform>& poses,
                                   const std::vector<std::size_t>& groups, double shift) {
   std::vector<TruthPose> out;
   for (std::size_t k = 0; k < poses.size(); ++k) {
-    TruthPose t{groups[k], query_exact(a, b, poses[k]).collides, false};
+    TruthPose t{groups[k], collides(exact, poses[k]), false};
     for (int axis = 0; axis < 3 && !t.ambiguous; ++axis)
       for (double sign : {-1.0, 1.0}) {
         RigidTransform moved = poses[k];
         moved.translation[axis] += sign * shift;
-        t.ambiguous = t.ambiguous || query_exact(a, b, moved).collides != t.truth;
+        t.ambiguous = t.ambiguous || collides(exact, moved) != t.truth;
       }
     out.push_back(t);
   }
   return out;
 }
 
-/// A cloud sampled from a mesh, its surface, and its ADB tree with the coverings: one side of a point query.
-/// Held by pointer: the side refers to the surface and the coverings.
+/// A cloud sampled from a mesh and its AABB tree with ADB counts from the points' areas: one side of a
+/// point query. The tree holds the cloud's surface and sphere coverings.
 struct Cloud {
-  PointCloud points;
-  std::unique_ptr<PointSurface> surface;
-  Tree<Aabb, AdbDensity> tree;
-  std::vector<SphereCovering> coverings;
+  PointCloud points;  ///< FCL's octrees are built from them
+  AnyTree tree;
   double spacing = 0;
-
-  [[nodiscard]] SurfaceSide side() const { return cloud_side(*surface, coverings); }
 };
 
-std::unique_ptr<Cloud> make_cloud(const Mesh& mesh, std::size_t n, const PointsSpec& spec) {
-  auto cloud = std::make_unique<Cloud>();
-  if (spec.varying) {
-    cloud->points = sample_varying(mesh, n, spec.seed, spec.ratio);
-    assign_knn_areas(cloud->points, 10);
-  } else {
-    cloud->points = sample_uniform(mesh, n, spec.seed);
-  }
-  cloud->surface = std::make_unique<PointSurface>(cloud->points);
+/// The cloud's tree with `density` ("none" or "adb" at the scene's grid).
+AnyTree cloud_tree(const PointCloud& points, const MeshUnits& units, const std::string& density,
+                   const PointsSpec& spec) {
+  UnitCloud cloud;
+  static_cast<PointCloud&>(cloud) = points;
+  cloud.units = units;
   BuildOptions options;
   options.max_leaf_points = spec.leaf;
-  cloud->tree = annotate_adb_points(Bvh<Aabb>::build(cloud->points, options), cloud->points, spec.grid);
-  cloud->coverings = sphere_coverings(cloud->tree.bvh, *cloud->surface);
-  cloud->spacing = std::sqrt(surface_area(mesh) / static_cast<double>(n));
-  return cloud;
+  const ParamValues grid{{"grid", spec.grid}};
+  return AnyTree::build_points(cloud, "aabb", density_spec(density, density == "adb" ? grid : ParamValues{}),
+                               options);
+}
+
+std::unique_ptr<Cloud> make_cloud(const Mesh& mesh, const MeshUnits& units, std::size_t n,
+                                  const PointsSpec& spec) {
+  PointCloud points;
+  if (spec.varying) {
+    points = sample_varying(mesh, n, spec.seed, spec.ratio);
+    assign_knn_areas(points, 10);
+  } else {
+    points = sample_uniform(mesh, n, spec.seed);
+  }
+  AnyTree tree = cloud_tree(points, units, "adb", spec);
+  const double spacing = std::sqrt(surface_area(mesh) / static_cast<double>(n));
+  return std::make_unique<Cloud>(Cloud{std::move(points), std::move(tree), spacing});
 }
 
 /// The rows of one series: per distance, then the total; errors on the clear poses only.
@@ -125,11 +137,19 @@ class RowMaker {
   double overhead_;
 };
 
-/// Times one series over every pose after a warm pass over all of them.
+/// Times one series over every pose after a warm pass over all of them (FCL's octrees).
 template <class Query>
 std::vector<QueryRecord> timed(const std::vector<RigidTransform>& poses, Query&& query) {
   std::vector<QueryRecord> records;
   timed_series(poses, static_cast<int>(poses.size()), records, query);
+  return records;
+}
+
+/// Times `variant` with `a` fixed and `b` moved over every pose, after a warm pass over all of them.
+std::vector<QueryRecord> timed(const std::vector<RigidTransform>& poses, const AnyTree& a, const AnyTree& b,
+                               const StrategyVariant& variant) {
+  std::vector<QueryRecord> records;
+  a.prepare(b, variant)->time(poses, static_cast<int>(poses.size()), records);
   return records;
 }
 
@@ -174,76 +194,71 @@ void cross_check(const Mesh& a, const Mesh& b, const std::vector<RigidTransform>
   }
 }
 
-/// Every series of one pair at one density.
-void run_density(const Mesh& mesh_a, const Mesh& mesh_b, const Bvh<Aabb>& tree_a, const Bvh<Aabb>& tree_b,
-                 bool same, std::size_t n, const PointsSpec& spec, PointsCloudInfo info, PointsOutput& out,
-                 bool quiet) {
-  const std::unique_ptr<Cloud> a = make_cloud(mesh_a, n, spec);
-  const std::unique_ptr<Cloud> b = same ? nullptr : make_cloud(mesh_b, n, spec);
-  const Cloud& cb = same ? *a : *b;
-  info.points = n;
-  info.spacing = std::max(a->spacing, cb.spacing);
-  info.band = spec.band * info.spacing;
+/// The poses of every distance in order, and the index of each one's distance.
+std::vector<RigidTransform> points_poses(const PointsSpec& spec, std::vector<std::size_t>& groups) {
   std::vector<RigidTransform> poses;
-  std::vector<std::size_t> groups;
   for (std::size_t g = 0; g < spec.distances.size(); ++g)
     for (const RigidTransform& pose : protocol_poses(spec.distances[g], spec.steps)) {
       poses.push_back(pose);
       groups.push_back(g);
     }
-  const std::vector<TruthPose> truth = mesh_truth(tree_a, tree_b, poses, groups, info.band);
-  cross_check(mesh_a, mesh_b, poses, truth, spec.cgal_sample, out);
+  return poses;
+}
+
+/// One object of a pair: its mesh, the mesh's plain AABB tree and its units.
+struct MeshSide {
+  const Mesh& mesh;
+  const AnyTree& tree;
+  MeshUnits units;
+};
+
+/// The ADB and time-critical series on the clouds.
+void add_adb_series(const Cloud& a, const Cloud& b, const PointsSpec& spec,
+                    const std::vector<RigidTransform>& poses, const RowMaker& rows, PointsOutput& out) {
+  for (double p_min : spec.p_mins)
+    rows.add(fmt::format("adb p_min={:g}", p_min),
+             timed(poses, a.tree, b.tree, strategy_variant("adb", {{"p_min", p_min}}, {})), out);
+  for (double levels : spec.confirm_levels)
+    for (double p_min : spec.confirm_p_mins)
+      rows.add(fmt::format("adb p_min={:g} confirm_levels={:g}", p_min, levels),
+               timed(poses, a.tree, b.tree,
+                     strategy_variant("adb", {{"p_min", p_min}, {"confirm_levels", levels}}, {})),
+               out);
+  for (double bv_tests : spec.bv_tests) {
+    // p_min 0.9; on exhaustion, "collision" iff the best queued estimate >= 0.5
+    const StrategyVariant capped =
+        strategy_variant("time_critical", {}, Budget{static_cast<std::uint64_t>(bv_tests), 0});
+    rows.add(fmt::format("time_critical p_min={:g} bv_tests={:g}", capped.value_or("p_min", 0), bv_tests),
+             timed(poses, a.tree, b.tree, capped), out);
+  }
+}
+
+/// Every series of one pair at one density.
+void run_density(const MeshSide& mesh_a, const MeshSide& mesh_b, bool same, std::size_t n,
+                 const PointsSpec& spec, PointsCloudInfo info, PointsOutput& out, bool quiet) {
+  const std::unique_ptr<Cloud> a = make_cloud(mesh_a.mesh, mesh_a.units, n, spec);
+  const std::unique_ptr<Cloud> b = same ? nullptr : make_cloud(mesh_b.mesh, mesh_b.units, n, spec);
+  const Cloud& cb = same ? *a : *b;
+  info.points = n;
+  info.spacing = std::max(a->spacing, cb.spacing);
+  info.band = spec.band * info.spacing;
+  std::vector<std::size_t> groups;
+  const std::vector<RigidTransform> poses = points_poses(spec, groups);
+  const StrategyVariant exact = strategy_variant("exact", {}, {});
+  const std::vector<TruthPose> truth =
+      mesh_truth(*mesh_a.tree.prepare(mesh_b.tree, exact), poses, groups, info.band);
+  cross_check(mesh_a.mesh, mesh_b.mesh, poses, truth, spec.cgal_sample, out);
   PointsRow head;
   head.pair = info.pair;
   head.points = n;
   head.spacing = info.spacing;
   const RowMaker rows(head, spec, truth, clock_overhead_us());
-  rows.add("exact_mesh",
-           timed(poses, [&](const RigidTransform& p) { return query_exact(tree_a, tree_b, p); }), out);
-  rows.add("exact_points",
-           timed(poses,
-                 [&](const RigidTransform& p) {
-                   return query_exact_points(a->tree.bvh, a->side(), cb.tree.bvh, cb.side(), p);
-                 }),
-           out);
-  rows.add("exact_points_vs_mesh",
-           timed(poses,
-                 [&](const RigidTransform& p) {
-                   return query_exact_points(a->tree.bvh, a->side(), tree_b, mesh_side(), p);
-                 }),
-           out);
-  for (double p_min : spec.p_mins) {
-    AdbOptions adb;
-    adb.p_min = p_min;
-    rows.add(fmt::format("adb p_min={:g}", p_min),
-             timed(poses,
-                   [&](const RigidTransform& p) {
-                     return query_adb_points(a->tree, a->side(), cb.tree, cb.side(), p, adb);
-                   }),
-             out);
-  }
-  for (double levels : spec.confirm_levels)
-    for (double p_min : spec.confirm_p_mins) {
-      AdbOptions confirmed;
-      confirmed.p_min = p_min;
-      confirmed.confirm_levels = static_cast<std::uint8_t>(levels);
-      rows.add(fmt::format("adb p_min={:g} confirm_levels={:g}", p_min, levels),
-               timed(poses,
-                     [&](const RigidTransform& p) {
-                       return query_adb_points(a->tree, a->side(), cb.tree, cb.side(), p, confirmed);
-                     }),
-               out);
-    }
-  for (double bv_tests : spec.bv_tests) {
-    AdbOptions capped;  // p_min 0.9; on exhaustion, "collision" iff the best queued estimate >= 0.5
-    capped.budget.max_bv_tests = static_cast<std::uint64_t>(bv_tests);
-    rows.add(fmt::format("time_critical p_min={:g} bv_tests={:g}", capped.p_min, bv_tests),
-             timed(poses,
-                   [&](const RigidTransform& p) {
-                     return query_adb_points(a->tree, a->side(), cb.tree, cb.side(), p, capped);
-                   }),
-             out);
-  }
+  rows.add("exact_mesh", timed(poses, mesh_a.tree, mesh_b.tree, exact), out);
+  rows.add("exact_points", timed(poses, a->tree, cb.tree, exact), out);
+  // The mesh's tree carries no density, so A's cloud is queried through a plain tree of the same shape.
+  const AnyTree plain_a = cloud_tree(a->points, mesh_a.units, "none", spec);
+  rows.add("exact_points_vs_mesh", timed(poses, plain_a, mesh_b.tree, exact), out);
+  add_adb_series(*a, cb, spec, poses, rows, out);
   add_octree_series(*a, cb, info.spacing, spec, poses, rows, info, out);
   if (!quiet)
     std::fprintf(stderr, "bvhlab: %s at %zu points: %zu poses measured\n", info.pair.c_str(), n,
@@ -274,17 +289,18 @@ PointsOutput run_points(const Scene& scene, bool quiet) {
       out.notes.push_back("pair " + pair.label() + " skipped: its mesh is not available (meshes/fetch.sh)");
       continue;
     }
-    const Mesh mesh_a = load_object(oa).mesh;
-    const Mesh mesh_b = pair.a == pair.b ? mesh_a : load_object(ob).mesh;
-    const auto tree_a = Bvh<Aabb>::build(mesh_a);
-    const auto tree_b = pair.a == pair.b ? tree_a : Bvh<Aabb>::build(mesh_b);
+    const ObjectData object_a = load_object(oa);
+    const ObjectData object_b = pair.a == pair.b ? object_a : load_object(ob);
+    const MeshUnits units_a{object_a.units, 1}, units_b{object_b.units, 1};
+    const AnyTree tree_a = AnyTree::build(object_a.mesh, units_a, "aabb", {}, {});
+    const AnyTree tree_b = pair.a == pair.b ? tree_a : AnyTree::build(object_b.mesh, units_b, "aabb", {}, {});
     PointsCloudInfo info;
     info.pair = pair.label();
-    info.triangles_a = mesh_a.triangles.size();
-    info.triangles_b = mesh_b.triangles.size();
+    info.triangles_a = object_a.mesh.triangles.size();
+    info.triangles_b = object_b.mesh.triangles.size();
     for (double n : spec.densities)
-      run_density(mesh_a, mesh_b, tree_a, tree_b, pair.a == pair.b, static_cast<std::size_t>(n), spec, info,
-                  out, quiet);
+      run_density({object_a.mesh, tree_a, units_a}, {object_b.mesh, tree_b, units_b}, pair.a == pair.b,
+                  static_cast<std::size_t>(n), spec, info, out, quiet);
   }
   return out;
 }
