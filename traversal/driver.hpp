@@ -25,9 +25,10 @@
 // Queue policies (the order in which admitted pairs are taken):
 //   DepthFirst          a stack: the last admitted pair first. With SplitLarger's order [right, left], the
 //                       left child is visited first.
-//   BestFirst           a priority queue on Pair::key: the highest key first (std::priority_queue, ties in
-//                       its order), with the highest pair pushed since the last pop held beside the heap:
-//                       taken next when nothing queued beats it (ties to it), without a push or pop.
+//   BestFirst           a priority queue on Pair::key: the highest key first (a four-ary heap,
+//                       traversal/four_ary_heap.hpp, ties in its order), with the highest pair pushed since
+//                       the last pop held beside the heap: taken next when nothing queued beats it (ties to
+//                       it), without a push or pop.
 //   OrderedDepthFirst   a stack on which the pairs admitted since the last pop are ordered by key: depth
 //                       first, into the most promising child (e.g. the most probable) first.
 //
@@ -86,6 +87,7 @@
 // overlap tests are left to the compiler, as before.
 #pragma once
 
+#include "four_ary_heap.hpp"
 #include "inline_stack.hpp"
 #include "result.hpp"
 #include "tree_pair.hpp"
@@ -96,7 +98,6 @@
 #include <cstdint>
 #include <new>
 #include <optional>
-#include <queue>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -166,22 +167,9 @@ struct BestFirst {
       if (items_.capacity() == 0) items_.reserve_empty(kReservedPairs);
       items_.push(p);
     }
-    struct ByKey {
-      bool operator()(const Pair& x, const Pair& y) const { return x.key < y.key; }
-    };
-    struct Heap : std::priority_queue<Pair, std::vector<Pair>, ByKey> {  // with access to its vector's room
-      [[nodiscard]] std::size_t capacity() const { return this->c.capacity(); }
-      /// Only while empty. Reserved in a fresh vector and swapped in: GCC 12 sees the vector's own reserve
-      /// read the storage it has just freed (-Wuse-after-free, a false positive) once the hooks inline.
-      void reserve_empty(std::size_t n) {
-        std::vector<Pair> room;
-        room.reserve(n);
-        this->c.swap(room);
-      }
-    };
     // 16 KiB of pairs: far below malloc's mmap threshold, so the reservation costs one ordinary allocation.
     static constexpr std::size_t kReservedPairs = std::max<std::size_t>(64, 16384 / sizeof(Pair));
-    Heap items_;
+    FourAryHeap<Pair> items_;
     Pair held_{};
     bool holding_ = false;
   };

@@ -6,12 +6,14 @@
 #include "traversal/adb.hpp"
 #include "traversal/driver.hpp"
 #include "traversal/exact.hpp"
+#include "traversal/four_ary_heap.hpp"
 #include "volumes/aabb.hpp"
 #include "volumes/restricted_box.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <queue>
 #include <random>
 #include <string>
 #include <vector>
@@ -50,6 +52,37 @@ TEST(QueuePolicies, TakeInTheirOrder) {
   std::vector<double> best_rest;
   while (!best.empty()) best_rest.push_back(best.pop().key);
   EXPECT_EQ(best_rest, (std::vector<double>{2.0, 1.0}));
+}
+
+// The four-ary heap and the best-first queue around it give back the highest key at every pop, against
+// std::priority_queue on random pushes and pops (heaps of every fill, the last group of children partial).
+TEST(QueuePolicies, BestFirstTakesTheHighestKeyAsABinaryHeapWould) {
+  struct Keyed {
+    double key;
+    int id;
+  };
+  std::mt19937 random(7);
+  std::uniform_int_distribution<int> key_of(0, 40);  // few keys: many ties
+  FourAryHeap<Keyed> heap;
+  BestFirst::Queue<Keyed> best;
+  std::priority_queue<double> reference;
+  for (int step = 0; step < 20000; ++step) {
+    const bool push = reference.empty() || random() % 5 < 3 - (step > 15000 ? 2 : 0);
+    if (push) {
+      const Keyed p{double(key_of(random)), step};
+      heap.push(p);
+      best.push(p);
+      reference.push(p.key);
+      continue;
+    }
+    ASSERT_EQ(heap.top().key, reference.top()) << "step " << step;
+    ASSERT_EQ(best.top().key, reference.top()) << "step " << step;
+    EXPECT_EQ(best.pop().key, reference.top());
+    heap.pop();
+    reference.pop();
+    ASSERT_EQ(heap.size(), reference.size());
+  }
+  EXPECT_TRUE(heap.empty() == reference.empty());
 }
 
 // The depth-first stack keeps its first pairs in place and moves to the heap past them: the pairs come back

@@ -1,0 +1,67 @@
+// A max-heap on Pair::key with four children a node: the queue behind best-first traversal (BestFirst,
+// traversal/driver.hpp). Against std::priority_queue's binary heap it has half the levels, and a node's
+// four children lie in one or two cache lines, so a pop moves fewer pairs and mispredicts fewer branches:
+// the pinion's wide OBB distance query at d = 2.0 ran about 8% faster with it, at 1% more instructions
+// (bench/RESULTS.md).
+// Written here rather than taken from Boost.Heap's d_ary_heap, whose option machinery every strategy's
+// translation unit would then compile. Ties leave in an order of their own, as in any heap.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace bvhlab {
+
+template <class Pair>
+class FourAryHeap {
+ public:
+  [[nodiscard]] bool empty() const { return pairs_.empty(); }
+  [[nodiscard]] std::size_t size() const { return pairs_.size(); }
+  /// The pair with the highest key. Only when not empty.
+  [[nodiscard]] const Pair& top() const { return pairs_.front(); }
+  [[nodiscard]] std::size_t capacity() const { return pairs_.capacity(); }
+  /// Room for `n` pairs; only while empty. Reserved in a fresh vector and swapped in: GCC 12 sees the
+  /// vector's own reserve read the storage it has just freed (-Wuse-after-free, a false positive) once a
+  /// traversal's hooks inline around it.
+  void reserve_empty(std::size_t n) {
+    std::vector<Pair> room;
+    room.reserve(n);
+    pairs_.swap(room);
+  }
+
+  void push(const Pair& p) {
+    std::size_t hole = pairs_.size();
+    pairs_.push_back(p);
+    while (hole > 0) {
+      const std::size_t parent = (hole - 1) / 4;
+      if (!(pairs_[parent].key < p.key)) break;
+      pairs_[hole] = pairs_[parent];
+      hole = parent;
+    }
+    pairs_[hole] = p;
+  }
+
+  /// Removes the top pair. Only when not empty.
+  void pop() {
+    const Pair last = pairs_.back();
+    pairs_.pop_back();
+    const std::size_t n = pairs_.size();
+    if (n == 0) return;
+    std::size_t hole = 0;
+    for (std::size_t first = 1; first < n; first = 4 * hole + 1) {
+      std::size_t highest = first;
+      for (std::size_t child = first + 1; child < std::min(first + 4, n); ++child)
+        if (pairs_[highest].key < pairs_[child].key) highest = child;
+      if (!(last.key < pairs_[highest].key)) break;
+      pairs_[hole] = pairs_[highest];
+      hole = highest;
+    }
+    pairs_[hole] = last;
+  }
+
+ private:
+  std::vector<Pair> pairs_;
+};
+
+}  // namespace bvhlab
