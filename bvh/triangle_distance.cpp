@@ -22,14 +22,25 @@ using local_frame::Frame;
 // pair is then within 1e-70 of the vertex-edge candidates, which stand for it.
 constexpr double kTinySquared = 1e-280;
 
-// A triangle with its normal. `flat` (collinear, repeated vertices, or a sliver narrower than 1e-70): no
-// plane, its edges are the point set.
+// A segment [a, b] with b - a and its squared length, computed once for the many points measured against it.
+struct Segment {
+  Vec3 a, b, d;
+  double squared;
+  Segment(const Vec3& from, const Vec3& to) : a(from), b(to), d(to - from), squared(d.squaredNorm()) {}
+};
+
+// A triangle with its edges and its normal. `flat` (collinear, repeated vertices, or a sliver narrower than
+// 1e-70): no plane, its edges are the point set.
 struct DistanceFace {
   TrianglePoints v;
+  std::array<Segment, 3> edges;  ///< edges[k] from v[k] to v[k + 1]
   Vec3 normal, unit = Vec3::Zero();
   bool flat;
 
-  explicit DistanceFace(const TrianglePoints& t) : v(t), normal(accurate_cross(t[1] - t[0], t[2] - t[0])) {
+  explicit DistanceFace(const TrianglePoints& t)
+      : v(t),
+        edges{Segment(t[0], t[1]), Segment(t[1], t[2]), Segment(t[2], t[0])},
+        normal(accurate_cross(t[1] - t[0], t[2] - t[0])) {
     const double squared = normal.squaredNorm();
     flat = !(squared > kTinySquared);
     if (!flat) unit = normal / std::sqrt(squared);
@@ -41,7 +52,7 @@ struct DistanceFace {
   [[nodiscard]] std::optional<double> height_over(const Vec3& x) const {
     if (flat) return std::nullopt;
     for (int k = 0; k < 3; ++k)
-      if ((next(k) - v[k]).cross(x - v[k]).dot(normal) < 0) return std::nullopt;
+      if (edges[k].d.cross(x - v[k]).dot(normal) < 0) return std::nullopt;
     return (x - v[0]).dot(unit);
   }
 };
@@ -54,18 +65,16 @@ double length(const Vec3& v) {
   return largest > 0 ? largest * (v / largest).norm() : 0.0;
 }
 
-// The point of segment [a, b] nearest x; a zero-length segment is its endpoint.
-Vec3 nearest_on_segment(const Vec3& x, const Vec3& a, const Vec3& b) {
-  const Vec3 d = b - a;
-  const double squared = d.squaredNorm();
-  if (!(squared > 0)) return a;
-  const double t = std::clamp((x - a).dot(d) / squared, 0.0, 1.0);
-  return t < 1 ? Vec3(a + t * d) : b;
+// The point of the segment nearest x; a zero-length segment is its endpoint.
+Vec3 nearest_on_segment(const Vec3& x, const Segment& e) {
+  if (!(e.squared > 0)) return e.a;
+  const double t = std::clamp((x - e.a).dot(e.d) / e.squared, 0.0, 1.0);
+  return t < 1 ? Vec3(e.a + t * e.d) : e.b;
 }
 
 double distance_to_face(const DistanceFace& f, const Vec3& x) {
   double d = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 3; ++k) d = std::min(d, length(x - nearest_on_segment(x, f.v[k], f.next(k))));
+  for (const Segment& e : f.edges) d = std::min(d, length(x - nearest_on_segment(x, e)));
   if (const auto height = f.height_over(x)) d = std::min(d, std::abs(*height));
   return d;
 }
@@ -87,13 +96,13 @@ void keep_nearer(Pair& best, const Vec3& on_p, const Vec3& on_q) {
 // here), but sliding both points along the edges together barely changes their distance, and the two
 // projections that follow remove the rest. Parallel or tiny edges have an endpoint among their nearest
 // points: the vertex-edge candidates.
-void edge_edge(Pair& best, const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1) {
-  const Vec3 u = a1 - a0, v = b1 - b0, n = u.cross(v);
+void edge_edge(Pair& best, const Segment& a, const Segment& b) {
+  const Vec3 n = a.d.cross(b.d);
   const double squared = n.squaredNorm();
   if (!(squared > kTinySquared)) return;
-  const double s = std::clamp((b0 - a0).cross(v).dot(n) / squared, 0.0, 1.0);
-  const Vec3 on_b = nearest_on_segment(a0 + s * u, b0, b1);
-  keep_nearer(best, nearest_on_segment(on_b, a0, a1), on_b);
+  const double s = std::clamp((b.a - a.a).cross(b.d).dot(n) / squared, 0.0, 1.0);
+  const Vec3 on_b = nearest_on_segment(a.a + s * a.d, b);
+  keep_nearer(best, nearest_on_segment(on_b, a), on_b);
 }
 
 // The minimum over the features that can hold the nearest pair of disjoint triangles: vertex-edge (18),
@@ -102,9 +111,9 @@ Pair nearest_features(const DistanceFace& p, const DistanceFace& q) {
   Pair best;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      keep_nearer(best, p.v[i], nearest_on_segment(p.v[i], q.v[j], q.next(j)));
-      keep_nearer(best, nearest_on_segment(q.v[j], p.v[i], p.next(i)), q.v[j]);
-      edge_edge(best, p.v[i], p.next(i), q.v[j], q.next(j));
+      keep_nearer(best, p.v[i], nearest_on_segment(p.v[i], q.edges[j]));
+      keep_nearer(best, nearest_on_segment(q.v[j], p.edges[i]), q.v[j]);
+      edge_edge(best, p.edges[i], q.edges[j]);
     }
     if (const auto height = q.height_over(p.v[i]); height && std::abs(*height) < best.distance)
       best = {std::abs(*height), p.v[i], p.v[i] - *height * q.unit};
