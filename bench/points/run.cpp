@@ -20,7 +20,7 @@
 
 #include <cmath>
 #include <cstdio>
-#include <memory>
+#include <optional>
 #include <span>
 
 namespace bvhlab {
@@ -57,20 +57,16 @@ std::vector<TruthPose> mesh_truth(const PreparedQuery& exact, const std::vector<
   return out;
 }
 
-/// A cloud sampled from a mesh and its AABB tree with ADB counts from the points' areas: one side of a
-/// point query. The tree holds the cloud's surface and sphere coverings.
+/// A cloud sampled from a mesh, in the mesh's units, and its AABB tree with ADB counts from the points'
+/// areas: one side of a point query. The tree holds the cloud's surface and sphere coverings.
 struct Cloud {
-  PointCloud points;  ///< FCL's octrees are built from them
+  UnitCloud points;  ///< FCL's octrees and the plain tree are built from them
   AnyTree tree;
   double spacing = 0;
 };
 
 /// The cloud's tree with `density` ("none" or "adb" at the scene's grid).
-AnyTree cloud_tree(const PointCloud& points, const MeshUnits& units, const std::string& density,
-                   const PointsSpec& spec) {
-  UnitCloud cloud;
-  static_cast<PointCloud&>(cloud) = points;
-  cloud.units = units;
+AnyTree cloud_tree(const UnitCloud& cloud, const std::string& density, const PointsSpec& spec) {
   BuildOptions options;
   options.max_leaf_points = spec.leaf;
   const ParamValues grid{{"grid", spec.grid}};
@@ -78,18 +74,18 @@ AnyTree cloud_tree(const PointCloud& points, const MeshUnits& units, const std::
                                options);
 }
 
-std::unique_ptr<Cloud> make_cloud(const Mesh& mesh, const MeshUnits& units, std::size_t n,
-                                  const PointsSpec& spec) {
-  PointCloud points;
+Cloud make_cloud(const Mesh& mesh, const MeshUnits& units, std::size_t n, const PointsSpec& spec) {
+  UnitCloud points;
   if (spec.varying) {
-    points = sample_varying(mesh, n, spec.seed, spec.ratio);
+    static_cast<PointCloud&>(points) = sample_varying(mesh, n, spec.seed, spec.ratio);
     assign_knn_areas(points, 10);
   } else {
-    points = sample_uniform(mesh, n, spec.seed);
+    static_cast<PointCloud&>(points) = sample_uniform(mesh, n, spec.seed);
   }
-  AnyTree tree = cloud_tree(points, units, "adb", spec);
+  points.units = units;
+  AnyTree tree = cloud_tree(points, "adb", spec);
   const double spacing = std::sqrt(surface_area(mesh) / static_cast<double>(n));
-  return std::make_unique<Cloud>(Cloud{std::move(points), std::move(tree), spacing});
+  return Cloud{std::move(points), std::move(tree), spacing};
 }
 
 /// The rows of one series: per distance, then the total; errors on the clear poses only.
@@ -236,11 +232,12 @@ void add_adb_series(const Cloud& a, const Cloud& b, const PointsSpec& spec,
 /// Every series of one pair at one density.
 void run_density(const MeshSide& mesh_a, const MeshSide& mesh_b, bool same, std::size_t n,
                  const PointsSpec& spec, PointsCloudInfo info, PointsOutput& out, bool quiet) {
-  const std::unique_ptr<Cloud> a = make_cloud(mesh_a.mesh, mesh_a.units, n, spec);
-  const std::unique_ptr<Cloud> b = same ? nullptr : make_cloud(mesh_b.mesh, mesh_b.units, n, spec);
-  const Cloud& cb = same ? *a : *b;
+  const Cloud a = make_cloud(mesh_a.mesh, mesh_a.units, n, spec);
+  const std::optional<Cloud> b =
+      same ? std::nullopt : std::optional<Cloud>(make_cloud(mesh_b.mesh, mesh_b.units, n, spec));
+  const Cloud& cb = same ? a : *b;
   info.points = n;
-  info.spacing = std::max(a->spacing, cb.spacing);
+  info.spacing = std::max(a.spacing, cb.spacing);
   info.band = spec.band * info.spacing;
   std::vector<std::size_t> groups;
   const std::vector<RigidTransform> poses = points_poses(spec, groups);
@@ -254,12 +251,12 @@ void run_density(const MeshSide& mesh_a, const MeshSide& mesh_b, bool same, std:
   head.spacing = info.spacing;
   const RowMaker rows(head, spec, truth, clock_overhead_us());
   rows.add("exact_mesh", timed(poses, mesh_a.tree, mesh_b.tree, exact), out);
-  rows.add("exact_points", timed(poses, a->tree, cb.tree, exact), out);
+  rows.add("exact_points", timed(poses, a.tree, cb.tree, exact), out);
   // The mesh's tree carries no density, so A's cloud is queried through a plain tree of the same shape.
-  const AnyTree plain_a = cloud_tree(a->points, mesh_a.units, "none", spec);
+  const AnyTree plain_a = cloud_tree(a.points, "none", spec);
   rows.add("exact_points_vs_mesh", timed(poses, plain_a, mesh_b.tree, exact), out);
-  add_adb_series(*a, cb, spec, poses, rows, out);
-  add_octree_series(*a, cb, info.spacing, spec, poses, rows, info, out);
+  add_adb_series(a, cb, spec, poses, rows, out);
+  add_octree_series(a, cb, info.spacing, spec, poses, rows, info, out);
   if (!quiet)
     std::fprintf(stderr, "bvhlab: %s at %zu points: %zu poses measured\n", info.pair.c_str(), n,
                  poses.size());
