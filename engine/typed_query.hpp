@@ -269,14 +269,16 @@ struct TreeQueries {
   }
 
  private:
+  /// Throws std::invalid_argument with a StrategyInfo refusal, unless it is empty (nothing refused).
+  static void refuse_if(const std::string& refusal) {
+    if (!refusal.empty()) throw std::invalid_argument(refusal);
+  }
+
   /// Every check of `variant` on trees `a` and `b` that the strategy's row (`info`) answers, in this order:
   /// the volume, the density and its parameters, coherent, contact geometry, wide, the point clouds' sides
   /// or the polygons. The strategy's options and, on clouds, its leaf test follow (make_query).
   static void check_variant(const StrategyInfo& info, const Base& a, const Base& b,
                             const StrategyVariant& variant) {
-    const auto refuse_if = [](const std::string& refusal) {
-      if (!refusal.empty()) throw std::invalid_argument(refusal);
-    };
     refuse_if(info.volume_refusal(BV::name()));
     refuse_if(info.refusal(D::name()));
     if constexpr (ProbabilityDensity<D>)  // refuses trees annotated with other parameters, before any pose
@@ -301,8 +303,7 @@ struct TreeQueries {
   /// The refusals of a wide variant: a strategy without a wide walk, a volume without a wide layout or one
   /// the strategy's wide walk does not take, a coherent walk, point leaves.
   static void check_wide(const StrategyInfo& info, const StrategyVariant& variant, bool cloud) {
-    if (std::string refusal = info.wide_walk_refusal(BV::name()); !refusal.empty())
-      throw std::invalid_argument(refusal);
+    refuse_if(info.wide_walk_refusal(BV::name()));
     if (variant.coherent)
       throw std::invalid_argument(
           "a coherent query walks the binary trees; ask for coherent or wide, not both");
