@@ -7,7 +7,6 @@
 // translation unit would then compile. Ties leave in an order of their own, as in any heap.
 #pragma once
 
-#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -50,9 +49,7 @@ class FourAryHeap {
     if (n == 0) return;
     std::size_t hole = 0;
     for (std::size_t first = 1; first < n; first = 4 * hole + 1) {
-      std::size_t highest = first;
-      for (std::size_t child = first + 1; child < std::min(first + 4, n); ++child)
-        if (pairs_[highest].key < pairs_[child].key) highest = child;
+      const std::size_t highest = first + 4 <= n ? highest_of_four(first) : highest_of_last(first, n);
       if (!(last.key < pairs_[highest].key)) break;
       pairs_[hole] = pairs_[highest];
       hole = highest;
@@ -61,6 +58,23 @@ class FourAryHeap {
   }
 
  private:
+  /// The first child of highest key among pairs_[first, first + 4): as a tournament of selects, without
+  /// the loop's branches (which child wins is what a branch predictor cannot learn). The same child as the
+  /// loop in highest_of_last picks, ties included.
+  [[nodiscard]] std::size_t highest_of_four(std::size_t first) const {
+    const Pair* child = pairs_.data() + first;
+    const std::size_t left = child[0].key < child[1].key ? 1 : 0;
+    const std::size_t right = child[2].key < child[3].key ? 3 : 2;
+    return first + (child[left].key < child[right].key ? right : left);
+  }
+  /// The first child of highest key among the fewer than four children at the end of the heap.
+  [[nodiscard]] std::size_t highest_of_last(std::size_t first, std::size_t n) const {
+    std::size_t highest = first;
+    for (std::size_t child = first + 1; child < n; ++child)
+      if (pairs_[highest].key < pairs_[child].key) highest = child;
+    return highest;
+  }
+
   std::vector<Pair> pairs_;
 };
 
