@@ -14,6 +14,7 @@
 #include "inline_stack.hpp"
 
 #include <array>
+#include <bit>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -70,8 +71,16 @@ template <class Lanes, class Stack, class AVolumes, class BPlaced>
 [[gnu::always_inline]] inline void push_hits(Stack& stack, unsigned hits, bool nearest_first,
                                              const AVolumes& a_volumes, const BPlaced& b_placed,
                                              const WidePair& base, bool split_b) {
+  // A step that hits no lane or one needs no order: no loop, no sort.
+  if (hits == 0) return;
+  if ((hits & (hits - 1)) == 0) {
+    WidePair child = base;
+    (split_b ? child.b_lane : child.a_lane) = static_cast<std::uint32_t>(std::countr_zero(hits));
+    stack.push_back(child);
+    return;
+  }
   std::array<float, 4> distance{};
-  if (nearest_first && (hits & (hits - 1)) != 0) distance = Lanes::center_distances(a_volumes, b_placed);
+  if (nearest_first) distance = Lanes::center_distances(a_volumes, b_placed);
   std::array<std::uint32_t, 4> order;  // the lanes hit, in the order they are to be taken
   int n = 0;
   for (std::uint32_t k = 0; k < 4; ++k) {
