@@ -45,7 +45,6 @@ struct DistanceFace {
     flat = !(squared > kTinySquared);
     if (!flat) unit = normal / std::sqrt(squared);
   }
-  [[nodiscard]] const Vec3& next(int k) const { return v[(k + 1) % 3]; }
 
   // Signed distance of x above the plane when x's foot lies in the closed face. A foot on the boundary is an
   // edge's business: rounding either way there changes the distance only to second order.
@@ -123,12 +122,12 @@ Pair nearest_features(const DistanceFace& p, const DistanceFace& q) {
   return best;
 }
 
-// Where segment [a, b] meets the face's plane, when its ends are on opposite sides or one is on it.
-std::optional<Vec3> plane_crossing(const DistanceFace& f, const Vec3& a, const Vec3& b) {
+// Where edge e meets the face's plane, when its ends are on opposite sides or one is on it.
+std::optional<Vec3> plane_crossing(const DistanceFace& f, const Segment& e) {
   if (f.flat) return std::nullopt;
-  const double da = (a - f.v[0]).dot(f.normal), db = (b - f.v[0]).dot(f.normal);
+  const double da = (e.a - f.v[0]).dot(f.normal), db = (e.b - f.v[0]).dot(f.normal);
   if (da == db || (da > 0 && db > 0) || (da < 0 && db < 0)) return std::nullopt;
-  return a + (da / (da - db)) * (b - a);  // |da| <= |da - db|: the ratio is in [0, 1]
+  return e.a + (da / (da - db)) * e.d;  // |da| <= |da - db|: the ratio is in [0, 1]
 }
 
 // A point of both triangles, known to intersect: where an edge of one crosses the other's plane (the ends of
@@ -147,8 +146,8 @@ Vec3 common_point(const DistanceFace& p, const DistanceFace& q, const Pair& near
   };
   consider((nearest.on_p + nearest.on_q) / 2);
   for (int k = 0; k < 3 && residual > 0; ++k) {
-    if (const auto x = plane_crossing(q, p.v[k], p.next(k))) consider(*x);
-    if (const auto x = plane_crossing(p, q.v[k], q.next(k))) consider(*x);
+    if (const auto x = plane_crossing(q, p.edges[k])) consider(*x);
+    if (const auto x = plane_crossing(p, q.edges[k])) consider(*x);
   }
   return best;
 }
