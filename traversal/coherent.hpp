@@ -18,8 +18,9 @@
 // While the stored tree is the root pair alone, step 2 is the root pair's test, made without the walk.
 // The answer is exact whatever the state holds: "no contact" only when every front pair was found disjoint
 // or without contact at the current pose, "contact" only with a triangle pair intersecting at it. The state
-// starts from the root when it is new, after a pose jump or when its tree grew past max_pairs; while the
-// poses keep jumping, the query is the cold one and stores no front.
+// starts from the root after a pose jump or when its tree grew past max_pairs; while the poses keep jumping,
+// and at a new state's first query, the query is the cold one and stores no front (the root pair alone where
+// the objects were apart).
 #pragma once
 
 #include "coherent_binding.hpp"
@@ -233,8 +234,12 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   coherent_detail::attach(state, a, b);
   state.serve(CoherentState::Use::Exact);
   // The cold query's answer, with what this query spent before it, recorded as a query from the root.
+  // Objects it found apart at the root pair leave that pair as the stored tree: the next query tests it
+  // alone (root_apart below), as after a walk that found the same.
   const auto cold_answer = [&](const Counters& spent) {
     Result cold_result = exact_traversal(a, b, b_to_a, mode, leaves);
+    const Counters& own = cold_result.counters;
+    if (!cold_result.collides && own.bv_tests == 1 && own.triangle_tests == 0) state.store_root_apart(b_to_a);
     cold_result.counters += spent;
     state.witness.reset();
     state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
@@ -246,7 +251,8 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   if (state.cold_turns_left() > 1) return cold_answer({});
   // With nothing stored (the poses jumped before, or the state is new) there is no remembered contact or root
   // pair to try first: the jump is judged before the traversal's set-up, so that while the poses keep
-  // jumping the cold query answers at little more than its own cost.
+  // jumping the cold query answers at little more than its own cost. A new state's first query counts as one
+  // of such a run (CoherentState::jumped): it is the cold one.
   std::optional<bool> jumped;
   if (!cold && !state.witness && state.pairs().empty()) {
     jumped = state.jumped(b_to_a);

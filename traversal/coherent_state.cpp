@@ -70,10 +70,13 @@ void CoherentState::InUse::release() {
 }
 
 bool CoherentState::jumped(const RigidTransform& pose) {
-  const bool jump = moved_too_far(pose);
-  jumping_on_ = jump && last_jumped_;
+  // A state that has seen no pose knows nothing a front could start from: its first query counts as one in
+  // a run of jumps (the cold query, the pose noted), and a walk from the root waits for a pose that stays
+  // near it. Poses that jump from the first then never pay for a walk.
+  const bool jump = !stamped_ || moved_too_far(pose);
+  jumping_on_ = jump && (last_jumped_ || !stamped_);
   last_jumped_ = jump;
-  if (jump) ++jumps_;
+  if (jump && stamped_) ++jumps_;
   return jump;
 }
 

@@ -127,9 +127,11 @@ class CoherentState {
   };
 
   /// True when `pose` lies farther than max_jump from the pose of the last query that stored its front or
-  /// noted its pose (store, restamp, forget_front); counts the jump. False while no query has.
+  /// noted its pose (store, restamp, forget_front); counts the jump. True, but not counted, while no query
+  /// has: a new state's first query is answered cold (traversal/coherent.hpp).
   [[nodiscard]] bool jumped(const RigidTransform& pose);
-  /// Whether the last two calls of jumped() were both true: the poses keep jumping.
+  /// Whether the last two calls of jumped() were both true (or the first call, on a state that had seen no
+  /// pose, was true): the poses keep jumping.
   [[nodiscard]] bool jumping_on() const { return jumping_on_; }
   std::vector<FrontPair>& pairs() { return pairs_; }
   /// Whether the stored tree is the root pair alone, disjoint when last tested: the objects were apart.
@@ -143,6 +145,12 @@ class CoherentState {
   void restamp(const RigidTransform& pose) {
     pose_ = pose;
     stamped_ = true;
+  }
+  /// Keeps the root pair alone, disjoint at `pose`: a query from the root found the objects apart there, and
+  /// the next query tests that pair without a walk (root_apart), as after a walk that found the same.
+  void store_root_apart(const RigidTransform& pose) {
+    pairs_.assign(1, FrontPair{.separated = 1});
+    restamp(pose);
   }
   /// Drops the stored tree and notes `pose` alone: a query after a pose jump, answered from the root.
   void forget_front(const RigidTransform& pose) {

@@ -18,12 +18,14 @@ namespace {
 using EvenVolumes = testing::AlternateTypes<0, testing::TraversalTestVolumes>::type;
 INSTANTIATE_TYPED_TEST_SUITE_P(EvenVolumes, Coherent, EvenVolumes);
 
-/// AABB trees, and a state whose first query found no contact close to it: B moved along x from 1.0 to the
+/// AABB trees, and a state whose first walk found no contact close to it: B moved along x from 1.0 to the
 /// first pose without contact, 0.01 at a time.
 class ClearOfContact : public ::testing::Test {
  protected:
   void SetUp() override {
     while (query_exact(a, b, pose).collides && pose.translation.x() < 3) pose.translation.x() += 0.01;
+    // A new state's first query is the cold one; the second, at the same pose, walks from the root.
+    ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
     ASSERT_FALSE(query_exact_coherent(a, b, pose, state).collides);
   }
   const Bvh<Aabb> a = Bvh<Aabb>::build(torus());
@@ -77,7 +79,10 @@ TEST_F(ClearOfContact, APoseJumpStartsFromTheRootAndJumpsInARowRunTheColdQuery) 
       -pose.translation.x();  // to the other side of A: B's box moves by far more than its radius
   const Result far = query_exact_coherent(a, b, pose, state);
   EXPECT_EQ(state.jumps(), 1u);
-  CoherentState fresh;  // the query from the root: the same work, and a front for the next step
+  // The walk from the root: the same work as a new state's (its second query at a pose: the first is cold),
+  // and a front for the next step.
+  CoherentState fresh;
+  query_exact_coherent(a, b, pose, fresh);
   EXPECT_EQ(far.counters.bv_tests, query_exact_coherent(a, b, pose, fresh).counters.bv_tests);
   EXPECT_GE(state.stored_pairs(), 1u);
   pose.translation.y() += 2;  // a second jump right after: the cold query, and no front kept
@@ -87,7 +92,7 @@ TEST_F(ClearOfContact, APoseJumpStartsFromTheRootAndJumpsInARowRunTheColdQuery) 
   EXPECT_EQ(again.collides, cold.collides);
   EXPECT_EQ(again.counters.bv_tests, cold.counters.bv_tests);
   EXPECT_EQ(again.counters.nodes_visited, cold.counters.nodes_visited);
-  EXPECT_EQ(state.stored_pairs(), 0u);
+  EXPECT_EQ(state.stored_pairs(), cold.counters.bv_tests == 1 ? 1u : 0u);  // the root pair where apart
   pose.translation.y() -= 0.01;  // a step from there: no jump, a walk from the root stores the front
   const Result next = query_exact_coherent(a, b, pose, state);
   EXPECT_EQ(state.jumps(), 2u);
@@ -99,22 +104,48 @@ TEST(Coherent, PosesThatKeepJumpingCostTheColdQueries) {
   const auto a = Bvh<Aabb>::build(torus());
   const auto b = Bvh<Aabb>::build(soup());
   CoherentState state{CoherenceOptions{.max_jump = 0.05, .max_cold_run = 0}};
-  int in_a_row = 0;
+  int in_a_row = 0, apart = 0;
   for (const RigidTransform& pose : path(40, 0.2)) {  // each step moves B far past 0.05 of its radius
     const std::uint64_t jumps = state.jumps();
     const Result r = query_exact_coherent(a, b, pose, state);
     const Result cold = query_exact(a, b, pose);
     ASSERT_EQ(r.collides, cold.collides);
-    if (state.jumps() == jumps || !state.jumping_on()) continue;
+    if (state.jumps() == jumps || !state.jumping_on()) {
+      if (r.counters.bv_tests == 1 && state.root_apart()) ++apart;  // the stored root pair, tested alone
+      continue;
+    }
     // The cold query's work, and at most the root pair (objects apart before) and the remembered contact
     // (one triangle pair a leaf) tried first.
     ++in_a_row;
     EXPECT_LE(r.counters.bv_tests, cold.counters.bv_tests + 1);
     EXPECT_LE(r.counters.nodes_visited, cold.counters.nodes_visited + 1);
     EXPECT_LE(r.counters.triangle_tests, cold.counters.triangle_tests + 1);
-    EXPECT_EQ(state.stored_pairs(), 0u);
+    // No front kept: at most the root pair, where the cold query found the objects apart.
+    if (state.stored_pairs() != 0) EXPECT_TRUE(state.stored_pairs() == 1 && state.root_apart());
   }
+  // The first query of a new state is answered cold too: each query, the first included, jumps in a row or
+  // tests the root pair alone where the objects were apart. None walks.
+  EXPECT_EQ(in_a_row + apart, 40);
   EXPECT_GT(in_a_row, 20);
+}
+
+TEST(Coherent, ANewStateStartsWithTheColdQuery) {
+  const auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  for (const double x : {0.7, 5.0}) {  // in contact, apart
+    CoherentState state;
+    const RigidTransform pose = RigidTransform::translate(Vec3(x, 0, 0));
+    const Result first = query_exact_coherent(a, b, pose, state);
+    const Result cold = query_exact(a, b, pose);
+    EXPECT_EQ(first.collides, cold.collides);
+    EXPECT_EQ(first.counters.bv_tests, cold.counters.bv_tests);
+    EXPECT_EQ(first.counters.triangle_tests, cold.counters.triangle_tests);
+    EXPECT_EQ(state.jumps(), 0u);  // not a jump from anywhere
+    // In contact nothing is kept; apart, the root pair, which the next query tests alone.
+    EXPECT_EQ(state.stored_pairs(), x < 1 ? 0u : 1u);
+    if (x < 1) continue;
+    EXPECT_EQ(query_exact_coherent(a, b, pose, state).counters.bv_tests, 1u);
+  }
 }
 
 TEST(Coherent, ARepeatedContactIsAnsweredByItsWitness) {
@@ -122,7 +153,8 @@ TEST(Coherent, ARepeatedContactIsAnsweredByItsWitness) {
   const auto b = Bvh<Aabb>::build(soup());
   CoherentState state;
   const RigidTransform pose = RigidTransform::translate(Vec3(0.7, 0, 0));
-  const Result first = query_exact_coherent(a, b, pose, state);
+  ASSERT_TRUE(query_exact_coherent(a, b, pose, state).collides);  // a new state's first query: cold
+  const Result first = query_exact_coherent(a, b, pose, state);   // the walk from the root
   ASSERT_TRUE(first.collides);
   EXPECT_GT(state.stored_pairs(), 1u);  // the tree walked up to the contact: the next walk starts there
   const Result again = query_exact_coherent(a, b, pose, state);
