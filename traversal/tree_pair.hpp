@@ -81,7 +81,8 @@ struct TriangleLeaves {
   template <TreeVolume BV>
   static void require(const Bvh<BV>& a, const Bvh<BV>& b, const char* who) {
     for (const Bvh<BV>* tree : {&a, &b}) {
-      const std::string side = tree == &a ? "tree A" : "tree B";
+      // A string is made only for a message: every query runs this check.
+      const char* side = tree == &a ? "tree A" : "tree B";
       if (tree->has_points())
         throw std::invalid_argument(std::string(who) + ": " + side +
                                     " holds a point cloud, not triangles; query point trees with their "
