@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <iostream>
 #include <numbers>
 
@@ -236,12 +237,50 @@ TYPED_TEST(DopTest, ExtremalVertexSearchAnswersAsTheScalarReference) {
   }
 }
 
+TYPED_TEST(DopTest, RealignmentWalkFindsTheScansTripleBitForBit) {
+  // realign walks the prototype's edges and stops only deep inside a vertex's normal cone; it must give the
+  // scan's triple and coefficients exactly, and leave to the scan the directions where vertices tie: along
+  // a face's normal, and along the sum of the two normals an edge lies on. Directions at random, of every
+  // magnitude, and towards the vertices.
+  using BV = TypeParam;
+  const auto& tables = BV::tables();
+  ASSERT_FALSE(tables.across.empty()) << "every shipped DOP's prototype has simple vertices: the walk is on";
+  std::vector<Vec3> ties(tables.normals.begin(), tables.normals.end());
+  for (const auto& vertex : tables.vertices) {
+    const auto& planes = vertex.triples[0].planes;
+    for (int k = 0; k < 3; ++k)
+      ties.push_back(tables.normals[planes[k]] + tables.normals[planes[(k + 1) % 3]]);
+  }
+  std::mt19937_64 rng(61);
+  std::vector<Vec3> random;
+  for (int k = 0; k < 20000; ++k)
+    random.push_back(gaussian_vec(rng).normalized() * std::pow(10.0, k % 7 * 50 - 150));
+  const auto same_as_scan = [&](const Vec3& v) {
+    std::array<std::uint8_t, 3> walked_planes{}, scanned_planes{};
+    std::array<double, 3> walked{}, scanned{};
+    const bool walk = tables.walk(v, walked_planes, walked);
+    tables.realign_by_scan(v, scanned_planes, scanned);
+    if (walk) {
+      EXPECT_EQ(walked_planes, scanned_planes) << "direction " << v.transpose();
+      for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(walked[k]), std::bit_cast<std::uint64_t>(scanned[k]));
+    }
+    return walk;
+  };
+  int walked = 0;
+  for (const Vec3& v : random) walked += same_as_scan(v);
+  EXPECT_GE(walked, 19900) << "the walk should settle almost every direction at random";
+  for (const auto& vertex : tables.vertices) same_as_scan(vertex.position);
+  for (const Vec3& v : ties) EXPECT_FALSE(same_as_scan(v)) << "a tie, direction " << v.transpose();
+}
+
 TEST(DopRealignment, NonSimplePrototypeVerticesUseATripleWhoseConeHoldsTheDirection) {
   // The four corner diagonals alone: the prototype is an octahedron, four planes meet at each vertex.
   const dop_detail::DirectionSet<4> set{{{{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}}}};
   const dop_detail::Tables<4> tables(set);
   ASSERT_EQ(tables.vertices.size(), 6u);
   for (const auto& v : tables.vertices) EXPECT_EQ(v.triples.size(), 4u);
+  EXPECT_TRUE(tables.across.empty()) << "no walk over vertices that are not simple";
   std::mt19937_64 rng(43);
   for (int k = 0; k < 2000; ++k) {
     Vec3 v = gaussian_vec(rng).normalized();
