@@ -60,7 +60,7 @@ struct Tables {
   /// across[x][k] is the vertex that shares vertex x's planes but its k-th. Empty where some vertex is not.
   std::vector<std::array<std::uint8_t, 3>> across;
   /// Where the walk starts for a direction in each bin (direction_bin): the vertex extremal at the bin's
-  /// centroid. From there it takes 0.09 steps on average for the 24-DOP (2.3 from the octant's corner).
+  /// centroid. From there it takes 0.09 steps on average for the 24-DOP (1.3 from an octant's corner).
   std::array<std::uint8_t, 64> bin_start{};
 
   /// Plane m's opposite: the same axis, the other side. The prototype is symmetric, so the triple realign
@@ -146,7 +146,7 @@ struct Tables {
     }
   }
 
-  /// realign's shortcut, the simplex method on the prototype: from the vertex of v's octant, across the plane
+  /// realign's shortcut, the simplex method on the prototype: from bin_start of v's bin, across the plane
   /// of the most negative coefficient, until every coefficient is at least kCertain |v|_1. Then v lies so
   /// deep inside that vertex's normal cone that every other vertex is farther from v's maximum than
   /// extremal_vertex's rounding by orders of magnitude (find_edges checks the prototype's share of that
@@ -243,7 +243,7 @@ struct Tables {
     }
   }
 
-  /// The walk's edges and octant starts, where every vertex is simple. A vertex x of planes T is v's unique
+  /// The walk's edges and bin starts, where every vertex is simple. A vertex x of planes T is v's unique
   /// maximum by at least min(lambda) * sum over T of (1 - n_k . y) against any other vertex y; the
   /// prototype's smallest such sum, times kCertain, must dwarf the scan's rounding, or there is no walk.
   void find_edges() {
@@ -280,9 +280,9 @@ struct Tables {
                                std::sqrt(1 / 3.0)};
     for (int signs = 0; signs < 8; ++signs)
       for (int order = 0; order < 8; ++order) {
-        const bool a_b = order & 1, a_c = order & 2,
-                   b_c = order & 4;                                // |v0| < |v1|, |v0| < |v2|, |v1| < |v2|
-        const int rank[3] = {a_b + a_c, !a_b + b_c, !a_c + !b_c};  // how many components are larger
+        // |v0| < |v1|, |v0| < |v2|, |v1| < |v2|, as direction_bin packs them
+        const bool a_b = order & 1, a_c = order & 2, b_c = order & 4;
+        const int rank[3] = {a_b + a_c, !a_b + b_c, !a_c + !b_c};         // how many components are larger
         if ((1 << rank[0] | 1 << rank[1] | 1 << rank[2]) != 7) continue;  // no real direction has this order
         Vec3 centroid;
         for (int i = 0; i < 3; ++i) centroid[i] = (signs >> i & 1 ? -1 : 1) * by_rank[rank[i]];
