@@ -76,7 +76,10 @@ bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t 
 /// less than a quarter of the tests: from the pair taken into the child of smallest bound down to a leaf
 /// pair, whose triangles bring the upper end down early. Best first alone reaches its first leaf pair only
 /// after every pair of smaller bound, which a small budget does not allow; the dives cost a few tests per
-/// level, counted and capped.
+/// level, counted and capped. Under a cap of BV tests, its last four dives' worth of tests (all of a small
+/// cap) hold one dive, taken when only a dive's tests are left, from the nearest pair the search reached.
+/// A pair's bound is at least its parent's (its triangles are some of the parent's), which keeps the lower
+/// end of a stopped search at every ancestor's bound where a child's volumes bound it looser.
 template <DistanceVolume BV, class Limit = Unlimited>
 class DistanceHooks {
  public:
@@ -91,15 +94,17 @@ class DistanceHooks {
                                           trees_.context, nearest_.distance);
   }
   [[gnu::always_inline]] Admission admit(Pair& p, double bound) {
+    bound = std::max(bound, floor_);
     if (bound >= nearest_.distance) return Admission::Drop;
     p.key = bound > 0 ? -bound : ++overlapping_;
     return Admission::Queue;
   }
   /// Every pair still queued is at least as far as this one: none can hold a nearer triangle pair.
   [[gnu::always_inline]] Step taken(const Pair& p) {
-    if (bound_of(p.key) >= nearest_.distance) return Step::Decided;
+    floor_ = bound_of(p.key);
+    if (floor_ >= nearest_.distance) return Step::Decided;
     if constexpr (!Limit::never_stops)
-      if (trees_.counters.bv_tests >= kDiveShare * dive_tests_) {
+      if (dive_due()) {
         const std::uint64_t before = trees_.counters.bv_tests;
         dive(p);
         dive_tests_ += trees_.counters.bv_tests - before + 1;
@@ -125,6 +130,19 @@ class DistanceHooks {
  private:
   /// The bound a queue key stands for (admit).
   static double bound_of(double key) { return key > 0 ? 0 : -key; }
+
+  /// A dive is due while the dives have spent under a quarter of the tests, but under a cap, in its last
+  /// four dives' worth of tests, only once, when a dive's tests are left. So a small cap is not spent on a
+  /// dive from the root, which would leave the lower end at the root's bound.
+  bool dive_due() {
+    const std::uint64_t left = limit_.tests_left(trees_.counters);
+    if (last_dive_due_ && left <= dive_reserve_) {
+      last_dive_due_ = false;
+      return true;
+    }
+    if (left < kDiveShare * dive_reserve_) return false;
+    return trees_.counters.bv_tests >= kDiveShare * dive_tests_;
+  }
 
   /// From `p` into the child pair of smallest bound, down to a leaf pair, whose triangles are measured;
   /// stops where the budget's cap does.
@@ -157,7 +175,12 @@ class DistanceHooks {
   /// The dives take at most about 1 / kDiveShare of the tests: the search's own lift the lower end.
   static constexpr std::uint64_t kDiveShare = 4;
   std::uint64_t dive_tests_ = 0;  ///< BV tests the dives spent (plus one per dive)
-  double overlapping_ = 0;        ///< bound-0 pairs admitted so far: their keys
+  /// The tests a dive from the root may take: two a level of both trees.
+  std::uint64_t dive_reserve_ =
+      Limit::never_stops ? 0 : 2 * (trees_.a.stats().depth + trees_.b.stats().depth);
+  bool last_dive_due_ = true;  ///< the dive kept for when the cap's last reserve is reached
+  double overlapping_ = 0;     ///< bound-0 pairs admitted so far: their keys
+  double floor_ = 0;           ///< the bound of the pair being expanded: its children are no nearer
   bool stopped_ = false;
   double unexamined_bound_ = std::numeric_limits<double>::infinity();
 };

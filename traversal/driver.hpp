@@ -304,6 +304,11 @@ class BudgetLimit {
   [[gnu::always_inline]] bool allows_pop() { return --countdown_ != 0 || read_clock(); }
   /// True when a deadline is set and the clock has reached it.
   [[nodiscard]] bool deadline_passed() const { return has_deadline_ && Clock::now() >= end_; }
+  /// The BV tests still allowed; the largest count when the budget has no cap.
+  [[nodiscard]] std::uint64_t tests_left(const Counters& c) const {
+    if (!max_bv_tests_) return ~std::uint64_t{0};
+    return c.bv_tests >= max_bv_tests_ ? 0 : max_bv_tests_ - c.bv_tests;
+  }
 
  private:
   /// False once the deadline is reached; otherwise sets the pops until the next read.

@@ -107,6 +107,21 @@ TYPED_TEST(DistanceQuery, AnytimeIntervalHoldsTheDistanceAndClosesWithTheFullBud
   }
 }
 
+TYPED_TEST(DistanceQuery, AStoppedIntervalKeepsEveryAncestorsBound) {
+  // A child pair is no nearer than its parent pair, so a stopped query's lower end is never below the
+  // bound of the root pair (what a budget of one test answers), whatever the children's own bounds.
+  int raised = 0;
+  for (const RigidTransform& pose : this->poses()) {
+    const double root = query_distance_anytime(this->tree_a, this->tree_b, pose, Budget{1, 0}).lower_bound;
+    for (std::uint64_t cap : {2, 5, 10, 20, 40, 70, 100, 150}) {
+      const DistanceResult r = query_distance_anytime(this->tree_a, this->tree_b, pose, Budget{cap, 0});
+      ASSERT_GE(r.lower_bound, root) << "cap " << cap;
+      raised += r.lower_bound > root;
+    }
+  }
+  EXPECT_GT(raised, 0);  // the search lifts the lower end on some poses
+}
+
 TYPED_TEST(DistanceQuery, WithinToleranceAgreesWithTheDistance) {
   for (const RigidTransform& pose : this->poses()) {
     const double d = query_distance(this->tree_a, this->tree_b, pose).distance;
