@@ -107,23 +107,31 @@ std::vector<Proximity> proximities(const PreparedQuery& query, std::span<const R
   return out;
 }
 
+/// The share of the poses apart (full distance above 0) for which `holds(i)` is true; -1 when none is apart.
+template <class Predicate>
+double share_of_apart(const std::vector<Proximity>& full, Predicate holds) {
+  int apart = 0, count = 0;
+  for (std::size_t i = 0; i < full.size(); ++i) {
+    if (!(full[i].distance > 0)) continue;
+    ++apart;
+    count += holds(i);
+  }
+  return apart ? double(count) / apart : -1;
+}
+
 /// Share of the poses apart where the anytime distance, capped at `tenths` tenths of the full query's BV
 /// tests, answers an interval at most a tenth of the distance wide; -1 when no pose is apart.
 /// `full` and `full_work` hold each pose's full query.
 double anytime_share(const AnyTree& tree, const std::vector<RigidTransform>& poses,
                      const std::vector<Proximity>& full, const std::vector<Counters>& full_work,
                      std::uint64_t tenths) {
-  int apart = 0, narrow = 0;
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    if (!(full[i].distance > 0)) continue;
-    ++apart;
+  return share_of_apart(full, [&](std::size_t i) {
     const Budget cap{std::max<std::uint64_t>(1, full_work[i].bv_tests * tenths / 10), 0};
     Counters work;
     const auto query = tree.prepare(tree, strategy_variant("distance_anytime", {}, cap));
     const Proximity r = proximities(*query, std::span(poses).subspan(i, 1), work).front();
-    narrow += r.distance - r.lower_bound <= 0.1 * full[i].distance;
-  }
-  return apart ? double(narrow) / apart : -1;
+    return r.distance - r.lower_bound <= 0.1 * full[i].distance;
+  });
 }
 
 /// The share of the poses apart where even a known distance d would close the interval to a tenth of it
@@ -135,10 +143,7 @@ double anytime_share(const AnyTree& tree, const std::vector<RigidTransform>& pos
 double anytime_limit(const AnyTree& tree, const std::vector<RigidTransform>& poses,
                      const std::vector<Proximity>& full, const std::vector<Counters>& full_work,
                      std::uint64_t tenths) {
-  int apart = 0, within_reach = 0;
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    if (!(full[i].distance > 0)) continue;
-    ++apart;
+  return share_of_apart(full, [&](std::size_t i) {
     const auto query =
         tree.prepare(tree, strategy_variant("tolerance", {{"tolerance", 0.9 * full[i].distance}}, {}));
     Counters work;
@@ -146,9 +151,8 @@ double anytime_limit(const AnyTree& tree, const std::vector<RigidTransform>& pos
       if (r.collides) throw std::logic_error("bench_distance: a pair within 0.9 of the distance");
       work = r.counters;
     });
-    within_reach += work.bv_tests * 10 <= full_work[i].bv_tests * tenths;
-  }
-  return apart ? double(within_reach) / apart : -1;
+    return work.bv_tests * 10 <= full_work[i].bv_tests * tenths;
+  });
 }
 
 /// A twin of the full query's series: the same poses through the coherent query (in order, a fresh state
