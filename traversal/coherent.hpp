@@ -212,16 +212,15 @@ class FrontWalk {
 
 }  // namespace coherent_detail
 
-/// Exact first-contact (or all-contacts) query that starts from `state`, the memory of the previous queries
-/// on the same two trees (traversal/coherent_state.hpp), and leaves its own there. Answers, witnesses and
-/// contacts are those of query_exact; the counters say what this query tested. Throws std::invalid_argument
-/// for a non-rigid pose or a state made for other trees, std::logic_error for a state another query is
-/// using. The trees are read only: any number of states may share them, one per caller.
-template <TreeVolume BV, class Leaves = TriangleLeaves>
-Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
-                            CoherentState& state, ContactMode mode = ContactMode::First,
-                            const Leaves& leaves = kTriangleLeaves) {
-  check_exact_query<Leaves>(b_to_a, mode);
+namespace coherent_detail {
+
+/// query_exact_coherent past its checks and the stored root pair: the remembered contact, the jump test, the
+/// walk. `result` holds what the query did so far and receives its answer; `overlapping_root`, when given,
+/// is the stored root pair the caller tested and found overlapping (apart at the last query, not now).
+template <TreeVolume BV, class Leaves>
+void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, CoherentState& state,
+                      ContactMode mode, const Leaves& leaves, Result& result,
+                      const typename FrontWalk<BV, Leaves>::Pair* overlapping_root) {
   // What the query costs decides where the next ones start (CoherenceOptions::judge): the clock is read only
   // when that cost is the time.
   using Clock = std::chrono::steady_clock;
@@ -230,12 +229,9 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   const auto seconds = [&] {
     return timed ? std::chrono::duration<double>(Clock::now() - start).count() : 0.0;
   };
-  const CoherentState::InUse in_use(state);
-  coherent_detail::attach(state, a, b);
-  state.serve(CoherentState::Use::Exact);
   // The cold query's answer, with what this query spent before it, recorded as a query from the root.
   // Objects it found apart at the root pair leave that pair as the stored tree: the next query tests it
-  // alone (root_apart below), as after a walk that found the same.
+  // alone (query_exact_coherent), as after a walk that found the same.
   const auto cold_answer = [&](const Counters& spent) {
     Result cold_result = exact_traversal(a, b, b_to_a, mode, leaves);
     const Counters& own = cold_result.counters;
@@ -248,7 +244,10 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   // In a cold turn (the front cost more than starting from the root) neither the contact nor the front is
   // tried: the query is the cold one, but for the turn's last, a walk from the root that leaves its front.
   const bool cold = state.cold_turns_left() > 0;
-  if (state.cold_turns_left() > 1) return cold_answer({});
+  if (state.cold_turns_left() > 1) {
+    result = cold_answer({});
+    return;
+  }
   // With nothing stored (the poses jumped before, or the state is new) there is no remembered contact or root
   // pair to try first: the jump is judged before the traversal's set-up, so that while the poses keep
   // jumping the cold query answers at little more than its own cost. A new state's first query counts as one
@@ -258,38 +257,23 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
     jumped = state.jumped(b_to_a);
     if (*jumped && state.jumping_on()) {
       state.forget_front(b_to_a);
-      return cold_answer({});
+      result = cold_answer({});
+      return;
     }
   }
-  Result result;
-  result.exact = true;
-  if (a.empty() || b.empty()) return result;
+  if (a.empty() || b.empty()) return;
   if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "coherent exact query");
   const auto context = VolumeWalker<BV>::make_context(b_to_a);
   const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
-  using Walk = coherent_detail::FrontWalk<BV, Leaves>;
+  using Walk = FrontWalk<BV, Leaves>;
   typename Walk::Hooks hooks(trees, result, mode);
   if (!cold && mode == ContactMode::First && state.witness) {
     const auto [i, j] = *state.witness;
     if (hooks.leaf_pair(typename Walk::Pair{{}, i, j, {}, {}, {}}) == Step::Decided) {
       state.count_witness_hit();
       state.record_cost(result.counters, seconds(), CoherentState::Start::Front);
-      return result;
+      return;
     }
-  }
-  // Objects apart at the last query: walking the stored tree is testing the root pair, so it is tested
-  // directly, without the walk's bookkeeping; a root pair that overlaps now is walked from there. An answer
-  // from the root pair alone is what a query from the root would give at the same cost: it is not recorded
-  // as the front's cost (record_cost), which compares walks with queries from the root.
-  std::optional<typename Walk::Pair> overlapping_root;
-  if (!cold && state.root_apart()) {
-    ++result.counters.nodes_visited;
-    const auto root = trees.template root<typename Walk::Pair>();
-    if (!trees.overlap(root)) {
-      state.restamp(b_to_a);
-      return result;
-    }
-    overlapping_root = root;
   }
   // A pose that jumped from the last query's: no front of there pays here. After a query that did not
   // jump, the walk starts from the root and leaves a front for the steps that follow. While the poses keep
@@ -298,19 +282,55 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   if (!jumped) jumped = !cold && state.jumped(b_to_a);
   if (*jumped && state.jumping_on()) {
     state.forget_front(b_to_a);
-    return cold_answer(result.counters);  // with the remembered contact's or the root pair's test, if made
+    result = cold_answer(result.counters);  // with the remembered contact's or the root pair's test, if made
+    return;
   }
   const bool from_front = !cold && !*jumped && !state.pairs().empty();
   if (!from_front) state.pairs().clear();
   std::vector<FrontPair>& next = state.spare();
   Walk walk(trees, state.pairs(), next, hooks, state.options().raise_hold);
-  state.witness = walk.run(overlapping_root ? &*overlapping_root : nullptr);
+  state.witness = walk.run(overlapping_root);
   // A contact ends the walk early; the tree it built is still a cut of every pair (each pair not reached yet
   // is a front pair there, to be tested), so the next query starts from it rather than from the root.
   const std::size_t written = next.size();
   state.store(next, b_to_a);
   state.record_cost(result.counters, seconds(),
                     from_front ? CoherentState::Start::Front : CoherentState::Start::Root, written);
+}
+
+}  // namespace coherent_detail
+
+/// Exact first-contact (or all-contacts) query that starts from `state`, the memory of the previous queries
+/// on the same two trees (traversal/coherent_state.hpp), and leaves its own there. Answers, witnesses and
+/// contacts are those of query_exact; the counters say what this query tested. Throws std::invalid_argument
+/// for a non-rigid pose or a state made for other trees, std::logic_error for a state another query is
+/// using. The trees are read only: any number of states may share them, one per caller.
+template <TreeVolume BV, class Leaves = TriangleLeaves>
+Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
+                            CoherentState& state, ContactMode mode = ContactMode::First,
+                            const Leaves& leaves = kTriangleLeaves) {
+  check_exact_query<Leaves>(b_to_a, mode);
+  const CoherentState::InUse in_use(state);
+  coherent_detail::attach(state, a, b);
+  state.serve(CoherentState::Use::Exact);
+  Result result;  // every path returns it: a Result moved costs about what the root pair's test does
+  result.exact = true;
+  // Objects apart at the last query (which remembers no contact then): walking the stored tree is testing
+  // the root pair, so it is tested first, before the rest of the set-up, as the cold query would test it.
+  // Apart still, that is the answer, at about the cold query's cost, and not recorded as the front's
+  // (record_cost compares walks with queries from the root); overlapping now, it is walked from there.
+  if (state.root_apart() && state.cold_turns_left() == 0) {
+    const auto context = VolumeWalker<BV>::make_context(b_to_a);
+    const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
+    ++result.counters.nodes_visited;
+    const auto root = trees.template root<typename coherent_detail::FrontWalk<BV, Leaves>::Pair>();
+    if (trees.overlap(root))
+      coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result, &root);
+    else
+      state.restamp(b_to_a);
+    return result;
+  }
+  coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result, nullptr);
   return result;
 }
 
