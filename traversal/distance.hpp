@@ -121,6 +121,8 @@ class DistanceHooks {
     stopped_ = true;
     // An empty queue here means the budget refused the root's test: nothing is known.
     unexamined_bound_ = queue.empty() ? 0 : bound_of(queue.top().key);
+    if (!queue.empty() && !(nearest_.distance < std::numeric_limits<double>::infinity()))
+      measure_below(queue.top());
   }
 
   [[nodiscard]] bool stopped() const { return stopped_; }
@@ -144,13 +146,26 @@ class DistanceHooks {
     return trees_.counters.bv_tests >= kDiveShare * dive_tests_;
   }
 
+  /// Measures a leaf pair below `p`, reached through the trees' topology alone (the budget allows no more BV
+  /// tests): a search stopped before any leaf pair still answers a finite upper end, near where it was.
+  void measure_below(const Pair& p) {
+    std::uint32_t i = p.a, j = p.b;
+    while (!trees_.a.node(i).is_leaf()) i = trees_.a.node(i).left();
+    while (!trees_.b.node(j).is_leaf()) j = trees_.b.node(j).left();
+    distance_detail::nearer_triangles(trees_, i, j, nearest_);
+  }
+
   /// From `p` into the child pair of smallest bound, down to a leaf pair, whose triangles are measured;
-  /// stops where the budget's cap does.
+  /// where the budget's cap stops it on the way, it finishes by the topology (measure_below).
   void dive(Pair p) {
     while (!trees_.is_leaf_pair(p)) {
       NearestChild children{*this};
-      if (!SplitLarger::expand(trees_, p, children) || !(children.bound < nearest_.distance)) return;
-      p = children.pair;
+      const bool expanded = SplitLarger::expand(trees_, p, children);
+      if (children.bound < nearest_.distance)
+        p = children.pair;
+      else if (expanded)
+        return;                                // no child is nearer than the best pair found
+      if (!expanded) return measure_below(p);  // the cap ran out on the way down
     }
     distance_detail::nearer_triangles(trees_, p.a, p.b, nearest_);
   }

@@ -122,6 +122,24 @@ TYPED_TEST(DistanceQuery, AStoppedIntervalKeepsEveryAncestorsBound) {
   EXPECT_GT(raised, 0);  // the search lifts the lower end on some poses
 }
 
+TYPED_TEST(DistanceQuery, AStoppedSearchAnswersAFiniteUpperEndOnSurfacePoints) {
+  // Even a budget spent before any leaf pair answers a pair of points on the two surfaces: the upper end is
+  // their distance, not infinity.
+  for (const RigidTransform& pose : this->poses()) {
+    for (std::uint64_t cap : {1, 2, 3, 5}) {
+      const DistanceResult r = query_distance_anytime(this->tree_a, this->tree_b, pose, Budget{cap, 0});
+      ASSERT_TRUE(std::isfinite(r.distance)) << "cap " << cap;
+      ASSERT_TRUE(r.triangles.has_value());
+      const TrianglePoints tb = this->b.triangle(r.triangles->b);
+      const TrianglePoints moved = {pose.apply(tb[0]), pose.apply(tb[1]), pose.apply(tb[2])};
+      EXPECT_LT(off_triangle(r.on_a, this->a.triangle(r.triangles->a)), 1e-12);
+      EXPECT_LT(off_triangle(r.on_b, moved), 1e-12);
+      EXPECT_NEAR((r.on_a - r.on_b).norm(), r.distance, 1e-12);
+      EXPECT_LE(r.counters.bv_tests, cap);
+    }
+  }
+}
+
 TYPED_TEST(DistanceQuery, WithinToleranceAgreesWithTheDistance) {
   for (const RigidTransform& pose : this->poses()) {
     const double d = query_distance(this->tree_a, this->tree_b, pose).distance;
