@@ -78,8 +78,8 @@ bool nearer_triangles(const TreePair<BV>& trees, std::uint32_t i, std::uint32_t 
 /// after every pair of smaller bound, which a small budget does not allow; the dives cost a few tests per
 /// level, counted and capped. Under a cap of BV tests, its last four dives' worth of tests (all of a small
 /// cap) hold one dive, taken when only a dive's tests are left, from the nearest pair the search reached.
-/// A pair's bound is at least its parent's (its triangles are some of the parent's), which keeps the lower
-/// end of a stopped search at every ancestor's bound where a child's volumes bound it looser.
+/// Under a budget, a pair's bound is at least its parent's (its triangles are some of the parent's), which
+/// keeps the lower end of a stopped search at every ancestor's bound where a child's volumes bound it looser.
 template <DistanceVolume BV, class Limit = Unlimited>
 class DistanceHooks {
  public:
@@ -94,21 +94,23 @@ class DistanceHooks {
                                           trees_.context, nearest_.distance);
   }
   [[gnu::always_inline]] Admission admit(Pair& p, double bound) {
-    bound = std::max(bound, floor_);
+    if constexpr (!Limit::never_stops) bound = std::max(bound, floor_);  // only a stopped search reads it
     if (bound >= nearest_.distance) return Admission::Drop;
     p.key = bound > 0 ? -bound : ++overlapping_;
     return Admission::Queue;
   }
   /// Every pair still queued is at least as far as this one: none can hold a nearer triangle pair.
   [[gnu::always_inline]] Step taken(const Pair& p) {
-    floor_ = bound_of(p.key);
-    if (floor_ >= nearest_.distance) return Step::Decided;
-    if constexpr (!Limit::never_stops)
+    const double bound = bound_of(p.key);
+    if (bound >= nearest_.distance) return Step::Decided;
+    if constexpr (!Limit::never_stops) {
+      floor_ = bound;
       if (dive_due()) {
         const std::uint64_t before = trees_.counters.bv_tests;
         dive(p);
         dive_tests_ += trees_.counters.bv_tests - before + 1;
       }
+    }
     return Step::Continue;
   }
   [[gnu::always_inline]] Step leaf_pair(const Pair& p) {
@@ -121,8 +123,7 @@ class DistanceHooks {
     stopped_ = true;
     // An empty queue here means the budget refused the root's test: nothing is known.
     unexamined_bound_ = queue.empty() ? 0 : bound_of(queue.top().key);
-    if (!queue.empty() && !(nearest_.distance < std::numeric_limits<double>::infinity()))
-      measure_below(queue.top());
+    if (!queue.empty() && !std::isfinite(nearest_.distance)) measure_below(queue.top());
   }
 
   [[nodiscard]] bool stopped() const { return stopped_; }
@@ -161,11 +162,11 @@ class DistanceHooks {
     while (!trees_.is_leaf_pair(p)) {
       NearestChild children{*this};
       const bool expanded = SplitLarger::expand(trees_, p, children);
-      if (children.bound < nearest_.distance)
-        p = children.pair;
-      else if (expanded)
-        return;                                // no child is nearer than the best pair found
-      if (!expanded) return measure_below(p);  // the cap ran out on the way down
+      const bool nearer = children.bound < nearest_.distance;
+      // The cap ran out on the way down: on by the topology, from the nearest child tested if any.
+      if (!expanded) return measure_below(nearer ? children.pair : p);
+      if (!nearer) return;  // no child is nearer than the best pair found
+      p = children.pair;
     }
     distance_detail::nearer_triangles(trees_, p.a, p.b, nearest_);
   }
@@ -195,7 +196,7 @@ class DistanceHooks {
       Limit::never_stops ? 0 : 2 * (trees_.a.stats().depth + trees_.b.stats().depth);
   bool last_dive_due_ = true;  ///< the dive kept for when the cap's last reserve is reached
   double overlapping_ = 0;     ///< bound-0 pairs admitted so far: their keys
-  double floor_ = 0;           ///< the bound of the pair being expanded: its children are no nearer
+  double floor_ = 0;           ///< under a budget, the bound of the pair expanded: its children are no nearer
   bool stopped_ = false;
   double unexamined_bound_ = std::numeric_limits<double>::infinity();
 };

@@ -37,6 +37,15 @@ class DistanceQuery : public ::testing::Test {
   Mesh b = testing::make_random_soup(100, 0.15, 3);
   Bvh<BV> tree_a = Bvh<BV>::build(a);
   Bvh<BV> tree_b = Bvh<BV>::build(b);
+  /// The reported points lie on the named triangles (B's moved by `pose`) and are as far apart as reported.
+  void expect_points_on_named_triangles(const DistanceResult& r, const RigidTransform& pose) const {
+    ASSERT_TRUE(r.triangles.has_value());
+    const TrianglePoints tb = b.triangle(r.triangles->b);
+    const TrianglePoints moved = {pose.apply(tb[0]), pose.apply(tb[1]), pose.apply(tb[2])};
+    EXPECT_LT(off_triangle(r.on_a, a.triangle(r.triangles->a)), 1e-12);
+    EXPECT_LT(off_triangle(r.on_b, moved), 1e-12);
+    EXPECT_NEAR((r.on_a - r.on_b).norm(), r.distance, 1e-12);
+  }
   /// Poses from deep overlap to a few object sizes apart.
   std::vector<RigidTransform> poses() const {
     std::mt19937_64 rng(17);
@@ -64,12 +73,7 @@ TYPED_TEST(DistanceQuery, FindsTheNearestTrianglePairWithItsPoints) {
     ASSERT_FALSE(r.budget_exhausted);
     ASSERT_EQ(r.lower_bound, r.distance);
     ASSERT_TRUE(r.triangles.has_value());
-    // The points lie on the named triangles and are as far apart as reported.
-    const TrianglePoints tb = this->b.triangle(r.triangles->b);
-    const TrianglePoints moved = {pose.apply(tb[0]), pose.apply(tb[1]), pose.apply(tb[2])};
-    EXPECT_LT(off_triangle(r.on_a, this->a.triangle(r.triangles->a)), 1e-12);
-    EXPECT_LT(off_triangle(r.on_b, moved), 1e-12);
-    EXPECT_NEAR((r.on_a - r.on_b).norm(), r.distance, 1e-12);
+    this->expect_points_on_named_triangles(r, pose);
     // Distance 0 exactly when the exact intersection query finds a contact.
     EXPECT_EQ(r.distance == 0, query_exact(this->tree_a, this->tree_b, pose).collides);
     (r.distance == 0 ? touching : apart) += 1;
@@ -130,11 +134,7 @@ TYPED_TEST(DistanceQuery, AStoppedSearchAnswersAFiniteUpperEndOnSurfacePoints) {
       const DistanceResult r = query_distance_anytime(this->tree_a, this->tree_b, pose, Budget{cap, 0});
       ASSERT_TRUE(std::isfinite(r.distance)) << "cap " << cap;
       ASSERT_TRUE(r.triangles.has_value());
-      const TrianglePoints tb = this->b.triangle(r.triangles->b);
-      const TrianglePoints moved = {pose.apply(tb[0]), pose.apply(tb[1]), pose.apply(tb[2])};
-      EXPECT_LT(off_triangle(r.on_a, this->a.triangle(r.triangles->a)), 1e-12);
-      EXPECT_LT(off_triangle(r.on_b, moved), 1e-12);
-      EXPECT_NEAR((r.on_a - r.on_b).norm(), r.distance, 1e-12);
+      this->expect_points_on_named_triangles(r, pose);
       EXPECT_LE(r.counters.bv_tests, cap);
     }
   }
