@@ -15,7 +15,8 @@
 //   3. raises: an inner pair whose children are all disjoint again is tested itself, and if disjoint becomes
 //      one front pair (so objects moving apart end up with their root pair alone). A parent that still
 //      overlaps is not tested again for CoherenceOptions::raise_hold queries.
-// While the stored tree is the root pair alone, step 2 is the root pair's test, made without the walk.
+// While the stored tree is the root pair alone, step 2 is the root pair's test, made without the walk; a
+// deeper stored tree without a contact is tested at its root pair first too, while that pays.
 // The answer is exact whatever the state holds: "no contact" only when every front pair was found disjoint
 // or without contact at the current pose, "contact" only with a triangle pair intersecting at it. The state
 // starts from the root after a pose jump or when its tree grew past max_pairs; while the poses keep jumping,
@@ -214,6 +215,39 @@ class FrontWalk {
 
 namespace coherent_detail {
 
+/// The exact query's hooks, noting the leaf pair of the first contact.
+template <TreeVolume BV, class Leaves>
+class ContactNotingHooks : public ExactHooks<BV, QueuedPair<BV>, Leaves> {
+  using Base = ExactHooks<BV, QueuedPair<BV>, Leaves>;
+
+ public:
+  using Base::Base;
+  [[gnu::always_inline]] Step leaf_pair(const typename Base::Pair& p) {
+    const Step step = Base::leaf_pair(p);
+    if (step == Step::Decided) contact = LeafPair{p.a, p.b};
+    return step;
+  }
+  std::optional<LeafPair> contact;
+};
+
+/// exact_traversal, with the leaf pair of the first contact (first-contact mode) in `contact`.
+template <TreeVolume BV, class Leaves>
+Result exact_traversal_noting_contact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
+                                      ContactMode mode, const Leaves& leaves,
+                                      std::optional<LeafPair>& contact) {
+  Result result;
+  result.exact = true;
+  if (a.empty() || b.empty()) return result;
+  if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "exact query");
+  const auto context = VolumeWalker<BV>::make_context(b_to_a);
+  const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
+  ContactNotingHooks<BV, Leaves> hooks(trees, result, mode);
+  Unlimited limit;
+  traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
+  contact = hooks.contact;
+  return result;
+}
+
 /// query_exact_coherent past its checks and the stored root pair: the remembered contact, the jump test, the
 /// walk. `result` holds what the query did so far and receives its answer; `overlapping_root`, when given,
 /// is the stored root pair the caller tested and found overlapping (apart at the last query, not now).
@@ -231,21 +265,27 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
   };
   // The cold query's answer, with what this query spent before it, recorded as a query from the root.
   // Objects it found apart at the root pair leave that pair as the stored tree: the next query tests it
-  // alone (query_exact_coherent), as after a walk that found the same.
-  const auto cold_answer = [&](const Counters& spent) {
-    Result cold_result = exact_traversal(a, b, b_to_a, mode, leaves);
+  // alone (query_exact_coherent), as after a walk that found the same. In a cold turn its contact's leaf
+  // pair is remembered, to be tried first by the next query; while the poses keep jumping it is not.
+  const auto cold_answer = [&](const Counters& spent, bool keep_contact) {
+    std::optional<LeafPair> contact;
+    Result cold_result = exact_traversal_noting_contact(a, b, b_to_a, mode, leaves, contact);
     const Counters& own = cold_result.counters;
     if (!cold_result.collides && own.bv_tests == 1 && own.triangle_tests == 0) state.store_root_apart(b_to_a);
     cold_result.counters += spent;
-    state.witness.reset();
+    state.witness = keep_contact ? contact : std::nullopt;
     state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
     return cold_result;
   };
-  // In a cold turn (the front cost more than starting from the root) neither the contact nor the front is
-  // tried: the query is the cold one, but for the turn's last, a walk from the root that leaves its front.
+  // In a cold turn (the front cost more than starting from the root) the front is not walked: the query is
+  // the cold one, but for the turn's last, a walk from the root that leaves its front. The remembered
+  // contact is still tried first (where contact persists, a fifth to a half of the cold turns' queries on
+  // the pipes at 2.9 degrees a step; bench/RESULTS.md, "Contacts kept through cold turns").
   const bool cold = state.cold_turns_left() > 0;
-  if (state.cold_turns_left() > 1) {
-    result = cold_answer({});
+  const bool cold_only = state.cold_turns_left() > 1;
+  const bool try_contact = mode == ContactMode::First && state.witness.has_value();
+  if (cold_only && !try_contact) {
+    result = cold_answer({}, true);
     return;
   }
   // With nothing stored (the poses jumped before, or the state is new) there is no remembered contact or root
@@ -257,7 +297,7 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
     jumped = state.jumped(b_to_a);
     if (*jumped && state.jumping_on()) {
       state.forget_front(b_to_a);
-      result = cold_answer({});
+      result = cold_answer({}, false);
       return;
     }
   }
@@ -267,13 +307,21 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
   const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
   using Walk = FrontWalk<BV, Leaves>;
   typename Walk::Hooks hooks(trees, result, mode);
-  if (!cold && mode == ContactMode::First && state.witness) {
+  if (try_contact) {
     const auto [i, j] = *state.witness;
     if (hooks.leaf_pair(typename Walk::Pair{{}, i, j, {}, {}, {}}) == Step::Decided) {
       state.count_witness_hit();
-      state.record_cost(result.counters, seconds(), CoherentState::Start::Front);
+      // A hit in a cold turn takes the turn's place: what it cost is neither a walk's nor a cold query's.
+      if (cold)
+        state.skip_cold_turn();
+      else
+        state.record_cost(result.counters, seconds(), CoherentState::Start::Front);
       return;
     }
+  }
+  if (cold_only) {
+    result = cold_answer(result.counters, true);  // with the remembered contact's test
+    return;
   }
   // A pose that jumped from the last query's: no front of there pays here. After a query that did not
   // jump, the walk starts from the root and leaves a front for the steps that follow. While the poses keep
@@ -282,7 +330,7 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
   if (!jumped) jumped = !cold && state.jumped(b_to_a);
   if (*jumped && state.jumping_on()) {
     state.forget_front(b_to_a);
-    result = cold_answer(result.counters);  // with the remembered contact's or the root pair's test, if made
+    result = cold_answer(result.counters, false);  // with the remembered contact's or the root pair's test
     return;
   }
   const bool from_front = !cold && !*jumped && !state.pairs().empty();
@@ -319,15 +367,30 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   // the root pair, so it is tested first, before the rest of the set-up, as the cold query would test it.
   // Apart still, that is the answer, at about the cold query's cost, and not recorded as the front's
   // (record_cost compares walks with queries from the root); overlapping now, it is walked from there.
-  if (state.root_apart() && state.cold_turns_left() == 0) {
+  // A deeper stored tree without a contact is tested at its root pair first too, while that pays
+  // (CoherentState::root_check_due): objects moving apart leave a front that rises back to the root pair
+  // only level by level, each level held for raise_hold queries, and walking it cost up to 14 times the
+  // root pair's test (bench/RESULTS.md, "The root pair before a stored front").
+  const bool root_apart = state.root_apart();
+  if (state.cold_turns_left() == 0 &&
+      (root_apart || (!state.witness && !state.pairs().empty() && state.root_check_due()))) {
     const auto context = VolumeWalker<BV>::make_context(b_to_a);
     const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
     ++result.counters.nodes_visited;
     const auto root = trees.template root<typename coherent_detail::FrontWalk<BV, Leaves>::Pair>();
-    if (trees.overlap(root))
-      coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result, &root);
-    else
-      state.restamp(b_to_a);
+    const bool apart = !trees.overlap(root);
+    if (!root_apart) state.root_checked(apart);
+    if (apart) {
+      // A cut of every triangle pair at this pose, as the cold query would leave it.
+      if (root_apart)
+        state.restamp(b_to_a);
+      else
+        state.store_root_apart(b_to_a);
+      return result;
+    }
+    // Overlapping: from the root pair just tested where it was the stored tree, else the stored tree.
+    coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result,
+                                      root_apart ? &root : nullptr);
     return result;
   }
   coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result, nullptr);

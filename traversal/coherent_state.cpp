@@ -34,6 +34,7 @@ void CoherentState::reset() {
   front_cost_ = root_cost_ = -1;
   cold_left_ = 0;
   cold_run_ = 2;
+  root_backoff_ = root_wait_ = 0;
 }
 
 std::size_t CoherentState::front_size() const {

@@ -6,6 +6,7 @@
 #include "../volumes/geometry.hpp"
 #include "result.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -170,10 +171,29 @@ class CoherentState {
     use_ = use;
   }
   void count_witness_hit() { ++witness_hits_; }
+  /// Whether a query with a stored tree deeper than the root pair, and no remembered contact, tests the root
+  /// pair first (traversal/coherent.hpp): yes, unless that test found the root pair overlapping lately.
+  /// Each such test waits twice as many queries as the last (1, 2, 4, up to 64) until one finds it apart,
+  /// so where the objects' root volumes keep overlapping it costs at most a test in 64 queries.
+  [[nodiscard]] bool root_check_due() {
+    if (root_wait_ == 0) return true;
+    --root_wait_;
+    return false;
+  }
+  /// What the root pair's test of root_check_due found.
+  void root_checked(bool apart) {
+    root_backoff_ = apart ? 0 : std::min<std::uint8_t>(64, root_backoff_ == 0 ? 1 : 2 * root_backoff_);
+    root_wait_ = root_backoff_;
+  }
   /// While the front lost its last comparison with queries from the root: the queries of that run still to
   /// go (this one included). They start from the root; the last one builds the front the next walk starts
   /// from.
   [[nodiscard]] std::uint32_t cold_turns_left() const { return cold_left_; }
+  /// A query of a cold turn answered otherwise (by the remembered contact): one turn fewer to go, but for
+  /// the turn's last, which builds the front and waits for a query that needs it.
+  void skip_cold_turn() {
+    if (cold_left_ > 1) --cold_left_;
+  }
   /// How a query started, for record_cost.
   enum class Start : std::uint8_t { Front, Root };
   /// Records one query's cost (its seconds or its work: CoherenceOptions::judge) and decides whether the
@@ -200,6 +220,7 @@ class CoherentState {
   double front_cost_ = -1, root_cost_ = -1;
   std::uint32_t cold_left_ = 0;  ///< queries from the root still to run before the front is tried again
   std::uint32_t cold_run_ = 2;   ///< the length of the next such run
+  std::uint8_t root_backoff_ = 0, root_wait_ = 0;  ///< root_check_due: the current wait, the queries left
   /// The state this thread holds (InUse), if any.
   static inline thread_local const CoherentState* held_here_ = nullptr;
   /// Set while a query uses the state; a copy of the state is not in use.

@@ -148,6 +148,41 @@ TEST(Coherent, ANewStateStartsWithTheColdQuery) {
   }
 }
 
+// A stored tree deeper than the root pair, without a contact, is tested at its root pair first: objects
+// that moved apart are answered by that one test, and the root pair alone is stored.
+TEST_F(ClearOfContact, ObjectsThatMovedApartAreAnsweredAtTheRootPair) {
+  CoherentState steady{CoherenceOptions{.max_jump = 1e9, .max_cold_run = 0}};  // never a jump, never cold
+  ASSERT_FALSE(query_exact_coherent(a, b, pose, steady).collides);             // the cold one
+  ASSERT_FALSE(query_exact_coherent(a, b, pose, steady).collides);             // the walk from the root
+  ASSERT_GT(steady.front_size(), 10u);
+  pose.translation.x() = 5.0;
+  const Result apart = query_exact_coherent(a, b, pose, steady);
+  EXPECT_FALSE(apart.collides);
+  EXPECT_EQ(apart.counters.bv_tests, 1u);
+  EXPECT_EQ(apart.counters.nodes_visited, 1u);
+  EXPECT_TRUE(steady.root_apart());
+}
+
+// Where the root pair keeps overlapping, its test waits 1, 2, 4 ... up to 64 queries after each one that
+// found it so; one that finds it apart makes the next due at once.
+TEST(Coherent, TheRootPairsTestBacksOffWhileItOverlaps) {
+  CoherentState state;
+  EXPECT_TRUE(state.root_check_due());
+  int expected = 1;
+  for (int k = 0; k < 9; ++k) {
+    state.root_checked(false);
+    int skipped = 0;
+    while (!state.root_check_due() && skipped < 1000) ++skipped;
+    EXPECT_EQ(skipped, expected) << k;
+    expected = std::min(64, 2 * expected);
+  }
+  state.root_checked(true);
+  EXPECT_TRUE(state.root_check_due());
+  state.root_checked(false);
+  state.reset();
+  EXPECT_TRUE(state.root_check_due());
+}
+
 TEST(Coherent, ARepeatedContactIsAnsweredByItsWitness) {
   const auto a = Bvh<Aabb>::build(torus());
   const auto b = Bvh<Aabb>::build(soup());
@@ -162,6 +197,39 @@ TEST(Coherent, ARepeatedContactIsAnsweredByItsWitness) {
   EXPECT_EQ(again.witness, first.witness);
   EXPECT_EQ(again.counters.bv_tests, 0u);
   EXPECT_EQ(state.witness_hits(), 1u);
+}
+
+// In a cold turn (the front lost to queries from the root) the remembered contact is still tried first, and
+// a cold answer's contact is remembered for the next query.
+TEST(Coherent, AColdTurnKeepsTheRememberedContact) {
+  const auto a = Bvh<Aabb>::build(torus());
+  const auto b = Bvh<Aabb>::build(soup());
+  CoherentState state;
+  const RigidTransform pose = RigidTransform::translate(Vec3(0.7, 0, 0));
+  ASSERT_TRUE(query_exact_coherent(a, b, pose, state).collides);  // cold, a new state's first query
+  ASSERT_TRUE(query_exact_coherent(a, b, pose, state).collides);  // the walk from the root
+  ASSERT_TRUE(state.witness.has_value());
+  Counters costly;  // a walk far costlier than the cold query: a cold turn of two queries begins
+  costly.bv_tests = 1'000'000;
+  state.record_cost(costly, 0, CoherentState::Start::Front);
+  ASSERT_EQ(state.cold_turns_left(), 2u);
+  const Result by_contact = query_exact_coherent(a, b, pose, state);
+  EXPECT_TRUE(by_contact.collides);
+  EXPECT_EQ(by_contact.counters.bv_tests, 0u);
+  EXPECT_EQ(state.witness_hits(), 1u);
+  EXPECT_EQ(state.cold_turns_left(), 1u);  // the hit took a turn's place
+  // Without a contact to try, the cold query answers and its contact is remembered.
+  state.witness.reset();
+  state.record_cost(costly, 0, CoherentState::Start::Front);
+  ASSERT_GT(state.cold_turns_left(), 1u);
+  const std::uint32_t turns = state.cold_turns_left();
+  const Result cold = query_exact_coherent(a, b, pose, state);
+  EXPECT_TRUE(cold.collides);
+  EXPECT_GT(cold.counters.bv_tests, 0u);
+  EXPECT_EQ(state.cold_turns_left(), turns - 1);
+  ASSERT_TRUE(state.witness.has_value());
+  EXPECT_EQ(query_exact_coherent(a, b, pose, state).counters.bv_tests, 0u);
+  EXPECT_EQ(state.witness_hits(), 2u);
 }
 
 /// The stored pairs marked as leading to the remembered contact: a chain from the root pair to the contact's
