@@ -230,22 +230,14 @@ class ContactNotingHooks : public ExactHooks<BV, QueuedPair<BV>, Leaves> {
   std::optional<LeafPair> contact;
 };
 
-/// exact_traversal, with the leaf pair of the first contact (first-contact mode) in `contact`.
+/// The exact query past its checks, with the leaf pair of the first contact (first-contact mode) in
+/// `contact`.
 template <TreeVolume BV, class Leaves>
 Result exact_traversal_noting_contact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
                                       ContactMode mode, const Leaves& leaves,
                                       std::optional<LeafPair>& contact) {
-  Result result;
-  result.exact = true;
-  if (a.empty() || b.empty()) return result;
-  if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "exact query");
-  const auto context = VolumeWalker<BV>::make_context(b_to_a);
-  const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
-  ContactNotingHooks<BV, Leaves> hooks(trees, result, mode);
-  Unlimited limit;
-  traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
-  contact = hooks.contact;
-  return result;
+  return exact_traversal_with<ContactNotingHooks<BV, Leaves>>(
+      a, b, b_to_a, mode, leaves, [&contact](const auto& hooks) { contact = hooks.contact; });
 }
 
 /// query_exact_coherent past its checks and the stored root pair: the remembered contact, the jump test, the

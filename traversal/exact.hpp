@@ -7,6 +7,7 @@
 
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 namespace bvhlab {
 
@@ -53,20 +54,21 @@ void check_exact_query(const RigidTransform& b_to_a, ContactMode mode) {
       throw std::invalid_argument("all contacts: point surfaces have no triangle pairs to list");
 }
 
-/// query_exact after check_exact_query, for callers that made the checks already (the coherent query's cold
-/// answers).
-template <TreeVolume BV, class Leaves>
-Result exact_traversal(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, ContactMode mode,
-                       const Leaves& leaves) {
+/// query_exact after check_exact_query (for callers that made the checks already), with hooks of the
+/// caller's type (ExactHooks or one built on it); `done` is called with them after the traversal.
+template <class Hooks, TreeVolume BV, class Leaves, class Done>
+Result exact_traversal_with(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
+                            ContactMode mode, const Leaves& leaves, Done&& done) {
   Result result;
   result.exact = true;
   if (a.empty() || b.empty()) return result;
   if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "exact query");
   const auto context = VolumeWalker<BV>::make_context(b_to_a);
   const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
-  ExactHooks<BV, QueuedPair<BV>, Leaves> hooks(trees, result, mode);
+  Hooks hooks(trees, result, mode);
   Unlimited limit;
   traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
+  done(std::as_const(hooks));
   return result;
 }
 
@@ -78,7 +80,8 @@ template <TreeVolume BV, class Leaves = TriangleLeaves>
 Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
                    ContactMode mode = ContactMode::First, const Leaves& leaves = kTriangleLeaves) {
   check_exact_query<Leaves>(b_to_a, mode);
-  return exact_traversal(a, b, b_to_a, mode, leaves);
+  return exact_traversal_with<ExactHooks<BV, QueuedPair<BV>, Leaves>>(a, b, b_to_a, mode, leaves,
+                                                                      [](const auto&) {});
 }
 
 }  // namespace bvhlab
