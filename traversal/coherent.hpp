@@ -31,6 +31,7 @@
 #include <chrono>
 #include <optional>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -230,23 +231,15 @@ class ContactNotingHooks : public ExactHooks<BV, QueuedPair<BV>, Leaves> {
   std::optional<LeafPair> contact;
 };
 
-/// The exact query past its checks, with the leaf pair of the first contact (first-contact mode) in
-/// `contact`.
-template <TreeVolume BV, class Leaves>
-Result exact_traversal_noting_contact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
-                                      ContactMode mode, const Leaves& leaves,
-                                      std::optional<LeafPair>& contact) {
-  return exact_traversal_with<ContactNotingHooks<BV, Leaves>>(
-      a, b, b_to_a, mode, leaves, [&contact](const auto& hooks) { contact = hooks.contact; });
-}
-
 /// query_exact_coherent past its checks and the stored root pair: the remembered contact, the jump test, the
 /// walk. `result` holds what the query did so far and receives its answer; `overlapping_root`, when given,
-/// is the stored root pair the caller tested and found overlapping (apart at the last query, not now).
+/// is the stored root pair the caller tested and found overlapping (apart at the last query, not now);
+/// `tested_with`, the pair of trees the caller made for that test (at this pose, counting into `result`).
 template <TreeVolume BV, class Leaves>
 void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a, CoherentState& state,
                       ContactMode mode, const Leaves& leaves, Result& result,
-                      const typename FrontWalk<BV, Leaves>::Pair* overlapping_root) {
+                      const typename FrontWalk<BV, Leaves>::Pair* overlapping_root,
+                      const std::type_identity_t<TreePair<BV, Leaves>>* tested_with) {
   // What the query costs decides where the next ones start (CoherenceOptions::judge): the clock is read only
   // when that cost is the time.
   using Clock = std::chrono::steady_clock;
@@ -255,19 +248,26 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
   const auto seconds = [&] {
     return timed ? std::chrono::duration<double>(Clock::now() - start).count() : 0.0;
   };
-  // The cold query's answer, with what this query spent before it, recorded as a query from the root.
+  // The cold query's answer, after what this query spent before it, recorded as a query from the root: on
+  // the pair of trees the query made already, if it did (a k-DOP's context costs about 5,100 instructions).
   // Objects it found apart at the root pair leave that pair as the stored tree: the next query tests it
   // alone (query_exact_coherent), as after a walk that found the same. In a cold turn its contact's leaf
   // pair is remembered, to be tried first by the next query; while the poses keep jumping it is not.
-  const auto cold_answer = [&](const Counters& spent, bool keep_contact) {
+  const auto cold_answer = [&](const TreePair<BV, Leaves>* made, bool keep_contact) {
+    const Counters spent = result.counters;
     std::optional<LeafPair> contact;
-    Result cold_result = exact_traversal_noting_contact(a, b, b_to_a, mode, leaves, contact);
-    const Counters& own = cold_result.counters;
-    if (!cold_result.collides && own.bv_tests == 1 && own.triangle_tests == 0) state.store_root_apart(b_to_a);
-    cold_result.counters += spent;
+    const auto note = [&contact](const ContactNotingHooks<BV, Leaves>& hooks) { contact = hooks.contact; };
+    if (made) {
+      traverse_exact<ContactNotingHooks<BV, Leaves>>(*made, result, mode, note);
+    } else {
+      result = exact_traversal_with<ContactNotingHooks<BV, Leaves>>(a, b, b_to_a, mode, leaves, note);
+      result.counters += spent;
+    }
+    const Counters& now = result.counters;
+    if (!result.collides && now.bv_tests == spent.bv_tests + 1 && now.triangle_tests == spent.triangle_tests)
+      state.store_root_apart(b_to_a);
     state.witness = keep_contact ? contact : std::nullopt;
-    state.record_cost(cold_result.counters, seconds(), CoherentState::Start::Root);
-    return cold_result;
+    state.record_cost(now, seconds(), CoherentState::Start::Root);
   };
   // In a cold turn (the front cost more than starting from the root) the front is not walked: the query is
   // the cold one, but for the turn's last, a walk from the root that leaves its front. The remembered
@@ -277,7 +277,7 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
   const bool cold_only = state.cold_turns_left() > 1;
   const bool try_contact = mode == ContactMode::First && state.witness.has_value();
   if (cold_only && !try_contact) {
-    result = cold_answer({}, true);
+    cold_answer(nullptr, true);
     return;
   }
   // With nothing stored (the poses jumped before, or the state is new) there is no remembered contact or root
@@ -289,14 +289,21 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
     jumped = state.jumped(b_to_a);
     if (*jumped && state.jumping_on()) {
       state.forget_front(b_to_a);
-      result = cold_answer({}, false);
+      cold_answer(nullptr, false);
       return;
     }
   }
   if (a.empty() || b.empty()) return;
   if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "coherent exact query");
-  const auto context = VolumeWalker<BV>::make_context(b_to_a);
-  const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
+  // The volumes' context is made once a query: the caller's, where it tested the root pair (a k-DOP's costs
+  // about 5,100 instructions, and most root pairs of a world's candidate pairs overlap).
+  std::optional<typename VolumeWalker<BV>::Context> own_context;
+  std::optional<TreePair<BV, Leaves>> own_trees;
+  if (!tested_with) {
+    own_context.emplace(VolumeWalker<BV>::make_context(b_to_a));
+    own_trees.emplace(a, b, b_to_a, *own_context, result.counters, leaves);
+  }
+  const TreePair<BV, Leaves>& trees = tested_with ? *tested_with : *own_trees;
   using Walk = FrontWalk<BV, Leaves>;
   typename Walk::Hooks hooks(trees, result, mode);
   if (try_contact) {
@@ -312,7 +319,7 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
     }
   }
   if (cold_only) {
-    result = cold_answer(result.counters, true);  // with the remembered contact's test
+    cold_answer(&trees, true);  // after the remembered contact's test
     return;
   }
   // A pose that jumped from the last query's: no front of there pays here. After a query that did not
@@ -322,7 +329,7 @@ void exact_from_state(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& 
   if (!jumped) jumped = !cold && state.jumped(b_to_a);
   if (*jumped && state.jumping_on()) {
     state.forget_front(b_to_a);
-    result = cold_answer(result.counters, false);  // with the remembered contact's or the root pair's test
+    cold_answer(&trees, false);  // after the remembered contact's or the root pair's test
     return;
   }
   const bool from_front = !cold && !*jumped && !state.pairs().empty();
@@ -381,11 +388,11 @@ Result query_exact_coherent(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
       return result;
     }
     // Overlapping: from the root pair just tested where it was the stored tree, else the stored tree.
-    coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result,
-                                      root_apart ? &root : nullptr);
+    coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result, root_apart ? &root : nullptr,
+                                      &trees);
     return result;
   }
-  coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result, nullptr);
+  coherent_detail::exact_from_state(a, b, b_to_a, state, mode, leaves, result, nullptr, nullptr);
   return result;
 }
 

@@ -54,8 +54,18 @@ void check_exact_query(const RigidTransform& b_to_a, ContactMode mode) {
       throw std::invalid_argument("all contacts: point surfaces have no triangle pairs to list");
 }
 
+/// The exact strategy's traversal of `trees` (made for this query, counting into `result`) with hooks of
+/// the caller's type (ExactHooks or one built on it); `done` is called with them when it ends.
+template <class Hooks, TreeVolume BV, class Leaves, class Done>
+void traverse_exact(const TreePair<BV, Leaves>& trees, Result& result, ContactMode mode, Done&& done) {
+  Hooks hooks(trees, result, mode);
+  Unlimited limit;
+  traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
+  done(std::as_const(hooks));
+}
+
 /// query_exact after check_exact_query (for callers that made the checks already), with hooks of the
-/// caller's type (ExactHooks or one built on it); `done` is called with them after the traversal.
+/// caller's type, as traverse_exact.
 template <class Hooks, TreeVolume BV, class Leaves, class Done>
 Result exact_traversal_with(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_to_a,
                             ContactMode mode, const Leaves& leaves, Done&& done) {
@@ -65,10 +75,7 @@ Result exact_traversal_with(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   if constexpr (Leaves::kTriangles) TriangleLeaves::require(a, b, "exact query");
   const auto context = VolumeWalker<BV>::make_context(b_to_a);
   const TreePair<BV, Leaves> trees(a, b, b_to_a, context, result.counters, leaves);
-  Hooks hooks(trees, result, mode);
-  Unlimited limit;
-  traverse<DepthFirst, SplitLarger>(trees, hooks, limit);
-  done(std::as_const(hooks));
+  traverse_exact<Hooks>(trees, result, mode, std::forward<Done>(done));
   return result;
 }
 
