@@ -67,20 +67,8 @@ struct Tables {
   /// finds for -v is the opposite planes of the one for v, with the same coefficients.
   static constexpr std::size_t opposite(std::size_t m) { return m < Axes ? m + Axes : m - Axes; }
 
-  explicit Tables(const DirectionSet<Axes>& set) {
-    for (std::size_t a = 0; a < Axes; ++a) {
-      axes[a] = Vec3(set.raw[a][0], set.raw[a][1], set.raw[a][2]).normalized();
-      normals[a] = axes[a];
-      normals[a + Axes] = -axes[a];
-    }
-    find_vertices();
-    for (Vertex& v : vertices) find_triples(v);
-    // The prototype's circumradius bounds sum(lambda) for unit directions: sum(lambda) is the support of the
-    // prototype in direction v, attained at the chosen vertex.
-    for (const Vertex& v : vertices) max_lambda_sum = std::max(max_lambda_sum, v.position.norm());
-    pair_antipodes();
-    find_edges();
-  }
+  /// Derives the tables of `set` (out of line: the shipped sets are compiled once, below).
+  explicit Tables(const DirectionSet<Axes>& set);
 
   /// A vertex of the prototype that is extremal in direction v (largest v . x): of the first pair (i, i +
   /// half) with the largest |v . x_i|, the one on v's side. Per axis and query, in make_context: a scan of
@@ -179,117 +167,21 @@ struct Tables {
   static constexpr double kCertain = 1e-9;
 
   /// The 3x3 matrix of planes i, j, l's normals in m; false where they are (nearly) dependent.
-  bool independent(std::size_t i, std::size_t j, std::size_t l, Mat3& m) const {
-    m.row(0) = normals[i];
-    m.row(1) = normals[j];
-    m.row(2) = normals[l];
-    return std::abs(m.determinant()) > 1e-6;
-  }
+  bool independent(std::size_t i, std::size_t j, std::size_t l, Mat3& m) const;
   /// The prototype's vertices: every independent triple's common point that satisfies all planes.
-  void find_vertices() {
-    for (std::size_t i = 0; i < kPlanes; ++i)
-      for (std::size_t j = i + 1; j < kPlanes; ++j)
-        for (std::size_t l = j + 1; l < kPlanes; ++l) {
-          Mat3 m;
-          if (!independent(i, j, l, m)) continue;
-          const Vec3 x = m.inverse() * Vec3::Ones();
-          bool feasible = true;
-          for (const Vec3& n : normals) feasible = feasible && n.dot(x) <= 1 + kTolerance;
-          if (!feasible) continue;
-          const bool known = std::any_of(vertices.begin(), vertices.end(),
-                                         [&](const Vertex& v) { return (v.position - x).norm() < 1e-7; });
-          if (!known) vertices.push_back({x, {}});
-        }
-  }
+  void find_vertices();
   /// Every independent triple of the planes through vertex v, with the matrix that gives its coefficients.
-  void find_triples(Vertex& v) const {
-    std::vector<std::uint8_t> active;
-    for (std::size_t m = 0; m < kPlanes; ++m)
-      if (normals[m].dot(v.position) >= 1 - kTolerance) active.push_back(static_cast<std::uint8_t>(m));
-    for (std::size_t i = 0; i < active.size(); ++i)
-      for (std::size_t j = i + 1; j < active.size(); ++j)
-        for (std::size_t l = j + 1; l < active.size(); ++l) {
-          Mat3 m;
-          if (!independent(active[i], active[j], active[l], m)) continue;
-          v.triples.push_back({{active[i], active[j], active[l]}, m.inverse().transpose()});
-        }
-  }
+  void find_triples(Vertex& v) const;
   /// The largest v . x over the vertices is the largest |v . x| over one of each antipodal pair (the
   /// prototype is symmetric about the origin): orders the vertices so that vertex i + half is vertex i's
   /// antipode, and keeps the first half's coordinates side by side. Their antipodes agree to about 1e-16
   /// (each is solved from its own three planes), far inside the tolerance the triples are chosen with.
-  void pair_antipodes() {
-    std::vector<Vertex> first, second;
-    std::vector<bool> paired(vertices.size(), false);
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-      if (paired[i]) continue;
-      std::size_t j = i + 1;
-      while (j < vertices.size() &&
-             (paired[j] || (vertices[i].position + vertices[j].position).norm() > 1e-7))
-        ++j;
-      if (j == vertices.size()) throw std::logic_error("k-DOP prototype: a vertex without its antipode");
-      paired[i] = paired[j] = true;
-      first.push_back(vertices[i]);
-      second.push_back(vertices[j]);
-    }
-    half = first.size();
-    vertices = std::move(first);
-    vertices.insert(vertices.end(), second.begin(), second.end());
-    for (std::size_t i = 0; i < half + half % 2; ++i) {
-      const Vec3& x = vertices[std::min(i, half - 1)].position;
-      xs.push_back(x[0]);
-      ys.push_back(x[1]);
-      zs.push_back(x[2]);
-    }
-  }
+  void pair_antipodes();
 
   /// The walk's edges and bin starts, where every vertex is simple. A vertex x of planes T is v's unique
   /// maximum by at least min(lambda) * sum over T of (1 - n_k . y) against any other vertex y; the
   /// prototype's smallest such sum, times kCertain, must dwarf the scan's rounding, or there is no walk.
-  void find_edges() {
-    const auto simple = [](const Vertex& v) { return v.triples.size() == 1; };
-    if (vertices.size() > 255 || !std::all_of(vertices.begin(), vertices.end(), simple)) return;
-    std::vector<std::array<std::uint8_t, 3>> edges(vertices.size());
-    double smallest_sum = std::numeric_limits<double>::infinity();
-    for (std::size_t x = 0; x < vertices.size(); ++x) {
-      const auto& own = vertices[x].triples[0].planes;
-      for (int k = 0; k < 3; ++k) {
-        int found = 0;
-        for (std::size_t y = 0; y < vertices.size(); ++y) {
-          const auto& other = vertices[y].triples[0].planes;
-          const auto holds = [&](std::uint8_t p) {
-            return std::find(other.begin(), other.end(), p) != other.end();
-          };
-          if (y == x || !holds(own[(k + 1) % 3]) || !holds(own[(k + 2) % 3])) continue;
-          edges[x][k] = static_cast<std::uint8_t>(y);
-          ++found;
-        }
-        if (found != 1) return;
-      }
-      for (std::size_t y = 0; y < vertices.size(); ++y) {
-        if (y == x) continue;
-        double sum = 0;
-        for (const std::uint8_t p : own) sum += 1 - normals[p].dot(vertices[y].position);
-        smallest_sum = std::min(smallest_sum, sum);
-      }
-    }
-    if (!(kCertain * smallest_sum > 1e-12)) return;
-    // A bin is a triangle of the sphere with corners x, (x + y) / sqrt 2 and (x + y + z) / sqrt 3, the
-    // components in the bin's order of magnitude and with its signs: its centroid's magnitudes by rank.
-    const double by_rank[3] = {1 + std::sqrt(0.5) + std::sqrt(1 / 3.0), std::sqrt(0.5) + std::sqrt(1 / 3.0),
-                               std::sqrt(1 / 3.0)};
-    for (int signs = 0; signs < 8; ++signs)
-      for (int order = 0; order < 8; ++order) {
-        // |v0| < |v1|, |v0| < |v2|, |v1| < |v2|, as direction_bin packs them
-        const bool a_b = order & 1, a_c = order & 2, b_c = order & 4;
-        const int rank[3] = {a_b + a_c, !a_b + b_c, !a_c + !b_c};         // how many components are larger
-        if ((1 << rank[0] | 1 << rank[1] | 1 << rank[2]) != 7) continue;  // no real direction has this order
-        Vec3 centroid;
-        for (int i = 0; i < 3; ++i) centroid[i] = (signs >> i & 1 ? -1 : 1) * by_rank[rank[i]];
-        bin_start[signs * 8 + order] = static_cast<std::uint8_t>(extremal_vertex_scalar(centroid));
-      }
-    across = std::move(edges);
-  }
+  void find_edges();
   /// The walk's 64 bins: the signs of v's components, then the order of their magnitudes.
   static std::size_t direction_bin(const Vec3& v) {
     const double a = std::abs(v[0]), b = std::abs(v[1]), c = std::abs(v[2]);
@@ -305,6 +197,142 @@ struct Tables {
     return along(v, i) < 0 ? i + half : i;
   }
 };
+
+// The tables' derivation (the constructor and its steps), run once per direction set.
+
+template <std::size_t Axes>
+Tables<Axes>::Tables(const DirectionSet<Axes>& set) {
+  for (std::size_t a = 0; a < Axes; ++a) {
+    axes[a] = Vec3(set.raw[a][0], set.raw[a][1], set.raw[a][2]).normalized();
+    normals[a] = axes[a];
+    normals[a + Axes] = -axes[a];
+  }
+  find_vertices();
+  for (Vertex& v : vertices) find_triples(v);
+  // The prototype's circumradius bounds sum(lambda) for unit directions: sum(lambda) is the support of the
+  // prototype in direction v, attained at the chosen vertex.
+  for (const Vertex& v : vertices) max_lambda_sum = std::max(max_lambda_sum, v.position.norm());
+  pair_antipodes();
+  find_edges();
+}
+
+template <std::size_t Axes>
+bool Tables<Axes>::independent(std::size_t i, std::size_t j, std::size_t l, Mat3& m) const {
+  m.row(0) = normals[i];
+  m.row(1) = normals[j];
+  m.row(2) = normals[l];
+  return std::abs(m.determinant()) > 1e-6;
+}
+
+template <std::size_t Axes>
+void Tables<Axes>::find_vertices() {
+  for (std::size_t i = 0; i < kPlanes; ++i)
+    for (std::size_t j = i + 1; j < kPlanes; ++j)
+      for (std::size_t l = j + 1; l < kPlanes; ++l) {
+        Mat3 m;
+        if (!independent(i, j, l, m)) continue;
+        const Vec3 x = m.inverse() * Vec3::Ones();
+        bool feasible = true;
+        for (const Vec3& n : normals) feasible = feasible && n.dot(x) <= 1 + kTolerance;
+        if (!feasible) continue;
+        const bool known = std::any_of(vertices.begin(), vertices.end(),
+                                       [&](const Vertex& v) { return (v.position - x).norm() < 1e-7; });
+        if (!known) vertices.push_back({x, {}});
+      }
+}
+
+template <std::size_t Axes>
+void Tables<Axes>::find_triples(Vertex& v) const {
+  std::vector<std::uint8_t> active;
+  for (std::size_t m = 0; m < kPlanes; ++m)
+    if (normals[m].dot(v.position) >= 1 - kTolerance) active.push_back(static_cast<std::uint8_t>(m));
+  for (std::size_t i = 0; i < active.size(); ++i)
+    for (std::size_t j = i + 1; j < active.size(); ++j)
+      for (std::size_t l = j + 1; l < active.size(); ++l) {
+        Mat3 m;
+        if (!independent(active[i], active[j], active[l], m)) continue;
+        v.triples.push_back({{active[i], active[j], active[l]}, m.inverse().transpose()});
+      }
+}
+
+template <std::size_t Axes>
+void Tables<Axes>::pair_antipodes() {
+  std::vector<Vertex> first, second;
+  std::vector<bool> paired(vertices.size(), false);
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    if (paired[i]) continue;
+    std::size_t j = i + 1;
+    while (j < vertices.size() && (paired[j] || (vertices[i].position + vertices[j].position).norm() > 1e-7))
+      ++j;
+    if (j == vertices.size()) throw std::logic_error("k-DOP prototype: a vertex without its antipode");
+    paired[i] = paired[j] = true;
+    first.push_back(vertices[i]);
+    second.push_back(vertices[j]);
+  }
+  half = first.size();
+  vertices = std::move(first);
+  vertices.insert(vertices.end(), second.begin(), second.end());
+  for (std::size_t i = 0; i < half + half % 2; ++i) {
+    const Vec3& x = vertices[std::min(i, half - 1)].position;
+    xs.push_back(x[0]);
+    ys.push_back(x[1]);
+    zs.push_back(x[2]);
+  }
+}
+
+template <std::size_t Axes>
+void Tables<Axes>::find_edges() {
+  const auto simple = [](const Vertex& v) { return v.triples.size() == 1; };
+  if (vertices.size() > 255 || !std::all_of(vertices.begin(), vertices.end(), simple)) return;
+  std::vector<std::array<std::uint8_t, 3>> edges(vertices.size());
+  double smallest_sum = std::numeric_limits<double>::infinity();
+  for (std::size_t x = 0; x < vertices.size(); ++x) {
+    const auto& own = vertices[x].triples[0].planes;
+    for (int k = 0; k < 3; ++k) {
+      int found = 0;
+      for (std::size_t y = 0; y < vertices.size(); ++y) {
+        const auto& other = vertices[y].triples[0].planes;
+        const auto holds = [&](std::uint8_t p) {
+          return std::find(other.begin(), other.end(), p) != other.end();
+        };
+        if (y == x || !holds(own[(k + 1) % 3]) || !holds(own[(k + 2) % 3])) continue;
+        edges[x][k] = static_cast<std::uint8_t>(y);
+        ++found;
+      }
+      if (found != 1) return;
+    }
+    for (std::size_t y = 0; y < vertices.size(); ++y) {
+      if (y == x) continue;
+      double sum = 0;
+      for (const std::uint8_t p : own) sum += 1 - normals[p].dot(vertices[y].position);
+      smallest_sum = std::min(smallest_sum, sum);
+    }
+  }
+  if (!(kCertain * smallest_sum > 1e-12)) return;
+  // A bin is a triangle of the sphere with corners x, (x + y) / sqrt 2 and (x + y + z) / sqrt 3, the
+  // components in the bin's order of magnitude and with its signs: its centroid's magnitudes by rank.
+  const double by_rank[3] = {1 + std::sqrt(0.5) + std::sqrt(1 / 3.0), std::sqrt(0.5) + std::sqrt(1 / 3.0),
+                             std::sqrt(1 / 3.0)};
+  for (int signs = 0; signs < 8; ++signs)
+    for (int order = 0; order < 8; ++order) {
+      // |v0| < |v1|, |v0| < |v2|, |v1| < |v2|, as direction_bin packs them
+      const bool a_b = order & 1, a_c = order & 2, b_c = order & 4;
+      const int rank[3] = {a_b + a_c, !a_b + b_c, !a_c + !b_c};         // how many components are larger
+      if ((1 << rank[0] | 1 << rank[1] | 1 << rank[2]) != 7) continue;  // no real direction has this order
+      Vec3 centroid;
+      for (int i = 0; i < 3; ++i) centroid[i] = (signs >> i & 1 ? -1 : 1) * by_rank[rank[i]];
+      bin_start[signs * 8 + order] = static_cast<std::uint8_t>(extremal_vertex_scalar(centroid));
+    }
+  across = std::move(edges);
+}
+
+// The shipped sets' derivations are compiled once, in volumes/kdop_tables.cpp, not in every file that uses
+// a k-DOP; another set derives its own where it is used.
+extern template struct Tables<3>;   // 6-DOP
+extern template struct Tables<7>;   // 14-DOP
+extern template struct Tables<9>;   // 18-DOP
+extern template struct Tables<12>;  // 24-DOP
+extern template struct Tables<13>;  // 26-DOP
 
 /// The convex polytope clipped_box_volume cuts down: its faces as point lists, in two buffers that swap at
 /// every cut. Fixed sizes, no allocation: a face gains at most one vertex per cut, so it never has more than
