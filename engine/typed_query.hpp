@@ -320,8 +320,8 @@ struct TreeQueries {
     const Bvh<BV>& bvh_a = a->tree.bvh;
     const Bvh<BV>& bvh_b = b->tree.bvh;
     const SurfaceSide side_a = a->side(), side_b = b->side();
-    const Base& a_tree = *a;
-    const Base& b_tree = *b;
+    const WideLayoutSource<BV>& a_tree = *a;  // not Base: the layout's build stays in the slot file
+    const WideLayoutSource<BV>& b_tree = *b;
     QueryTrees<HierarchyOnly<BV>> trees{std::move(a), std::move(b), {bvh_a}, {bvh_b}, side_a, side_b};
     if constexpr (HasWideLayout<BV>)
       if (variant.wide) {

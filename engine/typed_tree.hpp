@@ -110,9 +110,20 @@ const QueryOps& query_ops() {
   return slot_query_ops<type_index<BV>(RegisteredVolumes{}), type_index<D>(RegisteredDensities{})>();
 }
 
+/// A tree's wide layout, reached apart from its density: the query files call it through this interface,
+/// so that the layout's build is compiled in the tree's slot file alone (a virtual call per prepared query).
+template <class BV>
+class WideLayoutSource {
+ public:
+  [[nodiscard]] virtual const WideForm<BV>& wide_layout() const = 0;
+
+ protected:
+  ~WideLayoutSource() = default;
+};
+
 /// A typed tree, of a mesh or of a point cloud (then with its surface): what a query needs of either.
 template <class BV, class D>
-struct TypedBase : TreeModel {
+struct TypedBase : TreeModel, WideLayoutSource<BV> {
   TypedBase(Tree<BV, D> built, const MeshUnits& units, double build_seconds, double annotate_seconds)
       : tree(std::move(built)), bounds(root_bounds(tree.bvh)) {
     const BvhStats s = tree.bvh.stats();
@@ -178,10 +189,14 @@ struct TypedBase : TreeModel {
   std::optional<RootBounds> bounds;
 
   /// The wide layout of this tree, built on the first wide query and kept with the tree for the next ones.
-  const WideForm<BV>& wide_layout() const {
-    const std::lock_guard lock(wide_mutex_);
-    if (!wide_) wide_ = std::make_unique<const WideForm<BV>>(WideForm<BV>::build(tree.bvh));
-    return *wide_;
+  [[nodiscard]] const WideForm<BV>& wide_layout() const override {
+    if constexpr (HasWideLayout<BV>) {
+      const std::lock_guard lock(wide_mutex_);
+      if (!wide_) wide_ = std::make_unique<const WideForm<BV>>(WideForm<BV>::build(tree.bvh));
+      return *wide_;
+    } else {
+      throw std::invalid_argument(wide_layout_refusal(BV::name()));
+    }
   }
 
  private:
