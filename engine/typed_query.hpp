@@ -8,6 +8,7 @@
 // Internal to engine/.
 #pragma once
 
+#include "engine/errors.hpp"
 #include "engine/typed_tree.hpp"
 #include "traversal/contact_geometry.hpp"
 #include "traversal/surface_leaves.hpp"
@@ -151,7 +152,7 @@ class TypedQuery final : public PreparedQuery {
   /// The coherent query (prepare lets coherent_ be set only for a strategy that has one).
   [[gnu::noinline]] Result query(const RigidTransform& pose, CoherentState& state) const {
     if constexpr (!kRunsCoherent<S>) {
-      throw std::logic_error("strategy " + std::string(S::name()) + " prepared coherent");
+      throw_logic_error({"strategy ", S::name(), " prepared coherent"});
     } else if constexpr (kSurfaces) {
       const SurfaceLeaves<BV> leaves(a().bvh, trees_.side_a, b().bvh, trees_.side_b, pose);
       return S::query_coherent(a(), b(), pose, options_, state, leaves);
@@ -189,7 +190,7 @@ std::unique_ptr<PreparedQuery> make_query(QueryTrees<Held> trees, typename S::Op
     return std::make_unique<TypedQuery<S, BV, Held, true>>(std::move(trees), std::move(options),
                                                            variant.coherent);
   else
-    throw std::logic_error("check_variant let a point cloud's tree through to strategy " + variant.strategy);
+    throw_logic_error({"check_variant let a point cloud's tree through to strategy ", variant.strategy});
 }
 
 /// The queries of the density-free strategies on volume slot V, for trees of any density: compiled in the
@@ -215,7 +216,7 @@ std::unique_ptr<PreparedQuery> DensityFreeQueries<V, kRegistered>::prepare(
           return make_query<S, BV, true>(std::move(trees),
                                          strategy_options<S>(variant.values, variant.budget), variant);
         else
-          throw std::logic_error("strategy " + variant.strategy + " reached the density-free queries");
+          throw_logic_error({"strategy ", variant.strategy, " reached the density-free queries"});
       });
 }
 
@@ -241,8 +242,8 @@ struct TreeQueries {
       if constexpr (!kDensityFree<S> && kAcceptsVolume<S, BV> && S::template accepts<D>)
         out = prepare_typed<S>(std::move(a), std::move(other), variant);
       else
-        throw std::logic_error("check_variant let strategy " + variant.strategy + " through on " +
-                               std::string(BV::name()) + ", " + std::string(D::name()));
+        throw_logic_error(
+            {"check_variant let strategy ", variant.strategy, " through on ", BV::name(), ", ", D::name()});
     });
     return out;
   }
