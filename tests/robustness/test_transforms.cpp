@@ -61,6 +61,33 @@ TEST(CallerTransforms, CheckedAcceptsRotationsUpToRounding) {
   EXPECT_EQ(RigidTransform::checked(r, Vec3::Zero()).rotation, r);
 }
 
+TEST(CallerTransforms, CheckedDecidesAtTheToleranceAndAtTheLimitsOfDouble) {
+  // validate passes plain rotations in one quick pass and sends every other transform through its checks one
+  // by one, which decide: a rotation off by between half the tolerance and the tolerance is accepted, beyond
+  // it refused; a translation whose sum overflows is finite all the same.
+  const Mat3 base = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  for (const double tolerance : {1e-9, 1e-6}) {
+    for (const double off : {0.3, 0.7, 1.5}) {
+      Mat3 r = base;
+      r(0, 0) += off * tolerance / (2 * std::abs(base(0, 0)));  // (R^T R)(0, 0) - 1 is about off * tolerance
+      const RigidTransform t{r, Vec3::Zero()};
+      if (off < 1)
+        EXPECT_NO_THROW(t.validate(tolerance)) << off << " of " << tolerance;
+      else
+        EXPECT_THROW(t.validate(tolerance), std::invalid_argument) << off << " of " << tolerance;
+    }
+  }
+  const double big = std::numeric_limits<double>::max();
+  EXPECT_NO_THROW((void)RigidTransform::checked(base, Vec3(big, big, -0.5 * big)));
+  EXPECT_NO_THROW((void)RigidTransform::checked(base, Vec3(-big, -big, 0)));
+  expect_refused(base, Vec3(big, std::numeric_limits<double>::infinity(), 0), "translation has a NaN");
+  Mat3 mirrored = base;
+  mirrored.col(2) *= -1;
+  expect_refused(mirrored, Vec3::Zero(), "reflection");
+  EXPECT_THROW(RigidTransform{}.validate(std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+  EXPECT_THROW(RigidTransform{}.validate(-1), std::invalid_argument);
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Scenes and pose files
 
