@@ -135,19 +135,23 @@ class TypedQuery final : public PreparedQuery {
       const SurfaceLeaves<BV> leaves(a().bvh, trees_.side_a, b().bvh, trees_.side_b, pose);
       return S::query(a(), b(), pose, options_, leaves);
     } else {
-      if constexpr (kWalksWide)
-        if (trees_.a.wide)
-          return with_geometry(pose, S::query_wide(a(), *a().wide, b(), *b().wide, pose, options_));
-      return with_geometry(pose, S::query(a(), b(), pose, options_));
+      Result result = walk(pose);  // returned in place: a Result is too large to move per query
+      add_geometry(pose, result);
+      return result;
     }
+  }
+  /// The walk of a query without surfaces: the wide layouts' when prepared with them.
+  Result walk(const RigidTransform& pose) const {
+    if constexpr (kWalksWide)
+      if (trees_.a.wide) return S::query_wide(a(), *a().wide, b(), *b().wide, pose, options_);
+    return S::query(a(), b(), pose, options_);
   }
   /// Whether a prepared query of this type may walk the wide layouts (prepare sets them only for a wide
   /// variant).
   static constexpr bool kWalksWide =
       kRunsWide<S> && HasWideLayout<BV> && kWalksWideOn<S, BV> && std::is_same_v<Held, HierarchyOnly<BV>>;
-  Result with_geometry(const RigidTransform& pose, Result r) const {
+  void add_geometry(const RigidTransform& pose, Result& r) const {
     if (geometry_) (*geometry_)(pose, r);
-    return r;
   }
   /// The coherent query (prepare lets coherent_ be set only for a strategy that has one).
   [[gnu::noinline]] Result query(const RigidTransform& pose, CoherentState& state) const {
@@ -157,7 +161,9 @@ class TypedQuery final : public PreparedQuery {
       const SurfaceLeaves<BV> leaves(a().bvh, trees_.side_a, b().bvh, trees_.side_b, pose);
       return S::query_coherent(a(), b(), pose, options_, state, leaves);
     } else {
-      return with_geometry(pose, S::query_coherent(a(), b(), pose, options_, state));
+      Result result = S::query_coherent(a(), b(), pose, options_, state);
+      add_geometry(pose, result);
+      return result;
     }
   }
   /// The coherent query as the timing loops call it.
