@@ -57,18 +57,20 @@ inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rota
 }
 
 /// A pose as re-boxing reads it in both directions: B into A's frame (R, |R|, t) and A into B's (R^T, |R|^T,
-/// -R^T t). A traversal makes it once per pose: the inverse is the same for every node pair.
+/// -R^T t). A traversal makes it once per pose: the inverse is the same for every node pair. It refers to
+/// the pose (R and t are not copied): the pose must outlive it.
 struct ReboxPose {
   explicit ReboxPose(const RigidTransform& b_to_a)
       : rotation(b_to_a.rotation),
-        abs_rotation(rotation.cwiseAbs()),
         translation(b_to_a.translation),
+        abs_rotation(rotation.cwiseAbs()),
         inverse_rotation(rotation.transpose()),
         inverse_abs_rotation(abs_rotation.transpose()),
         inverse_translation(-(inverse_rotation * translation)) {}
 
-  Mat3 rotation, abs_rotation;
-  Vec3 translation;
+  const Mat3& rotation;
+  const Vec3& translation;
+  Mat3 abs_rotation;
   Mat3 inverse_rotation, inverse_abs_rotation;
   Vec3 inverse_translation;
 };

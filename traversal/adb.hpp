@@ -104,7 +104,7 @@ class AdbHooks {
 
   AdbHooks(const TreePair<BV, Leaves>& trees, Result& result, const AdbOptions& options,
            const Estimator& estimate)
-      : trees_(trees), result_(result), options_(options), estimate_(estimate), rebox_(trees.b_to_a) {}
+      : trees_(trees), result_(result), options_(options), estimate_(estimate) {}
 
   /// Estimated probability of a pair; negative when the volumes do not overlap (provably no contact).
   [[gnu::always_inline]] double evaluate(const Pair& p) {
@@ -231,7 +231,13 @@ class AdbHooks {
       return node_frame_geometry(trees_.a.volume(p.a).oriented_box(), trees_.b.volume(p.b).oriented_box(),
                                  trees_.b_to_a);
     else
-      return tree_frame_geometry(trees_.box_a(p), trees_.box_b(p), rebox_);
+      return tree_frame_geometry(trees_.box_a(p), trees_.box_b(p), rebox());
+  }
+
+  /// Made at the first estimate: a query whose root volumes are apart needs none.
+  const ReboxPose& rebox() const {
+    if (!rebox_) rebox_.emplace(trees_.b_to_a);
+    return *rebox_;
   }
 
   Admission decide(double probability, const Pair& p) {
@@ -249,8 +255,8 @@ class AdbHooks {
   Result& result_;
   const AdbOptions& options_;
   const Estimator& estimate_;
-  const ReboxPose rebox_;                  ///< the pose as the overlap bound reads it, both ways
-  bool dropped_possible_contact_ = false;  // a pair whose volumes overlap was left unexamined
+  mutable std::optional<ReboxPose> rebox_;  ///< the pose as the overlap bound reads it, both ways
+  bool dropped_possible_contact_ = false;   // a pair whose volumes overlap was left unexamined
   double best_dropped_ = 0;
   double no_contact_in_leaves_ = 1;  // prod(1 - p) over leaf pairs left below p_min
   std::uint8_t parent_levels_ = 0;   // the tag of the pair whose children are being admitted
