@@ -79,6 +79,13 @@ Result exact_traversal_with(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTrans
   return result;
 }
 
+/// The `done` of a traversal whose hooks have nothing more to say: a named type, so that query_exact and a
+/// coherent query answering as the cold one (traversal/coherent.hpp) share one compiled traversal.
+struct NothingToNote {
+  template <class Hooks>
+  void operator()(const Hooks&) const {}
+};
+
 /// Exact first-contact (or all-contacts) query. `b_to_a` maps B's local frame into A's. `leaves` is the
 /// leaf test (TreePair's Leaves); the default tests triangles, and traversal/point_leaves.hpp passes the
 /// surfaces of point clouds (query_exact_points). Const and thread-safe on shared trees: all traversal
@@ -88,7 +95,7 @@ Result query_exact(const Bvh<BV>& a, const Bvh<BV>& b, const RigidTransform& b_t
                    ContactMode mode = ContactMode::First, const Leaves& leaves = kTriangleLeaves) {
   check_exact_query<Leaves>(b_to_a, mode);
   return exact_traversal_with<ExactHooks<BV, QueuedPair<BV>, Leaves>>(a, b, b_to_a, mode, leaves,
-                                                                      [](const auto&) {});
+                                                                      NothingToNote{});
 }
 
 }  // namespace bvhlab
