@@ -60,6 +60,7 @@ class FrontWalk {
   std::optional<LeafPair> run(const Pair* overlapping_root = nullptr) {
     next_.clear();
     next_.push_back(FrontPair{});
+    parents_.assign(1, 0);
     items_.clear();
     const std::uint32_t stored = stored_.empty() ? kCold : 0;
     if (!overlapping_root)
@@ -129,6 +130,7 @@ class FrontWalk {
     for (int c = 0; c < children.count; ++c) {
       const Pair& child = *children.at[c];
       next_.push_back(FrontPair{child.a, child.b});
+      parents_.push_back(item.out);
       items_.push_back({child, first + static_cast<std::uint32_t>(c), kCold, false});
     }
     return std::nullopt;
@@ -151,6 +153,7 @@ class FrontWalk {
     for (std::uint32_t c = 0; c < old.count; ++c) {
       const FrontPair& child = stored_[old.first + c];
       next_.push_back(FrontPair{child.a, child.b});
+      parents_.push_back(item.out);
       if (child.leads_to_witness)
         towards_witness = c;
       else
@@ -161,15 +164,14 @@ class FrontWalk {
     if (towards_witness != kCold) visit(towards_witness);
   }
 
-  /// Marks the pair at `out` in next_ and its ancestors as leading to the contact found there. A parent is
-  /// stored before its children, so one backward pass finds them all: a step per pair this walk wrote.
+  /// Marks the pair at `out` in next_ and its ancestors as leading to the contact found there, up the
+  /// parents the walk noted: a step per level. (A backward search of next_ for each parent took a step per
+  /// pair written, and on the pipes at 2.9 degrees a step a fifth of the walk's mispredicted branches.)
   void mark_path(std::uint32_t out) {
-    next_[out].leads_to_witness = 1;
-    for (std::uint32_t i = out; i-- > 0;) {
-      FrontPair& pair = next_[i];
-      if (pair.count == 0 || out < pair.first || out >= pair.first + pair.count) continue;
-      pair.leads_to_witness = 1;
-      out = i;
+    for (;;) {
+      next_[out].leads_to_witness = 1;
+      if (out == 0) return;
+      out = parents_[out];
     }
   }
 
@@ -210,6 +212,12 @@ class FrontWalk {
     return items;
   }
   std::vector<Item>& items_ = thread_stack();
+  /// The entry in next_ of each written pair's parent (the root's: 0), kept by the thread as the stack is.
+  static std::vector<std::uint32_t>& thread_parents() {
+    thread_local std::vector<std::uint32_t> parents;
+    return parents;
+  }
+  std::vector<std::uint32_t>& parents_ = thread_parents();
 };
 
 }  // namespace coherent_detail
