@@ -59,8 +59,8 @@ class FrontWalk {
   /// overlapping.
   std::optional<LeafPair> run(const Pair* overlapping_root = nullptr) {
     next_.clear();
-    next_.push_back(FrontPair{});
-    parents_.assign(1, 0);
+    parents_.clear();
+    write(FrontPair{}, 0);
     items_.clear();
     const std::uint32_t stored = stored_.empty() ? kCold : 0;
     if (!overlapping_root)
@@ -129,8 +129,7 @@ class FrontWalk {
     next_[item.out].count = static_cast<std::uint8_t>(children.count);
     for (int c = 0; c < children.count; ++c) {
       const Pair& child = *children.at[c];
-      next_.push_back(FrontPair{child.a, child.b});
-      parents_.push_back(item.out);
+      write(FrontPair{child.a, child.b}, item.out);
       items_.push_back({child, first + static_cast<std::uint32_t>(c), kCold, false});
     }
     return std::nullopt;
@@ -152,8 +151,7 @@ class FrontWalk {
     std::uint32_t towards_witness = kCold;
     for (std::uint32_t c = 0; c < old.count; ++c) {
       const FrontPair& child = stored_[old.first + c];
-      next_.push_back(FrontPair{child.a, child.b});
-      parents_.push_back(item.out);
+      write(FrontPair{child.a, child.b}, item.out);
       if (child.leads_to_witness)
         towards_witness = c;
       else
@@ -162,6 +160,12 @@ class FrontWalk {
     // Pushed last, so visited first: a contact lost at the remembered leaf pair is most likely found near it
     // (on the pipes at every step, 2 to 4 times fewer BV tests a query; bench/RESULTS.md).
     if (towards_witness != kCold) visit(towards_witness);
+  }
+
+  /// Appends a pair to the tree being built, with the entry of its parent there (the root's own: 0).
+  void write(const FrontPair& pair, std::uint32_t parent) {
+    next_.push_back(pair);
+    parents_.push_back(parent);
   }
 
   /// Marks the pair at `out` in next_ and its ancestors as leading to the contact found there, up the
