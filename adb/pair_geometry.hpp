@@ -60,8 +60,8 @@ inline double reboxed_overlap(const Box& box, const Box& other, const Mat3& rota
 /// -R^T t). A traversal makes it once per pose: the inverse is the same for every node pair. It refers to
 /// the pose (R and t are not copied): the pose must outlive it.
 struct ReboxPose {
-  /// Out of line (pair_geometry.cpp): made at most once a query, and inlined where ADB's loops estimate it
-  /// cost each of the engine's density query files 6% more compiling (bench/RESULTS.md).
+  /// Out of line (pair_geometry.cpp): it is made at most once a query, and inlined at each place an ADB loop
+  /// estimates, it made the engine's density query files compile 5% to 7% more (bench/RESULTS.md).
   explicit ReboxPose(const RigidTransform& b_to_a);
 
   const Mat3& rotation;
