@@ -32,6 +32,7 @@ void CoherentState::reset() {
   stamped_ = last_jumped_ = jumping_on_ = false;
   witness.reset();
   front_cost_ = root_cost_ = -1;
+  root_count_ = root_next_ = 0;
   cold_left_ = 0;
   cold_run_ = 2;
   root_backoff_ = root_wait_ = 0;
@@ -117,7 +118,7 @@ void CoherentState::record_cost(const Counters& counters, double seconds, Start 
                           ? seconds
                           : work_of(counters) + 0.5 * static_cast<double>(pairs_written);
   if (start == Start::Root) {
-    average_into(root_cost_, cost, 0.125);  // queries from the root vary with the pose: a longer memory
+    add_root_cost(cost);
     if (cold_left_ > 0) {
       --cold_left_;
       ++cold_queries_;
@@ -133,6 +134,17 @@ void CoherentState::record_cost(const Counters& counters, double seconds, Start 
   } else if (2 * front_cost_ < root_cost_) {
     cold_run_ = std::max(cold_run_ / 2, 2u);  // the front pays again: a later loss starts a shorter run
   }
+}
+
+void CoherentState::add_root_cost(double cost) {
+  root_costs_[root_next_] = cost;
+  root_next_ = static_cast<std::uint8_t>((root_next_ + 1) % root_costs_.size());
+  root_count_ = static_cast<std::uint8_t>(std::min<std::size_t>(root_count_ + 1, root_costs_.size()));
+  // The lower median: of two samples, the cheaper one.
+  std::array<double, 8> sorted = root_costs_;
+  const auto middle = sorted.begin() + (root_count_ - 1) / 2;
+  std::nth_element(sorted.begin(), middle, sorted.begin() + root_count_);
+  root_cost_ = *middle;
 }
 
 void CoherentState::store(std::vector<FrontPair>& next, const RigidTransform& pose) {

@@ -7,6 +7,7 @@
 #include "result.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -30,9 +31,9 @@ struct CoherenceOptions {
   /// before its parent is tested again (so pairs close to contact do not pay a useless test every query).
   std::uint8_t raise_hold = 8;
   /// Where the pose changes too much between queries for the front to pay, walking it costs more than a
-  /// query from the root. When the front's recent walks cost more than the recent queries from the root
-  /// (CoherentState::record_cost), the next queries start from the root: 2 of them, twice as many each time
-  /// the front loses again, at most this many. 0: always walk the front.
+  /// query from the root. When the front's recent walks cost more than the median of the last 8 queries from
+  /// the root (CoherentState::record_cost), the next queries start from the root: 2 of them, twice as many
+  /// each time the front loses again, at most this many. 0: always walk the front.
   std::uint32_t max_cold_run = 128;
   /// What "cost" means there. `work` (the default): node pairs, BV tests and triangle tests (four BV tests
   /// each), and half a unit per pair a walk stores (the cold query stores none), which repeat exactly from
@@ -217,7 +218,13 @@ class CoherentState {
   std::uint64_t jumps_ = 0, witness_hits_ = 0, cold_queries_ = 0;
   Use use_ = Use::None;
   // The comparison of the front's walks with queries from the root (record_cost); cost < 0: none yet.
-  double front_cost_ = -1, root_cost_ = -1;
+  double front_cost_ = -1;
+  /// The last queries from the root, their costs: record_cost compares the front with their median, so
+  /// that one pose far costlier than the rest (a new state's first query, say) does not stand for all.
+  std::array<double, 8> root_costs_{};
+  std::uint8_t root_count_ = 0, root_next_ = 0;
+  double root_cost_ = -1;  ///< their median, kept as each comes in; < 0: none yet
+  void add_root_cost(double cost);
   std::uint32_t cold_left_ = 0;  ///< queries from the root still to run before the front is tried again
   std::uint32_t cold_run_ = 2;   ///< the length of the next such run
   std::uint8_t root_backoff_ = 0, root_wait_ = 0;  ///< root_check_due: the current wait, the queries left

@@ -320,6 +320,32 @@ TEST(Coherent, AWalksStoredPairsCountAsItsWork) {
   EXPECT_EQ(timed.cold_turns_left(), 0u);
 }
 
+// The front is compared with the median of the last queries from the root: one far costlier query (a new
+// state's first, at a pose where much overlaps) does not make every walk look cheap.
+TEST(Coherent, OneCostlyQueryFromTheRootDoesNotStandForAll) {
+  Counters costly, cheap, walk;
+  costly.bv_tests = 40'000;
+  cheap.bv_tests = 600;
+  walk.bv_tests = 1'000;
+  CoherentState state;
+  state.record_cost(costly, 0, CoherentState::Start::Root);
+  state.record_cost(cheap, 0, CoherentState::Start::Root);
+  state.record_cost(walk, 0, CoherentState::Start::Front);
+  EXPECT_EQ(state.cold_turns_left(), 2u);  // the walk costs more than the usual query from the root
+  // With more samples, the median: two costly ones among five leave it at the cheap queries' cost.
+  CoherentState five;
+  for (const Counters& c : {costly, cheap, costly, cheap, cheap})
+    five.record_cost(c, 0, CoherentState::Start::Root);
+  five.record_cost(walk, 0, CoherentState::Start::Front);
+  EXPECT_EQ(five.cold_turns_left(), 2u);
+  // And a walk cheaper than that median keeps walking.
+  CoherentState pays;
+  for (const Counters& c : {costly, walk, costly, walk, costly})
+    pays.record_cost(c, 0, CoherentState::Start::Root);
+  pays.record_cost(cheap, 0, CoherentState::Start::Front);
+  EXPECT_EQ(pays.cold_turns_left(), 0u);
+}
+
 TEST(Coherent, RefusesWhatItCannotServe) {
   const auto a = Bvh<Aabb>::build(torus());
   const auto b = Bvh<Aabb>::build(soup());
