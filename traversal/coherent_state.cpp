@@ -141,7 +141,7 @@ void CoherentState::add_root_cost(double cost) {
   root_next_ = static_cast<std::uint8_t>((root_next_ + 1) % root_costs_.size());
   root_count_ = static_cast<std::uint8_t>(std::min<std::size_t>(root_count_ + 1, root_costs_.size()));
   // The lower median: of two samples, the cheaper one.
-  std::array<double, 8> sorted = root_costs_;
+  auto sorted = root_costs_;  // a copy: the ring keeps its order
   const auto middle = sorted.begin() + (root_count_ - 1) / 2;
   std::nth_element(sorted.begin(), middle, sorted.begin() + root_count_);
   root_cost_ = *middle;
