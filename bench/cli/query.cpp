@@ -68,6 +68,7 @@ std::vector<ListedPose> protocol_poses_argument(const std::string& protocol) {
   check_value(limits::kSteps, v.back(), "--protocol");
   const int steps = static_cast<int>(v.back());
   if (v.size() == 2) {
+    check_value(limits::kPoses, v.back(), "--protocol");  // every step is listed
     std::vector<ListedPose> out;
     for (const RigidTransform& pose : protocol_poses(v[0], steps)) out.push_back({pose, out.size()});
     return out;

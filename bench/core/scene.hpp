@@ -245,6 +245,10 @@ inline constexpr ParamSpec kDistance{
     .name = "distance", .description = "protocol distance", .min = 0, .max = 1e6};
 inline constexpr ParamSpec kSteps{
     .name = "steps", .description = "protocol poses per distance", .min = 1, .max = 1e7, .integer = true};
+/// Poses a scene generates in all (a protocol's distances times its steps over the stride, a random count, a
+/// training set): 20 times the largest shipped scene, and a bound on the parser's memory and time.
+inline constexpr ParamSpec kPoses{
+    .name = "poses", .description = "poses a scene generates", .min = 1, .max = 1e6, .integer = true};
 inline constexpr ParamSpec kBvTests{.name = "bv_tests",
                                     .description = "budget of BV-pair tests",
                                     .min = 1,

@@ -7,15 +7,18 @@
 #include "engine/protocol.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <numbers>
 #include <optional>
 #include <random>
-#include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace bvhlab {
@@ -88,11 +91,19 @@ void parse_pose_file(const Node& w, const std::filesystem::path& base_dir, Workl
   workload.identity = "poses:" + ContentHash().update(text).hex();
 }
 
+/// Fails unless `count` poses (made up as `how`) stay within limits::kPoses.
+void check_pose_count(const Node& at, double count, const std::string& how) {
+  if (count > limits::kPoses.max)
+    at.fail(how + " make " + std::to_string(static_cast<long long>(count)) +
+            " poses; a scene generates at most " +
+            std::to_string(static_cast<long long>(limits::kPoses.max)));
+}
+
 /// A "random" workload: seeded poses in a box, one group filed under distance 0.
 void parse_random(const Node& w, WorkloadSpec& workload) {
   w.expect_object({"type", "count", "seed", "box", "axis"});
   workload.kind = WorkloadSpec::Kind::Random;
-  workload.count = static_cast<int>(w.child("count").integer(1, static_cast<long long>(limits::kSteps.max)));
+  workload.count = static_cast<int>(w.child("count").integer(1, static_cast<long long>(limits::kPoses.max)));
   workload.seed = static_cast<std::uint64_t>(w.has("seed") ? w.child("seed").integer(0, 1LL << 53) : 1);
   const Node box = w.child("box");
   if (!box.value().is_array() || box.value().size() != 2)
@@ -111,20 +122,37 @@ void parse_random(const Node& w, WorkloadSpec& workload) {
   workload.identity = identity;
 }
 
-/// Fails unless no training pose equals (bit for bit) a pose of the workload.
+/// The pose's twelve numbers, bit for bit.
+std::array<std::uint64_t, 12> pose_bits(const RigidTransform& p) {
+  std::array<std::uint64_t, 12> out;
+  std::memcpy(out.data(), p.rotation.data(), 9 * sizeof(double));
+  std::memcpy(out.data() + 9, p.translation.data(), 3 * sizeof(double));
+  return out;
+}
+
+std::uint64_t pose_hash(const RigidTransform& p) {
+  std::uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (std::uint64_t word : pose_bits(p)) h = (h ^ word) * 0xff51afd7ed558ccdull + (h >> 29);
+  return h;
+}
+
+/// Fails unless no training pose equals (bit for bit) a pose of the workload. It sorts 64-bit hashes, not a
+/// tree of 96-byte keys: a scene may hold a million poses.
 void check_disjoint(const Node& at, const WorkloadSpec& training, const WorkloadSpec& test) {
-  auto bits = [](const RigidTransform& p) {
-    std::string out(reinterpret_cast<const char*>(p.rotation.data()), 9 * sizeof(double));
-    return out.append(reinterpret_cast<const char*>(p.translation.data()), 3 * sizeof(double));
-  };
-  std::set<std::string> seen;
+  std::vector<std::pair<std::uint64_t, const RigidTransform*>> seen;
   for (const PoseGroup& g : test.groups)
-    for (const RigidTransform& p : g.poses) seen.insert(bits(p));
+    for (const RigidTransform& p : g.poses) seen.emplace_back(pose_hash(p), &p);
+  auto by_hash = [](const auto& a, const auto& b) { return a.first < b.first; };
+  std::sort(seen.begin(), seen.end(), by_hash);
   for (const PoseGroup& g : training.groups)
-    for (const RigidTransform& p : g.poses)
-      if (seen.count(bits(p)))
-        at.fail("a training pose at distance " + std::to_string(g.distance) +
-                " equals a test pose; choose another training_seed");
+    for (const RigidTransform& p : g.poses) {
+      const auto [first, last] =
+          std::equal_range(seen.begin(), seen.end(), std::pair{pose_hash(p), &p}, by_hash);
+      for (auto it = first; it != last; ++it)
+        if (pose_bits(*it->second) == pose_bits(p))
+          at.fail("a training pose at distance " + std::to_string(g.distance) +
+                  " equals a test pose; choose another training_seed");
+    }
 }
 
 }  // namespace
@@ -210,6 +238,10 @@ void parse_workload(const Node& root, const std::filesystem::path& base_dir, Wor
         workload.steps = static_cast<int>(w.child("steps").integer(
             static_cast<long long>(limits::kSteps.min), static_cast<long long>(limits::kSteps.max)));
       if (w.has("stride")) workload.stride = static_cast<int>(w.child("stride").integer(1, workload.steps));
+      const int per_distance = (workload.steps + workload.stride - 1) / workload.stride;
+      check_pose_count(w, double(workload.distances.size()) * per_distance,
+                       std::to_string(workload.distances.size()) + " distances of " +
+                           std::to_string(per_distance) + " poses");
     } else {
       parse_pose_file(w, base_dir, workload);
     }
@@ -240,6 +272,12 @@ void parse_calibration(const Node& root, Scene& scene) {
       c.child("training_steps")
           .integer(static_cast<long long>(limits::kSteps.min), static_cast<long long>(limits::kSteps.max)));
   const WorkloadSpec& test = scene.workload;
+  const std::size_t groups = test.kind == WorkloadSpec::Kind::Protocol ? test.distances.size() : 1;
+  std::size_t test_poses = 0;
+  for (const PoseGroup& g : test.groups) test_poses += g.poses.size();
+  check_pose_count(c.child("training_steps"), double(groups) * spec.training_steps + double(test_poses),
+                   std::to_string(groups) + " training groups of " + std::to_string(spec.training_steps) +
+                       " poses and the workload's " + std::to_string(test_poses));
   WorkloadSpec& training = spec.training;
   training.steps = training.count = spec.training_steps;
   training.seed = spec.training_seed;
@@ -249,6 +287,7 @@ void parse_calibration(const Node& root, Scene& scene) {
     training.distances = test.distances;
     for (double d : test.distances) {
       PoseGroup group{d, {}};
+      group.poses.reserve(static_cast<std::size_t>(spec.training_steps));
       for (int k = 0; k < spec.training_steps; ++k) {
         const double theta = 2.0 * std::numbers::pi * unit();
         RigidTransform pose;

@@ -220,6 +220,7 @@ TEST_F(Cli, ValuesAreCheckedBeforeWorkStarts) {
                  "deadline_us must be a number in (0, 1e+09]");
   expect_refused("query small.obj small.obj --pose 1,0,0,0,0,0,90", "the rotation axis must be finite");
   expect_refused("query small.obj small.obj --pose 1,0,0 --repeat 0", "--repeat");
+  expect_refused("query small.obj small.obj --protocol 1,2000000", "poses must be an integer in [1, 1e+06]");
   ok("query small.obj small.obj --protocol 1,9,10");
 }
 

@@ -54,6 +54,8 @@ TEST_F(PointsSceneTest, RefusalsNameTheField) {
       {points_scene(R"({"sampling": "grid"})"), "/points/sampling: expected one of uniform, varying"},
       {points_scene(R"({"ratio": 3})"), "/points/ratio: applies to \"sampling\": \"varying\" only"},
       {points_scene(R"({"steps": 0})"), "/points/steps"},
+      {points_scene(R"({"distances": [1, 2], "steps": 500001})"),
+       "/points: 2 distances of 500001 steps make 1000002 poses; a scene generates at most 1000000"},
       {points_scene(R"({"distances": []})"), "/points/distances"},
       {points_scene(R"({"grid": 5})"), "/points/grid"},
       {points_scene(R"({"bv_tests": [0]})"), "/points/bv_tests/0"},

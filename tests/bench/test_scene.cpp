@@ -178,6 +178,15 @@ TEST_F(SceneTest, CoherentStrategiesAndProtocolStrides) {
       parse(scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
                        R"("workload": {"distances": [0.8, 1.2], "steps": 100})"));
   EXPECT_NE(scene.workload.identity, every_step.workload.identity);
+  // The poses a scene generates count after the stride: a fine turn sampled sparsely fits the limit.
+  auto turn = [&](int stride) {
+    return scene_with(
+        R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+        R"("workload": {"distances": [1.2], "steps": 10000000, "stride": )" + std::to_string(stride) + "}");
+  };
+  EXPECT_EQ(parse(turn(100000)).workload.groups[0].poses.size(), 100u);
+  EXPECT_NE(error_of(turn(9)).find("1 distances of 1111112 poses make 1111112 poses"), std::string::npos)
+      << error_of(turn(9));
   EXPECT_EQ(every_step.workload.groups[1].poses.size(), 100u);
 }
 
@@ -267,6 +276,17 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
                   R"("workload": {"type": "protocol", "steps": 100, "stride": 101})"),
        "/workload/stride: expected an integer in [1, 100]; got 101"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("workload": {"distances": [1, 2, 3], "steps": 400000})"),
+       "/workload: 3 distances of 400000 poses make 1200000 poses; a scene generates at most 1000000"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("workload": {"type": "random", "count": 1000001, "box": [[0, 0, 0], [1, 1, 1]]})"),
+       "/workload/count: expected an integer in [1, 1000000]; got 1000001"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])", R"([{"type": "exact"}])",
+                  R"("workload": {"distances": [1, 2], "steps": 10},)"
+                  R"( "calibration": {"training_seed": 2, "training_steps": 499991})"),
+       "/calibration/training_steps: 2 training groups of 499991 poses and the workload's 20 make "
+       "1000002 poses; a scene generates at most 1000000"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
                   R"([{"type": "exact", "coherent": 1}])", ""),
        "/strategies/0/coherent: expected true or false; got 1"},
