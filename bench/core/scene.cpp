@@ -40,13 +40,22 @@ double read_parameter(const Node& node, const ParamSpec& p) {
   return v;
 }
 
-/// A sweep parameter takes a number or a non-empty list of numbers; any other takes one number.
+/// A sweep parameter takes a number or a non-empty list of distinct numbers; any other takes one number.
 std::vector<double> read_values(const Node& node, const ParamSpec& p) {
   if (!p.sweep || !node.value().is_array()) return {read_parameter(node, p)};
   std::vector<double> out;
-  for (std::size_t k = 0, m = node.array_size(); k < m; ++k) out.push_back(read_parameter(node.child(k), p));
+  for (std::size_t k = 0, m = node.array_size(); k < m; ++k) {
+    const double v = read_parameter(node.child(k), p);
+    if (std::find(out.begin(), out.end(), v) != out.end())
+      node.child(k).fail(std::string(p.name) + " " + parameter_text(v) + " is in the list already");
+    out.push_back(v);
+  }
   return out;
 }
+
+/// The series one strategy entry may sweep (its lists' sizes multiplied, times its budgets): far more than a
+/// study plots, and a bound on what expanding and checking them costs.
+constexpr double kMaxSeries = 1000;
 
 /// The hierarchies a strategy entry names; false when every one of them was optional and left out.
 template <class Skipped>
@@ -113,6 +122,11 @@ std::optional<StrategySpec> parse_strategy(const Node& s, const Scene& scene, Sk
       s.child("wide").fail(
           "a coherent query walks the binary trees; give \"coherent\" or \"wide\", not both");
   }
+  double series = std::max<double>(1, static_cast<double>(spec.budgets.size()));
+  for (const auto& [name, values] : spec.values) series *= static_cast<double>(values.size());
+  if (series > kMaxSeries)
+    s.fail("sweeps " + number_text(series) + " series; a strategy entry sweeps at most " +
+           number_text(kMaxSeries) + " (split it, or take fewer values)");
   if (!parse_strategy_hierarchies(s, scene, spec, skipped)) return std::nullopt;
   if (info.needs_density) check_densities(s, scene, spec, info);
   if (std::none_of(scene.hierarchies.begin(), scene.hierarchies.end(),

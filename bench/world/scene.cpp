@@ -17,7 +17,6 @@ namespace {
 
 constexpr long long kMaxInstances = 100000;
 constexpr long long kMaxWorldFrames = 1000000;
-constexpr double kMaxPoses = 2e6;  // frames x instances: 190 MB of poses
 
 std::vector<std::string> frame_schedule_names() {
   std::vector<std::string> names;
@@ -37,10 +36,17 @@ std::vector<std::string> object_names(const Scene& scene) {
   return names;
 }
 
+/// The instances read so far: their names, and the copies of each object (which number the next copy).
+struct InstanceIndex {
+  std::set<std::string, std::less<>> names;
+  std::map<std::string, std::size_t, std::less<>> copies;
+};
+
 /// One "instances" entry: {"object": NAME, "count": N} (named NAME#k, placed at random) or {"object": NAME,
 /// "name": ..., "placement": {...}} (one copy where it says). Returns the placements given (nullopt: random).
 std::vector<std::optional<RigidTransform>> parse_instance(const Node& entry, const Scene& scene,
-                                                          std::vector<WorldInstance>& out) {
+                                                          std::vector<WorldInstance>& out,
+                                                          InstanceIndex& index) {
   entry.expect_object({"object", "count", "name", "placement"});
   const std::string object = entry.child("object").string();
   if (!scene.object(object))
@@ -49,21 +55,19 @@ std::vector<std::optional<RigidTransform>> parse_instance(const Node& entry, con
   const long long count = entry.has("count") ? entry.child("count").integer(1, kMaxInstances) : 1;
   if (count > 1 && (entry.has("name") || entry.has("placement")))
     entry.child("count").fail("\"name\" and \"placement\" describe one instance; give \"count\": 1");
+  if (out.size() + static_cast<std::size_t>(count) > static_cast<std::size_t>(kMaxInstances))
+    entry.fail("more than " + std::to_string(kMaxInstances) + " instances");
   std::vector<std::optional<RigidTransform>> placements;
   for (long long k = 0; k < count; ++k) {
-    const std::size_t copy = static_cast<std::size_t>(
-        std::count_if(out.begin(), out.end(), [&](const WorldInstance& i) { return i.object == object; }));
-    WorldInstance instance{object + "#" + std::to_string(copy), object};
+    WorldInstance instance{object + "#" + std::to_string(index.copies[object]++), object};
     if (entry.has("name")) instance.name = entry.child("name").string();
-    if (std::any_of(out.begin(), out.end(), [&](const WorldInstance& i) { return i.name == instance.name; }))
+    if (!index.names.insert(instance.name).second)
       entry.fail("duplicate instance name \"" + instance.name + "\"");
     out.push_back(instance);
     placements.push_back(entry.has("placement")
                              ? std::optional<RigidTransform>(parse_transform(entry.child("placement"), {}))
                              : std::nullopt);
   }
-  if (out.size() > static_cast<std::size_t>(kMaxInstances))
-    entry.fail("more than " + std::to_string(kMaxInstances) + " instances");
   return placements;
 }
 
@@ -127,8 +131,8 @@ void parse_motion(const Node& m, const std::filesystem::path& base_dir, WorldSpe
   world.seed = m.has("seed") ? static_cast<std::uint64_t>(m.child("seed").integer(0, 1LL << 53)) : 0;
   world.step = m.has("step") ? m.child("step").number(0, 1e12) : 0;
   world.turn_deg = m.has("turn_deg") ? m.child("turn_deg").number(0, 180) : 0;
-  if (static_cast<double>(world.frames) * static_cast<double>(world.instances.size()) > kMaxPoses)
-    m.child("frames").fail("frames x instances is above " + number_text(kMaxPoses) + " poses");
+  if (static_cast<double>(world.frames) * static_cast<double>(world.instances.size()) > limits::kPoses.max)
+    m.child("frames").fail("frames x instances is above " + number_text(limits::kPoses.max) + " poses");
   world.poses = random_walk(placements, world.region, world.seed, world.frames, world.step, world.turn_deg);
   world.identity = "walk:" + std::to_string(world.seed) + ":" + std::to_string(world.frames) + ":" +
                    number_text(world.step) + ":" + number_text(world.turn_deg);
@@ -221,8 +225,9 @@ void parse_world(const Node& root, const std::filesystem::path& base_dir, Scene&
   WorldSpec world;
   std::vector<std::optional<RigidTransform>> placements;
   const Node instances = w.child("instances");
+  InstanceIndex index;
   for (std::size_t k = 0, n = instances.array_size(); k < n; ++k) {
-    auto more = parse_instance(instances.child(k), scene, world.instances);
+    auto more = parse_instance(instances.child(k), scene, world.instances, index);
     placements.insert(placements.end(), more.begin(), more.end());
   }
   const bool walk = w.child("motion").child("type").choice({"random_walk", "frame_file"}) == "random_walk";

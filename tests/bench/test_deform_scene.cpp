@@ -65,6 +65,10 @@ TEST_F(DeformSceneTest, RefusalsNameTheField) {
        "/deform/density_updates/0"},
       {deform_scene(twist(R"(, "density_updates": [{"type": "guess"}])")), "/deform/density_updates/0/type"},
       {deform_scene(twist(R"(, "refit": "sometimes")")), "/deform/refit"},
+      {deform_scene(
+           R"({"object": "torus", "deformation": "twist", "frames": 2,)"
+           R"( "poses": {"distances": [1, 1.5, 2, 2.5, 3, 3.5, 4, 4.5, 5, 5.5, 6], "steps": 100000}})"),
+       "/deform/poses: 11 distances of 100000 steps make 1100000 poses; a scene generates at most 1000000"},
       {"{" + kHead + R"(, "pairs": [["torus", "torus"]], "deform": )" + twist() + "}", "/pairs"},
       {deform_scene(twist(), R"("objects": [{"mesh": "torus.obj"}], "hierarchies": [{"bv": "aabb"}],
           "annotation": {"type": "adb_paper"}, "strategies": [{"type": "adb"}])"),

@@ -29,6 +29,13 @@ std::string scene_with(
          strategies + (extra.empty() ? "" : ", " + extra) + "}";
 }
 
+// `count` numbers from `first` by `step`, comma separated: a sweep's list.
+std::string sweep(double first, double step, int count) {
+  std::string out;
+  for (int k = 0; k < count; ++k) out += (k ? ", " : "") + std::to_string(first + k * step);
+  return out;
+}
+
 TEST_F(SceneTest, ParsesWhatTheFileSays) {
   const Scene scene = parse(R"({
     "name": "t",
@@ -287,6 +294,14 @@ TEST_F(SceneTest, BadFieldsAreNamedByTheirJsonPath) {
                   R"( "calibration": {"training_seed": 2, "training_steps": 499991})"),
        "/calibration/training_steps: 2 training groups of 499991 poses and the workload's 20 make "
        "1000002 poses; a scene generates at most 1000000"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                  R"([{"type": "adb", "p_min": [0.5, 0.9, 0.5]}])", R"("annotation": {"type": "adb"})"),
+       "/strategies/0/p_min/2: p_min 0.5 is in the list already"},
+      {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
+                  R"([{"type": "adb", "p_min": [)" + sweep(0.01, 0.001, 100) +
+                      R"(], "confirm_levels": [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10]}])",
+                  R"("annotation": {"type": "adb"})"),
+       "/strategies/0: sweeps 1100 series; a strategy entry sweeps at most 1000"},
       {scene_with(R"([{"mesh": "torus.obj"}])", R"([{"bv": "aabb"}])",
                   R"([{"type": "exact", "coherent": 1}])", ""),
        "/strategies/0/coherent: expected true or false; got 1"},

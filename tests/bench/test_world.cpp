@@ -143,6 +143,33 @@ TEST_F(WorldTest, AFrameFileWithAMissingOrUnknownInstanceOrABadPoseIsRefused) {
   EXPECT_NE(error_of(world_scene(world)).find("cannot read the frame file"), std::string::npos);
 }
 
+// The largest world the parser takes: its instances are numbered and checked for duplicates in one pass
+// (a search of the instances read so far for each new one took minutes here), and a motion beyond a million
+// poses is refused before any is drawn.
+TEST_F(WorldTest, AHundredThousandInstancesAreReadInOnePass) {
+  auto world = [](const std::string& instances, int frames) {
+    return R"({"instances": )" + instances + R"(, "region": {"min": [0, 0, 0], "max": [100, 100, 100]},
+        "motion": {"type": "random_walk", "frames": )" +
+           std::to_string(frames) + "}}";
+  };
+  const std::string many = R"([{"object": "ring", "name": "first"}, {"object": "torus", "count": 99998},
+      {"object": "ring"}])";
+  const Scene scene = parse(world_scene(world(many, 1)));
+  ASSERT_EQ(scene.world->instances.size(), 100000u);
+  EXPECT_EQ(scene.world->instances[99998].name, "torus#99997");
+  EXPECT_EQ(scene.world->instances[99999].name, "ring#1");
+  EXPECT_NE(error_of(world_scene(world(many, 11))).find("/world/motion/frames: frames x instances is above"),
+            std::string::npos);
+  // The torus numbered 1 meets the ring named so first.
+  const std::string clash = R"([{"object": "ring", "name": "torus#1"}, {"object": "torus", "count": 3}])";
+  EXPECT_NE(
+      error_of(world_scene(world(clash, 2))).find("/world/instances/1: duplicate instance name \"torus#1\""),
+      std::string::npos);
+  const std::string too_many = R"([{"object": "ring"}, {"object": "torus", "count": 100000}])";
+  EXPECT_NE(error_of(world_scene(world(too_many, 2))).find("/world/instances/1: more than 100000 instances"),
+            std::string::npos);
+}
+
 TEST_F(WorldTest, OptionsThatDoNotApplyAreRefusedByName) {
   auto expect = [&](const std::string& text, const std::string& message) {
     const std::string error = error_of(text);
