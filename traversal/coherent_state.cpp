@@ -95,8 +95,11 @@ bool CoherentState::moved_too_far(const RigidTransform& pose) const {
 
 namespace {
 /// A query's work: a node pair taken, a BV test, and a triangle test worth about four BV tests. A walk also
-/// stores its tree, half a unit a pair: without it, on the pipes at m = 16 a walk looked a little cheaper
-/// than the cold query by work and took 1.5 times its time (bench/RESULTS.md, "Storing counts as work").
+/// stores its tree, kStoredPairWork units a pair: a walk's pair takes two to three times a cold traversal's
+/// node pair in time, which its counts do not show. 5 was measured against 0.5 to 3.5 (bench/RESULTS.md,
+/// "What a stored pair weighs"): with half a unit, walks that took 1.5 times the cold query's time looked
+/// cheaper by work.
+constexpr double kStoredPairWork = 5;
 double work_of(const Counters& c) {
   return static_cast<double>(c.nodes_visited + c.bv_tests + 4 * c.triangle_tests);
 }
@@ -116,7 +119,7 @@ void CoherentState::record_cost(const Counters& counters, double seconds, Start 
   if (options_.max_cold_run == 0) return;
   const double cost = options_.judge == CoherenceOptions::Judge::time
                           ? seconds
-                          : work_of(counters) + 0.5 * static_cast<double>(pairs_written);
+                          : work_of(counters) + kStoredPairWork * static_cast<double>(pairs_written);
   if (start == Start::Root) {
     add_root_cost(cost);
     if (cold_left_ > 0) {

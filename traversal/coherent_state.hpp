@@ -36,7 +36,7 @@ struct CoherenceOptions {
   /// each time the front loses again, at most this many. 0: always walk the front.
   std::uint32_t max_cold_run = 128;
   /// What "cost" means there. `work` (the default): node pairs, BV tests and triangle tests (four BV tests
-  /// each), and half a unit per pair a walk stores (the cold query stores none), which repeat exactly from
+  /// each), and five units per pair a walk stores (the cold query stores none), which repeat exactly from
   /// run to run, so the counters do too. `time`: each query's own
   /// seconds, what the caller pays: a walk's node pair costs 1.05 to 2.5 times a cold traversal's, by
   /// volume (bench/RESULTS.md), which the work does not see; the counters then vary from run to run.

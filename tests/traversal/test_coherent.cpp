@@ -302,7 +302,7 @@ TEST(Coherent, AWalkAfterALostContactGoesTheMarkedWayFirst) {
   EXPECT_LT(marked_work.triangle_tests, unmarked_work.triangle_tests);
 }
 
-// Judged by work, a walk pays for the tree it stores (half a unit a pair): a walk of the cold query's
+// Judged by work, a walk pays for the tree it stores (five units a pair): a walk of the cold query's
 // counters that stores pairs costs more than the cold query, and the next queries start from the root.
 TEST(Coherent, AWalksStoredPairsCountAsItsWork) {
   Counters work;
