@@ -12,6 +12,13 @@ std::string number_text(double v) {
   return buf;
 }
 
+void check_pose_count(const Node& at, double count, const std::string& how) {
+  if (count > limits::kPoses.max)
+    at.fail(how + " make " + std::to_string(static_cast<long long>(count)) +
+            " poses; a scene generates at most " +
+            std::to_string(static_cast<long long>(limits::kPoses.max)));
+}
+
 std::string join(const std::vector<std::string>& items, std::string_view sep) {
   std::string out;
   for (std::size_t i = 0; i < items.size(); ++i) out += (i ? std::string(sep) : "") + items[i];

@@ -124,6 +124,10 @@ std::optional<Mat3> axis_angle_rotation(const Vec3& axis, double degrees);
 /// rotation is refused. `extra` names further fields the caller allows (and reads itself).
 RigidTransform parse_transform(const Node& node, const std::vector<std::string>& extra = {"group"});
 
+/// Fails at `at` unless `count` poses (made up as `how`, say "3 distances of 400000 poses") stay within
+/// limits::kPoses: the bound every generated pose set of a scene shares.
+void check_pose_count(const Node& at, double count, const std::string& how);
+
 /// A non-empty list of {"bv_tests": N, "deadline_us": T} (either or both), each checked against limits.
 std::vector<Budget> parse_budgets(const Node& budgets);
 

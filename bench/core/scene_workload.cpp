@@ -91,14 +91,6 @@ void parse_pose_file(const Node& w, const std::filesystem::path& base_dir, Workl
   workload.identity = "poses:" + ContentHash().update(text).hex();
 }
 
-/// Fails unless `count` poses (made up as `how`) stay within limits::kPoses.
-void check_pose_count(const Node& at, double count, const std::string& how) {
-  if (count > limits::kPoses.max)
-    at.fail(how + " make " + std::to_string(static_cast<long long>(count)) +
-            " poses; a scene generates at most " +
-            std::to_string(static_cast<long long>(limits::kPoses.max)));
-}
-
 /// A "random" workload: seeded poses in a box, one group filed under distance 0.
 void parse_random(const Node& w, WorkloadSpec& workload) {
   w.expect_object({"type", "count", "seed", "box", "axis"});

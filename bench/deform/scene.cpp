@@ -31,10 +31,8 @@ std::vector<PoseGroup> parse_poses(const Node& node) {
   const int steps = static_cast<int>(node.child("steps").integer(1, kMaxSteps));
   const Node distances = node.child("distances");
   const std::size_t n = distances.array_size();
-  if (static_cast<double>(n) * steps > limits::kPoses.max)
-    node.fail(std::to_string(n) + " distances of " + std::to_string(steps) + " steps make " +
-              std::to_string(static_cast<long long>(n) * steps) + " poses; a scene generates at most " +
-              std::to_string(static_cast<long long>(limits::kPoses.max)));
+  check_pose_count(node, static_cast<double>(n) * steps,
+                   std::to_string(n) + " distances of " + std::to_string(steps) + " steps");
   for (std::size_t k = 0; k < n; ++k) {
     const double d = distances.child(k).number(limits::kDistance.min, limits::kDistance.max);
     groups.push_back({d, protocol_poses(d, steps)});

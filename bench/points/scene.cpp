@@ -78,10 +78,9 @@ void parse_points(const Node& root, Scene& scene, bool fcl) {
   if (p.has("steps"))
     points.steps = static_cast<int>(p.child("steps").integer(static_cast<long long>(limits::kSteps.min),
                                                              static_cast<long long>(limits::kSteps.max)));
-  if (const double poses = double(points.distances.size()) * points.steps; poses > limits::kPoses.max)
-    p.fail(std::to_string(points.distances.size()) + " distances of " + std::to_string(points.steps) +
-           " steps make " + std::to_string(static_cast<long long>(poses)) +
-           " poses; a scene generates at most " + std::to_string(static_cast<long long>(limits::kPoses.max)));
+  check_pose_count(
+      p, double(points.distances.size()) * points.steps,
+      std::to_string(points.distances.size()) + " distances of " + std::to_string(points.steps) + " steps");
   if (p.has("band")) points.band = p.child("band").number(0, 100);
   if (p.has("leaf")) points.leaf = static_cast<std::uint32_t>(p.child("leaf").integer(1, 255));
   if (p.has("grid")) points.grid = static_cast<int>(p.child("grid").integer(2, 4));
