@@ -97,6 +97,8 @@ class WideBvh {
     }
     // Node 0: the root's own volume in lane 0; the wide nodes follow, shifted by one.
     out.nodes_.resize(topology.nodes.size() + 1);
+    out.binary_.resize(topology.nodes.size() + 1);
+    for (std::size_t w = 0; w < topology.nodes.size(); ++w) out.binary_[w + 1] = topology.nodes[w].binary;
     const auto fill = [&](Node& to, std::span<const std::uint32_t> children) {
       std::array<Box, 4> packed;
       for (std::size_t k = 0; k < children.size(); ++k) {
@@ -119,6 +121,12 @@ class WideBvh {
   }
 
   [[nodiscard]] const Node& node(std::uint32_t i) const { return nodes_[i]; }
+  /// The binary node that lane `lane` of wide node `i` holds: a binary leaf, or the binary inner node a wide
+  /// child stands for. What a walk reads the binary tree's annotations with (ADB's counts: wide_adb.hpp).
+  [[nodiscard]] std::uint32_t binary_node(std::uint32_t i, std::uint32_t lane) const {
+    const std::uint32_t c = nodes_[i].child[lane];
+    return (c & kLeaf) ? c & ~kLeaf : binary_[c];
+  }
   [[nodiscard]] std::size_t size() const { return nodes_.size(); }
   [[nodiscard]] std::uint64_t binary_identity() const { return binary_identity_; }
   /// The binary tree's volumes_revision() when this was built: a refit of the binary tree leaves this
@@ -127,10 +135,13 @@ class WideBvh {
   /// The lanes' volumes are stored less this point (the root box's centre): a tree far from its frame's
   /// origin keeps small numbers, and so does the pose between two near trees (Lanes::make_context).
   [[nodiscard]] const Vec3& origin() const { return origin_; }
-  [[nodiscard]] std::size_t bytes() const { return nodes_.size() * sizeof(Node); }
+  [[nodiscard]] std::size_t bytes() const {
+    return nodes_.size() * sizeof(Node) + binary_.size() * sizeof(std::uint32_t);
+  }
 
  private:
   std::vector<Node> nodes_;
+  std::vector<std::uint32_t> binary_;  ///< per wide node, the binary inner node it stands for (0 at node 0)
   std::uint64_t binary_identity_ = 0;
   std::uint64_t binary_revision_ = 0;
   Vec3 origin_ = Vec3::Zero();

@@ -6,3 +6,4 @@
 #include "traversal/adb.hpp"
 #include "traversal/coherent_adb.hpp"
 #include "traversal/frame_schedule.hpp"
+#include "traversal/wide_adb.hpp"

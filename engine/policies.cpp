@@ -30,8 +30,6 @@ StrategyInfo strategy_row() {
   info.coherent = kRunsCoherent<S>;
   info.wide = kRunsWide<S>;
   info.density_free = kDensityFree<S>;
-  static_assert(!kRunsWide<S> || kDensityFree<S>,
-                "a wide strategy is compiled once per volume: density_free");
   with_each_density([&]<class D>(std::type_identity<D>) {
     if constexpr (S::template accepts<D>) info.densities.emplace_back(D::name());
   });

@@ -63,7 +63,8 @@ struct StrategyVariant {
   bool contact_geometry = false;
   /// The query walks the trees' wide layout (four children a node tested at once, bvh/wide_bvh.hpp), built
   /// from each tree on first use and kept with it: only strategies that run wide take it
-  /// (StrategyInfo::wide), on volumes with a wide layout, not coherent. Same answers, less time.
+  /// (StrategyInfo::wide), on volumes with a wide layout, not coherent. The exact strategies give the same
+  /// answers in less time; ADB's wide walk estimates fewer pairs, and so may answer otherwise.
   bool wide = false;
   [[nodiscard]] std::string budget_label() const;  ///< "" or "bv_tests=200" or "deadline_us=20"
   [[nodiscard]] std::string label() const;         ///< e.g. "adb p_min=0.9", "exact coherent", "exact wide"

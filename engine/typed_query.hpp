@@ -60,10 +60,18 @@ struct HierarchyOnly {
   const WideForm<BV>* wide = nullptr;
 };
 
-/// A tree as strategy S reads it: `Held` is std::reference_wrapper<const Tree<BV, D>> or HierarchyOnly<BV>.
-template <class T>
-const T& tree_of(const std::reference_wrapper<const T>& held) {
-  return held.get();
+/// What a strategy that reads the density (ADB's) holds of a tree: the tree, and its wide layout when the
+/// query walks that.
+template <class BV, class D>
+struct AnnotatedTree {
+  const Tree<BV, D>& tree;
+  const WideForm<BV>* wide = nullptr;
+};
+
+/// A tree as strategy S reads it: `Held` is AnnotatedTree<BV, D> or HierarchyOnly<BV>.
+template <class BV, class D>
+const Tree<BV, D>& tree_of(const AnnotatedTree<BV, D>& held) {
+  return held.tree;
 }
 template <class BV>
 const HierarchyOnly<BV>& tree_of(const HierarchyOnly<BV>& held) {
@@ -143,13 +151,12 @@ class TypedQuery final : public PreparedQuery {
   /// The walk of a query without surfaces: the wide layouts' when prepared with them.
   Result walk(const RigidTransform& pose) const {
     if constexpr (kWalksWide)
-      if (trees_.a.wide) return S::query_wide(a(), *a().wide, b(), *b().wide, pose, options_);
+      if (trees_.a.wide) return S::query_wide(a(), *trees_.a.wide, b(), *trees_.b.wide, pose, options_);
     return S::query(a(), b(), pose, options_);
   }
   /// Whether a prepared query of this type may walk the wide layouts (prepare sets them only for a wide
   /// variant).
-  static constexpr bool kWalksWide =
-      kRunsWide<S> && HasWideLayout<BV> && kWalksWideOn<S, BV> && std::is_same_v<Held, HierarchyOnly<BV>>;
+  static constexpr bool kWalksWide = kRunsWide<S> && HasWideLayout<BV> && kWalksWideOn<S, BV>;
   void add_geometry(const RigidTransform& pose, Result& r) const {
     if (geometry_) (*geometry_)(pose, r);
   }
@@ -347,8 +354,14 @@ struct TreeQueries {
     const SurfaceSide side_a = a->side(), side_b = b->side();
     const Tree<BV, D>& tree_a = a->tree;
     const Tree<BV, D>& tree_b = b->tree;
-    QueryTrees<std::reference_wrapper<const Tree<BV, D>>> trees{
-        std::move(a), std::move(b), std::cref(tree_a), std::cref(tree_b), side_a, side_b};
+    const WideLayoutSource<BV>& a_tree = *a;  // not Base: the layout's build stays in the slot file
+    const WideLayoutSource<BV>& b_tree = *b;
+    QueryTrees<AnnotatedTree<BV, D>> trees{std::move(a), std::move(b), {tree_a}, {tree_b}, side_a, side_b};
+    if constexpr (HasWideLayout<BV>)
+      if (variant.wide) {
+        trees.a.wide = &a_tree.wide_layout();
+        trees.b.wide = &b_tree.wide_layout();
+      }
     return make_query<S, BV, kCloudDensity<D>>(std::move(trees), std::move(options), variant);
   }
 };

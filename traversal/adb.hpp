@@ -123,6 +123,15 @@ class AdbHooks {
     }
   }
 
+  /// The estimate of a pair whose volumes are known to overlap: a wide walk (traversal/wide_adb.hpp) tests
+  /// four at once and estimates the pairs it found overlapping. The boxes come from the nodes alone, so
+  /// only for volumes whose walkers carry no state.
+  [[gnu::always_inline]] double estimate_overlapping(const Pair& p) {
+    ++trees_.counters.probability_evaluations;
+    const PairGeometry g = geometry(p);
+    return estimate_(g.a, g.b, g.overlap, p.a, p.b);
+  }
+
   /// Decide, queue (possibly as a candidate), or drop.
   [[gnu::always_inline]] Admission admit(Pair& p, double probability) {
     if (probability < 0) return Admission::Drop;  // volumes apart: provably no contact below
@@ -285,6 +294,16 @@ bool recalled(const TreePair<BV, Leaves>& trees, Hooks& hooks, AdbRecall& recall
   }
 }
 
+/// The trees' probability model for this pose. A density whose estimate depends on the pair's relative
+/// rotation takes it; throws for incompatible annotations.
+template <TreeVolume BV, ProbabilityDensity D>
+auto pair_estimator(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a) {
+  if constexpr (requires { D::estimator(a.density, b.density, b_to_a.rotation); })
+    return D::estimator(a.density, b.density, b_to_a.rotation);
+  else
+    return D::estimator(a.density, b.density);
+}
+
 /// query_adb, with a remembered pair tried first when `recall` is given (one instantiation for both).
 template <class Order, TreeVolume BV, ProbabilityDensity D, class Leaves>
 Result adb_query(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a,
@@ -292,14 +311,7 @@ Result adb_query(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransfor
   BudgetLimit limit(options.budget);  // a deadline counts from here, set-up included
   options.validate();
   b_to_a.validate();
-  // A density whose estimate depends on the pair's relative rotation takes it (throws for incompatible
-  // annotations).
-  const auto estimate = [&] {
-    if constexpr (requires { D::estimator(a.density, b.density, b_to_a.rotation); })
-      return D::estimator(a.density, b.density, b_to_a.rotation);
-    else
-      return D::estimator(a.density, b.density);
-  }();
+  const auto estimate = pair_estimator(a, b, b_to_a);
   if constexpr (Leaves::kTriangles)
     if (options.exact_leaves) TriangleLeaves::require(a.bvh, b.bvh, "adb: guided exact");
 

@@ -8,5 +8,6 @@
 #include "distance.hpp"
 #include "exact.hpp"
 #include "strategy_types.hpp"
+#include "wide_adb.hpp"
 #include "wide_distance.hpp"
 #include "wide_exact.hpp"

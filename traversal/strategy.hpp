@@ -38,10 +38,11 @@
 //                          this pair of trees) and leaving its own front there. Its answers are those of
 //                          S::query: a state makes a query faster, never other.
 // Optional: running on the trees' wide layout (bvh/wide_bvh.hpp, traversal/wide_exact.hpp)
-//   S::wide                constexpr bool true: the strategy offers (it must be density_free too)
+//   S::wide                constexpr bool true: the strategy offers
 //   S::query_wide(a, wide_a, b, wide_b, b_to_a, options)
 //                          Result of S::query, walking the wide trees built from a.bvh and b.bvh (four
-//                          children a node tested at once). The same answers as S::query.
+//                          children a node tested at once). The same answers as S::query for the exact
+//                          strategies; ADB's wide walk estimates other pairs (traversal/wide_adb.hpp).
 //   S::walks_wide<BV>      optional constexpr bool: whether the wide walk runs on trees of volume BV
 //   (default:
 //                          every volume with a wide layout); the run-time layer refuses the others by name.

@@ -149,6 +149,16 @@ struct AdbStrategy : GuidedExactStrategy {
     options.validate();
     return options;
   }
+  /// On the wide layout (traversal/wide_adb.hpp): the same rule on fewer pairs, so other answers.
+  static constexpr bool wide = true;
+  template <class BV>
+  static constexpr bool walks_wide = std::is_empty_v<typename VolumeWalker<BV>::Working>;
+  template <class TreeA, class TreeB, class Lanes>
+  static Result query_wide(const TreeA& a, const WideBvh<Lanes>& wide_a, const TreeB& b,
+                           const WideBvh<Lanes>& wide_b, const RigidTransform& b_to_a,
+                           const Options& options) {
+    return query_adb_wide(a, wide_a, b, wide_b, b_to_a, options);
+  }
 };
 
 /// `Base` (a strategy running query_adb) in another order (`Order`: AdbDepthFirst, AdbLargerFirst). On the
@@ -156,6 +166,7 @@ struct AdbStrategy : GuidedExactStrategy {
 /// runner, the CLI and Python to compile, and the order does not depend on the density.
 template <class Base, class Order>
 struct InOrder : Base {
+  static constexpr bool wide = false;  // the wide walk has its own order
   template <class D>
   static constexpr bool accepts = ProbabilityDensity<D>&& D::name() == std::string_view("adb");
   template <class TreeA, class TreeB, class Leaves = TriangleLeaves>

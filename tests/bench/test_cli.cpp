@@ -469,9 +469,15 @@ TEST_F(Cli, WideQueriesAnswerAsTheBinaryWalk) {
   const std::string text =
       ok("query torus.obj torus.obj --protocol 1.2,12 --bv dop24 --wide --all-contacts").out;
   EXPECT_NE(text.find("torus vs torus, all_contacts wide on dop24, 12 poses\n"), std::string::npos) << text;
+  // ADB's wide walk: its own answers, four BV tests a step after the roots.
+  const std::string adb_text =
+      ok("query torus.obj torus.obj --protocol 1.2,12 --density adb --strategy adb --wide").out;
+  EXPECT_NE(adb_text.find("torus vs torus, adb p_min=0.9 wide on aabb, 12 poses\n"), std::string::npos)
+      << adb_text;
   expect_refused(
-      "query torus.obj torus.obj --pose 1,0,0 --wide --strategy adb --density adb",
-      "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts, distance)");
+      "query torus.obj torus.obj --pose 1,0,0 --wide --strategy adb_dfs --density adb",
+      "strategy adb_dfs does not run on wide trees (the strategies that do: exact, all_contacts, adb, "
+      "time_critical, distance)");
   expect_refused("query torus.obj torus.obj --pose 1,0,0 --wide --bv rss",
                  "bounding volume 'rss' has no wide layout (the volumes that do: aabb, ");
   expect_refused("query torus.obj torus.obj --pose 1,0,0 --wide --coherent", "give --coherent or --wide");

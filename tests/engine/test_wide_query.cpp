@@ -88,6 +88,37 @@ TEST(WideQuery, AnswersAsTheBinaryWalkOnEveryVolumeWithALayout) {
   EXPECT_LT(colliding, volumes * 2 * poses.size());
 }
 
+// ADB and time-critical walk the wide layouts of boxes, spheres, oriented boxes and k-DOPs through the
+// engine: honest answers (an exact "no" is a proof, a "collision" lies above p_min), four BV tests a step,
+// and the budget held to within a step.
+TEST(WideQuery, AdbAndTimeCriticalWalkWideHonestly) {
+  const Mesh torus_a = testing::make_torus(0.7, 0.25, 16, 8), torus_b = testing::make_torus(0.5, 0.2, 12, 8);
+  const auto poses = sliding_poses();
+  const StrategyVariant exact = strategy_variant("exact", {}, Budget{});
+  const StrategyVariant adb = strategy_variant("adb", {{"p_min", 0.9}}, Budget{});
+  const StrategyVariant budgeted = strategy_variant("time_critical", {}, Budget{9, 0});
+  std::size_t volumes = 0;
+  for (const std::string& bv : volume_names()) {
+    if (!strategy_info("adb").wide_walk_refusal(bv).empty()) continue;
+    SCOPED_TRACE(bv);
+    ++volumes;
+    const AnyTree a = AnyTree::build(torus_a, MeshUnits{}, bv, density_spec("adb", {}), BuildOptions{});
+    const AnyTree b = AnyTree::build(torus_b, MeshUnits{}, bv, density_spec("adb", {}), BuildOptions{});
+    const auto truth = results_of(a, b, exact, poses), binary = results_of(a, b, adb, poses),
+               walked = results_of(a, b, wide(adb), poses), limited = results_of(a, b, wide(budgeted), poses);
+    bool other_walk = false;  // the binary walk tests two or four children a step, the wide one four
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      if (walked[i].exact) EXPECT_EQ(walked[i].collides, truth[i].collides) << "pose " << i;
+      if (walked[i].collides) EXPECT_GT(walked[i].probability, 0.9) << "pose " << i;
+      EXPECT_EQ(walked[i].counters.bv_tests % 4, 1u) << "the roots, then four a step; pose " << i;
+      EXPECT_LE(limited[i].counters.bv_tests, 9u + 3u) << "pose " << i;
+      other_walk = other_walk || walked[i].counters.bv_tests != binary[i].counters.bv_tests;
+    }
+    EXPECT_TRUE(other_walk);
+  }
+  EXPECT_GE(volumes, 4u);  // aabb, the k-DOPs, obb, sphere
+}
+
 // A saved tree loaded with its mesh walks wide as the tree it was saved from (the layout is derived from
 // the binary tree, which is what the file keeps), and the contacts' geometry is the binary walk's.
 TEST(WideQuery, ALoadedTreeAndContactGeometryWalkWideToo) {
@@ -158,14 +189,21 @@ TEST(WideQuery, IsRefusedByNameWhereItDoesNotRun) {
     return AnyTree::build(testing::make_torus(0.7, 0.25, 12, 6), MeshUnits{}, bv, density_spec(density, {}),
                           BuildOptions{});
   };
-  StrategyVariant adb = wide(strategy_variant("adb", {}, Budget{}));
-  EXPECT_EQ(
-      error_of([&] { check_strategy_options(adb); }),
-      "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts, distance)");
+  const std::string no_walk =
+      "strategy adb_dfs does not run on wide trees (the strategies that do: exact, all_contacts, adb, "
+      "time_critical, distance)";
+  StrategyVariant dfs = wide(strategy_variant("adb_dfs", {}, Budget{}));
+  EXPECT_EQ(error_of([&] { check_strategy_options(dfs); }), no_walk);
   const AnyTree adb_tree = tree("aabb", "adb");
+  EXPECT_EQ(error_of([&] { (void)adb_tree.prepare(adb_tree, dfs); }), no_walk);
+  // ADB's wide walk reads a lane's box from its binary node alone: not the restricted boxtree's.
+  const AnyTree rbox = tree("rbox", "adb");
+  const std::string no_rbox =
+      error_of([&] { (void)rbox.prepare(rbox, wide(strategy_variant("adb", {}, {}))); });
   EXPECT_EQ(
-      error_of([&] { (void)adb_tree.prepare(adb_tree, adb); }),
-      "strategy adb does not run on wide trees (the strategies that do: exact, all_contacts, distance)");
+      no_rbox.rfind("strategy adb has no wide walk on 'rbox' trees (the volumes it walks wide: aabb, ", 0),
+      0u)
+      << no_rbox;
 
 #ifndef BVHLAB_LEAN_VOLUMES  // every volume of the sanitizer builds' lean registry has a wide layout
   const AnyTree rss = tree("rss", "none");

@@ -355,12 +355,26 @@ def test_wide_batches_answer_as_binary_ones(gear, strategy):
                                        "nodes_visited")
     single = bvhlab.query(tree, tree, poses[0], strategy=strategy, wide=True)
     assert single.collides == bool(binary["collides"][0])
-    with pytest.raises(ValueError, match="strategy adb does not run on wide trees"):
-        bvhlab.query_batch(tree, tree, poses, strategy="adb", wide=True)
+    with pytest.raises(ValueError, match="strategy adb_dfs does not run on wide trees"):
+        bvhlab.query_batch(tree, tree, poses, strategy="adb_dfs", wide=True)
     with pytest.raises(ValueError, match="bounding volume 'rss' has no wide layout"):
         bvhlab.query_batch(trees["rss"], trees["rss"], poses, strategy=strategy, wide=True)
     with pytest.raises(ValueError, match="coherent or wide, not both"):
         bvhlab.query_batch(tree, tree, poses, strategy=strategy, wide=True, coherent=True)
+
+
+def test_wide_adb_batches_are_honest(gear_trees):
+    """strategy="adb" with wide=True walks the wide layout of an annotated tree: its own answers (other pairs
+    are estimated), an exact "no" only where the exact answer is "no", four BV tests a step."""
+    tree = gear_trees["adb"]
+    poses = np.concatenate([bvhlab.protocol_poses(d, 40) for d in (0.8, 1.4, 2.0)])
+    truth = bvhlab.query_batch(tree, tree, poses, strategy="exact")["collides"]
+    walked = bvhlab.query_batch(tree, tree, poses, strategy="adb", p_min=0.9, wide=True)
+    exact_no = walked["exact"] & ~walked["collides"]
+    assert not truth[exact_no].any()
+    assert (walked["probability"][walked["collides"]] > 0.9).all()
+    assert (walked["bv_tests"] % 4 == 1).all()
+    assert 0 < walked["collides"].sum() < len(poses)
 
 
 def test_wide_distances_are_the_binary_ones(gear):
