@@ -45,8 +45,8 @@ struct StrategyInfo {
   /// Empty when it runs coherent; else the one message every caller gives: "strategy adb does not run
   /// coherent (the strategies that do: exact, all_contacts)".
   [[nodiscard]] std::string coherent_refusal() const;
-  /// Empty when it runs on the trees' wide layout; else the one message every caller gives: "strategy adb
-  /// does not run on wide trees (the strategies that do: exact, all_contacts, distance)".
+  /// Empty when it runs on the trees' wide layout; else the one message every caller gives: "strategy
+  /// adb_dfs does not run on wide trees (the strategies that do: exact, all_contacts, adb, ...)".
   [[nodiscard]] std::string wide_refusal() const;
   /// Empty when its wide walk runs on trees of volume `bv`; else the one message every caller gives: the
   /// wide_refusal() above, wide_layout_refusal(bv) below, or "strategy distance has no wide walk on 'aabb'

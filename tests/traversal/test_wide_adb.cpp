@@ -126,6 +126,18 @@ TYPED_TEST(WideAdb, BudgetsHoldWithinOneStep) {
   }
 }
 
+TEST(WideAdbDeadline, APassedDeadlineGivesTheBestEffortAnswerFlagged) {
+  const WideTrees<Aabb4> t;
+  AdbOptions options;
+  options.p_min = 1.0;                // never decisive: only the deadline ends the walk early
+  options.budget.deadline_us = 1e-6;  // passed before the first pop
+  const Result r = t.query(RigidTransform::identity(), options);
+  EXPECT_TRUE(r.budget_exhausted);
+  EXPECT_FALSE(r.exact);
+  EXPECT_EQ(r.collides, r.probability >= options.best_effort_threshold);
+  EXPECT_LE(r.counters.nodes_visited, 1u);  // the clock is read before the first pop
+}
+
 TEST(WideAdbInput, RefusesWideTreesOfOtherTreesAndNonRigidPoses) {
   const WideTrees<Aabb4> t;
   const WideAabbTree other = WideAabbTree::build(Bvh<Aabb>::build(testing::make_random_soup(50, 0.1, 9)));
