@@ -24,15 +24,6 @@ namespace bvhlab {
 
 namespace frame_detail {
 
-/// The density's estimator for a pair, in the form for its rotation when it has one (as query_adb).
-template <TreeVolume BV, ProbabilityDensity D>
-auto density_estimator(const Tree<BV, D>& a, const Tree<BV, D>& b, const RigidTransform& b_to_a) {
-  if constexpr (requires { D::estimator(a.density, b.density, b_to_a.rotation); })
-    return D::estimator(a.density, b.density, b_to_a.rotation);
-  else
-    return D::estimator(a.density, b.density);
-}
-
 /// The estimator in AdbHooks' argument order.
 template <class Model>
 struct NodeEstimate {
@@ -99,16 +90,16 @@ struct FrameOrderQueue {
 template <TreeVolume BV, ProbabilityDensity D>
 class PairRun {
  public:
-  using Estimate = NodeEstimate<decltype(density_estimator(std::declval<const Tree<BV, D>&>(),
-                                                           std::declval<const Tree<BV, D>&>(),
-                                                           std::declval<const RigidTransform&>()))>;
+  using Estimate = NodeEstimate<decltype(detail::pair_estimator(std::declval<const Tree<BV, D>&>(),
+                                                                std::declval<const Tree<BV, D>&>(),
+                                                                std::declval<const RigidTransform&>()))>;
   using Hooks = AdbHooks<BV, Estimate, TriangleLeaves, estimates_in_node_frames<D, BV>>;
   using Steps = Traversal<FrameOrderQueue, SplitBoth, BV, Hooks, TestCap>;
 
   PairRun(const FramePair<BV, D>& pair, const AdbOptions& options, FrameOrder order)
       : context_(VolumeWalker<BV>::make_context(pair.b_to_a)),
         trees_(pair.a->bvh, pair.b->bvh, pair.b_to_a, context_, result_.counters),
-        estimate_{density_estimator(*pair.a, *pair.b, pair.b_to_a)},
+        estimate_{detail::pair_estimator(*pair.a, *pair.b, pair.b_to_a)},
         hooks_(trees_, result_, options, estimate_),
         state_(pair.a->bvh.empty() || pair.b->bvh.empty() ? TraversalState::Done : TraversalState::Stopped) {
     queue_.order_by(order);

@@ -2,6 +2,7 @@
 // flagged however it ended (stopped, decided, queue empty); a deadline never reached changes nothing; a
 // BV-test cap flags only a traversal it stopped. Flags and answers only: no assertion on speed.
 #include "adb/adb_density.hpp"
+#include "support/crude_annotation.hpp"
 #include "support/generated_meshes.hpp"
 #include "support/volume_lists.hpp"
 #include "traversal/adb.hpp"
@@ -15,22 +16,12 @@
 namespace bvhlab {
 namespace {
 
-// A crude stand-in annotation, independent of adb/annotate: pc = min(8, triangles below the node).
-template <class BV>
-Tree<BV, AdbDensity> crude_annotation(const Mesh& mesh) {
-  Bvh<BV> bvh = Bvh<BV>::build(mesh);
-  std::vector<std::uint8_t> counts;
-  for (const auto& [begin, end] : node_triangle_ranges(bvh.nodes()))
-    counts.push_back(static_cast<std::uint8_t>(std::min<std::uint32_t>(8, end - begin)));
-  return {std::move(bvh), AdbDensity::make_storage({2, 0.5}, std::move(counts))};
-}
-
 template <class BV>
 struct Scene {
   Mesh mesh_a = testing::make_torus(0.7, 0.25, 40, 20);
   Mesh mesh_b = testing::make_random_soup(500, 0.1, 3);
-  Tree<BV, AdbDensity> a = crude_annotation<BV>(mesh_a);
-  Tree<BV, AdbDensity> b = crude_annotation<BV>(mesh_b);
+  Tree<BV, AdbDensity> a = testing::crude_adb_tree<BV>(mesh_a);
+  Tree<BV, AdbDensity> b = testing::crude_adb_tree<BV>(mesh_b);
 };
 
 AdbOptions with_deadline(double deadline_us, double p_min = 0.9) {

@@ -2,6 +2,7 @@
 // its answers are honest (an exact "no" only where no pair's volumes overlap, a "collision" only above
 // p_min), its errors against the exact answer are of the binary walk's size, and budgets hold.
 #include "adb/adb_density.hpp"
+#include "support/crude_annotation.hpp"
 #include "support/generated_meshes.hpp"
 #include "traversal/exact.hpp"
 #include "traversal/wide_adb.hpp"
@@ -15,22 +16,12 @@
 namespace bvhlab {
 namespace {
 
-// A crude annotation, independent of adb/annotate: pc = min(g^3, triangles below the node).
-template <class BV>
-Tree<BV, AdbDensity> crude_tree(const Mesh& mesh) {
-  Bvh<BV> bvh = Bvh<BV>::build(mesh);
-  std::vector<std::uint8_t> counts;
-  for (const auto& [begin, end] : node_triangle_ranges(bvh.nodes()))
-    counts.push_back(static_cast<std::uint8_t>(std::min<std::uint32_t>(8, end - begin)));
-  return {std::move(bvh), AdbDensity::make_storage({2, 0.5}, std::move(counts))};
-}
-
 template <class Lanes>
 struct WideTrees {
   using BV = typename Lanes::Volume;
   Mesh mesh_a = testing::make_torus(0.7, 0.25, 40, 20);
   Mesh mesh_b = testing::make_random_soup(500, 0.1, 3);
-  Tree<BV, AdbDensity> a = crude_tree<BV>(mesh_a), b = crude_tree<BV>(mesh_b);
+  Tree<BV, AdbDensity> a = testing::crude_adb_tree<BV>(mesh_a), b = testing::crude_adb_tree<BV>(mesh_b);
   WideBvh<Lanes> wide_a = WideBvh<Lanes>::build(a.bvh), wide_b = WideBvh<Lanes>::build(b.bvh);
   template <class Order = AdbBestFirst>
   Result query(const RigidTransform& pose, const AdbOptions& options) const {
