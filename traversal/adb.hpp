@@ -117,15 +117,12 @@ class AdbHooks {
       return estimate_(g.a, g.b, g.overlap, p.a, p.b);
     } else {
       if (!trees_.overlap(p)) return -1;
-      ++trees_.counters.probability_evaluations;
-      const PairGeometry g = geometry(p);
-      return estimate_(g.a, g.b, g.overlap, p.a, p.b);
+      return estimate_overlapping(p);
     }
   }
 
-  /// The estimate of a pair whose volumes are known to overlap: a wide walk (traversal/wide_adb.hpp) tests
-  /// four at once and estimates the pairs it found overlapping. The boxes come from the nodes alone, so
-  /// only for volumes whose walkers carry no state.
+  /// The estimate of a pair whose volumes are known to overlap: evaluate's after its test, and a wide walk's
+  /// (traversal/wide_adb.hpp), which tests four at once and estimates the pairs it found overlapping.
   [[gnu::always_inline]] double estimate_overlapping(const Pair& p) {
     ++trees_.counters.probability_evaluations;
     const PairGeometry g = geometry(p);
@@ -284,7 +281,7 @@ struct AdbRecall {
 /// start below it (as the frame budget's memory).
 template <TreeVolume BV, class Leaves, class Hooks>
 bool recalled(const TreePair<BV, Leaves>& trees, Hooks& hooks, AdbRecall& recall) {
-  if constexpr (!std::is_empty_v<typename VolumeWalker<BV>::Working>) {
+  if constexpr (!StatelessWalk<BV>) {
     return false;
   } else {
     if (!recall.pair) return false;

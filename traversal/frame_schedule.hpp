@@ -161,7 +161,7 @@ class PairRun {
   /// Node pair (i, j) decides "collision" on its own estimate (one BV test): what the traversal would
   /// decide on reaching it. Volumes whose walkers carry state down from the root cannot start below it.
   bool decides_again(std::uint32_t i, std::uint32_t j) {
-    if constexpr (!std::is_empty_v<typename VolumeWalker<BV>::Working>) {
+    if constexpr (!StatelessWalk<BV>) {
       return false;
     } else {
       if (i >= trees_.a.nodes().size() || j >= trees_.b.nodes().size()) return false;

@@ -152,7 +152,7 @@ struct AdbStrategy : GuidedExactStrategy {
   /// On the wide layout (traversal/wide_adb.hpp): the same rule on fewer pairs, so other answers.
   static constexpr bool wide = true;
   template <class BV>
-  static constexpr bool walks_wide = std::is_empty_v<typename VolumeWalker<BV>::Working>;
+  static constexpr bool walks_wide = StatelessWalk<BV>;
   template <class TreeA, class TreeB, class Lanes>
   static Result query_wide(const TreeA& a, const WideBvh<Lanes>& wide_a, const TreeB& b,
                            const WideBvh<Lanes>& wide_b, const RigidTransform& b_to_a,

@@ -7,6 +7,8 @@
 
 #include "../bvh/bvh.hpp"
 
+#include <type_traits>
+
 namespace bvhlab {
 
 template <TreeVolume BV>
@@ -23,6 +25,12 @@ const auto& bvh_of(const Tree& tree) {
 
 template <TreeVolume BV>
 struct VolumeWalker;
+
+/// Whether a node index alone gives a node's volume and box: the walker carries no state down the tree
+/// (every volume but the hierarchical ones). Only then may a walk start below the root pair (a remembered
+/// pair) or reach a node without its ancestors (a wide tree's lane).
+template <class BV>
+concept StatelessWalk = std::is_empty_v<typename VolumeWalker<BV>::Working>;
 
 template <BoundingVolume BV>
 struct VolumeWalker<BV> {

@@ -45,7 +45,7 @@ struct EmptyState {
 };
 /// Self-contained volumes: the walkers carry no state, and it takes no room (a pair is 8 bytes).
 template <TreeVolume BV, class Key, class Tag>
-requires std::is_empty_v<typename VolumeWalker<BV>::Working>
+requires StatelessWalk<BV>
 struct QueuedPair<BV, Key, Tag> {
   using Working = typename VolumeWalker<BV>::Working;
   [[no_unique_address]] Key key{};

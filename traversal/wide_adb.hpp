@@ -17,7 +17,6 @@
 #include "wide_exact.hpp"
 
 #include <bit>
-#include <type_traits>
 #include <vector>
 
 namespace bvhlab {
@@ -31,11 +30,6 @@ struct WideAdbPair {
   std::uint32_t a_node = 0, a_lane = 0, b_node = 0, b_lane = 0, placed = 0;
   std::uint8_t tag = 0;
 };
-
-/// Which volumes the wide ADB walk runs on: those whose walkers carry no state, so that a lane's binary
-/// node alone gives its box to the estimate (not the restricted boxtree).
-template <class BV>
-inline constexpr bool kAdbWalksWide = std::is_empty_v<typename VolumeWalker<BV>::Working>;
 
 /// The walk itself, filling `hooks`' result: see the header comment.
 template <class Order, class Lanes, class Hooks>
@@ -129,11 +123,14 @@ void adb_walk(const WideBvh<Lanes>& wide_a, const WideBvh<Lanes>& wide_b,
 /// trees. `Order` is AdbBestFirst (the default) or AdbDepthFirst: the queue; the descent splits the larger
 /// volume, four children at once. Throws std::invalid_argument as query_adb does, and for wide trees not
 /// built from these trees' hierarchies (or built before a refit). Const and thread-safe on shared trees.
+/// Only volumes whose walkers carry no state: a lane's binary node alone then gives its box to the estimate.
 template <class Order = AdbBestFirst, class Lanes, ProbabilityDensity D>
-requires wide_detail::kAdbWalksWide<typename Lanes::Volume> Result
-query_adb_wide(const Tree<typename Lanes::Volume, D>& a, const WideBvh<Lanes>& wide_a,
-               const Tree<typename Lanes::Volume, D>& b, const WideBvh<Lanes>& wide_b,
-               const RigidTransform& b_to_a, const AdbOptions& options) {
+requires StatelessWalk<typename Lanes::Volume> Result query_adb_wide(const Tree<typename Lanes::Volume, D>& a,
+                                                                     const WideBvh<Lanes>& wide_a,
+                                                                     const Tree<typename Lanes::Volume, D>& b,
+                                                                     const WideBvh<Lanes>& wide_b,
+                                                                     const RigidTransform& b_to_a,
+                                                                     const AdbOptions& options) {
   using BV = typename Lanes::Volume;
   BudgetLimit limit(options.budget);  // a deadline counts from here, set-up included
   options.validate();
