@@ -30,6 +30,7 @@
 #include "probability.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -87,8 +88,7 @@ class AdbModel {
       s_b *= face_ratio<rule.cells>(face_b, face_a);
     const double cell_volume = (move_a ? volume_b : volume_a) / cells;
     const double s_real = cell_volume > 0 ? overlap / cell_volume : cells;
-    const int s =
-        !(s_real < cells) ? cells : std::clamp(static_cast<int>(std::ceil(s_real - 1e-9)), 1, cells);
+    const int s = !(s_real < cells) ? cells : std::clamp(ceil_to_int(s_real - 1e-9), 1, cells);
     s_a = std::min(s_a, double(s));
     s_b = std::min(s_b, double(s));
     return interpolate(s, s_a, s_b);
@@ -104,12 +104,20 @@ class AdbModel {
     return target == AdbRule::Cells::Finer ? std::clamp(ratio, 1.0, kMaxFaceRatio) : std::min(ratio, 1.0);
   }
 
+  /// std::ceil for |x| < 2^31, without the library call a baseline x86-64 build makes for it.
+  static int ceil_to_int(double x) {
+    const int truncated = static_cast<int>(x);
+    return truncated + (x > truncated ? 1 : 0);
+  }
+
   [[nodiscard]] double interpolate(int s, double s_a, double s_b) const {
     const int a0 = static_cast<int>(s_a), b0 = static_cast<int>(s_b);
     const int a1 = std::min(a0 + 1, s), b1 = std::min(b0 + 1, s);
     const double fa = s_a - a0, fb = s_b - b0;
-    const double p00 = table_.lookup(s, a0, b0), p10 = table_.lookup(s, a1, b0);
-    const double p01 = table_.lookup(s, a0, b1), p11 = table_.lookup(s, a1, b1);
+    assert(s >= 0 && s <= table_.s_max() && s_a >= 0 && s_a <= s && s_b >= 0 && s_b <= s);
+    const double* layer = table_.layer(s);
+    const double p00 = ProbabilityTable::at(layer, a0, b0), p10 = ProbabilityTable::at(layer, a1, b0);
+    const double p01 = ProbabilityTable::at(layer, a0, b1), p11 = ProbabilityTable::at(layer, a1, b1);
     return (1 - fa) * ((1 - fb) * p00 + fb * p01) + fa * ((1 - fb) * p10 + fb * p11);
   }
 

@@ -78,6 +78,18 @@ class ProbabilityTable {
     return values_[index(s, hi, lo)];
   }
 
+  /// The entries of one s, for several lookups at the same s (AdbModel's interpolation): at(layer, ...)
+  /// reads what lookup(s, ...) does. Precondition as lookup's.
+  [[nodiscard]] const double* layer(int s) const noexcept {
+    assert(s >= 0 && s <= s_max_);
+    return values_.data() + index(s, 0, 0);
+  }
+  [[nodiscard]] static double at(const double* layer, int s_a, int s_b) noexcept {
+    const auto [lo, hi] = std::minmax(s_a, s_b);
+    const auto hu = static_cast<std::size_t>(hi);
+    return layer[hu * (hu + 1) / 2 + static_cast<std::size_t>(lo)];
+  }
+
   /// Checked query. Inside the table it returns lookup(); for s > s_max it computes the estimate directly
   /// (same value the table would hold, at the cost of transcendental math), rather than rescaling the
   /// counts: shrinking s, s_a, s_b by s_max / s shrinks the expected number of collision cells

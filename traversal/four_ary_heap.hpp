@@ -5,6 +5,7 @@
 // (bench/RESULTS.md).
 // Written here rather than taken from Boost.Heap's d_ary_heap, whose option machinery every strategy's
 // translation unit would then compile. Ties leave in an order of their own, as in any heap.
+// `Storage` holds the pairs in heap order: a std::vector, or (the best-first queue's) an InlineStack.
 #pragma once
 
 #include <cstddef>
@@ -12,22 +13,13 @@
 
 namespace bvhlab {
 
-template <class Pair>
+template <class Pair, class Storage = std::vector<Pair>>
 class FourAryHeap {
  public:
   [[nodiscard]] bool empty() const { return pairs_.empty(); }
   [[nodiscard]] std::size_t size() const { return pairs_.size(); }
   /// The pair with the highest key. Only when not empty.
   [[nodiscard]] const Pair& top() const { return pairs_.front(); }
-  [[nodiscard]] std::size_t capacity() const { return pairs_.capacity(); }
-  /// Room for `n` pairs; only while empty. Reserved in a fresh vector and swapped in: GCC 12 sees the
-  /// vector's own reserve read the storage it has just freed (-Wuse-after-free, a false positive) once a
-  /// traversal's hooks inline around it.
-  void reserve_empty(std::size_t n) {
-    std::vector<Pair> room;
-    room.reserve(n);
-    pairs_.swap(room);
-  }
 
   void push(const Pair& p) {
     std::size_t hole = pairs_.size();
@@ -75,7 +67,7 @@ class FourAryHeap {
     return highest;
   }
 
-  std::vector<Pair> pairs_;
+  Storage pairs_;
 };
 
 }  // namespace bvhlab

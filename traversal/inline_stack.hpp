@@ -1,7 +1,7 @@
 // A stack of plain pairs that keeps its first N in place (in the walk's own frame) and moves to the heap only
 // past them. A depth-first walk seldom holds more than a few dozen pairs, and a heap block reserved per query
 // cost as much as the whole of a query decided at its root pair (bench/RESULTS.md, "The walk's stack in
-// place").
+// place"). The best-first queue's four-ary heap keeps its pairs in one too.
 #pragma once
 
 #include <cstddef>
@@ -24,8 +24,11 @@ class InlineStack {
 
   [[nodiscard]] bool empty() const { return size_ == 0; }
   [[nodiscard]] std::size_t size() const { return size_; }
+  [[nodiscard]] const T& front() const { return data_[0]; }
   [[nodiscard]] const T& back() const { return data_[size_ - 1]; }
   [[nodiscard]] const T& operator[](std::size_t i) const { return data_[i]; }
+  [[nodiscard]] T& operator[](std::size_t i) { return data_[i]; }
+  [[nodiscard]] const T* data() const { return data_; }
   [[gnu::always_inline]] void push_back(const T& item) {
     if (size_ == capacity_) [[unlikely]]
       grow();

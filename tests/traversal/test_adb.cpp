@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 namespace bvhlab {
@@ -253,6 +255,23 @@ TEST(AdbModel, DifferentSizesMapOntoTheRulesCells) {
       EXPECT_DOUBLE_EQ(model.estimate<kAdbPaperRule>(cube(1), cube(2), 1.0, pa, pb),
                        model.estimate<kAdbPaperRule>(cube(2), cube(1), 1.0, pb, pa));
     }
+}
+
+// The overlap's cell count s is rounded up (less 1e-9 of slack), into [1, g^3]: the estimate then reads the
+// table's layer s, interpolating between the entries around the expected counts.
+TEST(AdbModel, TheOverlapsCellCountRoundsUp) {
+  const AdbModel model(2, 0.5);
+  const auto& table = model.table();
+  for (const double overlap : {0.3, 1.5, 2.0, 2.0 + 1e-12, 2.0 + 1e-6, 2.0 - 1e-6, 5.0 - 1e-10, 7.999}) {
+    // Equal full cubes of volume 8 (cells of volume 1): s_real = overlap, s_a = s_b = overlap, capped at s.
+    const int s = std::clamp(static_cast<int>(std::ceil(overlap - 1e-9)), 1, 8);
+    const double x = std::min(overlap, double(s));
+    const int lo = static_cast<int>(x), hi = std::min(lo + 1, s);
+    const double f = x - lo;
+    const double expected = (1 - f) * ((1 - f) * table.lookup(s, lo, lo) + f * table.lookup(s, lo, hi)) +
+                            f * ((1 - f) * table.lookup(s, hi, lo) + f * table.lookup(s, hi, hi));
+    EXPECT_DOUBLE_EQ(model.estimate(cube(2), cube(2), overlap, 8, 8), expected) << "overlap " << overlap;
+  }
 }
 
 TEST(AdbModel, AnEmptyCountIsZeroOnlyUnderThePapersRule) {

@@ -56,6 +56,7 @@ TEST(QueuePolicies, TakeInTheirOrder) {
 
 // The four-ary heap and the best-first queue around it give back the highest key at every pop, against
 // std::priority_queue on random pushes and pops (heaps of every fill, the last group of children partial).
+// The queue's heap keeps its first pairs in place (an InlineStack): it moves to the heap and grows there.
 TEST(QueuePolicies, BestFirstTakesTheHighestKeyAsABinaryHeapWould) {
   struct Keyed {
     double key;
