@@ -74,20 +74,18 @@ class ProbabilityTable {
   /// Hot path. Precondition (asserted in debug builds only): 0 <= s_a, s_b <= s <= s_max().
   [[nodiscard]] double lookup(int s, int s_a, int s_b) const noexcept {
     assert(s >= 0 && s <= s_max_ && s_a >= 0 && s_a <= s && s_b >= 0 && s_b <= s);
-    const auto [lo, hi] = std::minmax(s_a, s_b);
-    return values_[index(s, hi, lo)];
+    return at(layer(s), s_a, s_b);
   }
 
-  /// The entries of one s, for several lookups at the same s (AdbModel's interpolation): at(layer, ...)
-  /// reads what lookup(s, ...) does. Precondition as lookup's.
+  /// The entries of one s, for several lookups at the same s (AdbModel's interpolation): at(layer(s), ...)
+  /// is lookup(s, ...). Precondition as lookup's.
   [[nodiscard]] const double* layer(int s) const noexcept {
     assert(s >= 0 && s <= s_max_);
-    return values_.data() + index(s, 0, 0);
+    return values_.data() + layer_start(s);
   }
   [[nodiscard]] static double at(const double* layer, int s_a, int s_b) noexcept {
     const auto [lo, hi] = std::minmax(s_a, s_b);
-    const auto hu = static_cast<std::size_t>(hi);
-    return layer[hu * (hu + 1) / 2 + static_cast<std::size_t>(lo)];
+    return layer[in_layer(hi, lo)];
   }
 
   /// Checked query. Inside the table it returns lookup(); for s > s_max it computes the estimate directly
@@ -98,11 +96,15 @@ class ProbabilityTable {
 
  private:
   // Layer s starts at the tetrahedral number s(s+1)(s+2)/6; inside it, row hi holds hi + 1 entries.
-  static std::size_t index(int s, int hi, int lo) noexcept {
+  static std::size_t layer_start(int s) noexcept {
     const auto su = static_cast<std::size_t>(s);
-    const auto hu = static_cast<std::size_t>(hi);
-    return su * (su + 1) * (su + 2) / 6 + hu * (hu + 1) / 2 + static_cast<std::size_t>(lo);
+    return su * (su + 1) * (su + 2) / 6;
   }
+  static std::size_t in_layer(int hi, int lo) noexcept {
+    const auto hu = static_cast<std::size_t>(hi);
+    return hu * (hu + 1) / 2 + static_cast<std::size_t>(lo);
+  }
+  static std::size_t index(int s, int hi, int lo) noexcept { return layer_start(s) + in_layer(hi, lo); }
 
   int s_max_;
   double lb_;
